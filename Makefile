@@ -1,0 +1,45 @@
+# make demo / make test / make bench: each creates .venv when absent.
+SHELL := /bin/bash
+VENV := .venv
+PY := $(VENV)/bin/python
+MPIEXEC := $(VENV)/bin/mpiexec
+# First Python >= 3.12 found: python3.12 on PATH, then pyenv's, then python3.
+PYTHON ?= $(shell for p in python3.12 $$HOME/.pyenv/versions/3.12*/bin/python3.12 python3.13 python3; do \
+	$$p -c 'import sys; assert sys.version_info >= (3, 12)' >/dev/null 2>&1 && { echo $$p; break; }; done)
+
+.PHONY: demo test test-serial test-mpi test-notebooks bench lint clean
+
+$(VENV)/.installed: pyproject.toml
+	@test -n "$(PYTHON)" || { echo "error: no Python >= 3.12 found (set PYTHON=...)"; exit 1; }
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[test]'
+	touch $@
+
+demo: $(VENV)/.installed
+	$(PY) demos/inclusion_contact.py
+
+test: $(VENV)/.installed
+	$(MAKE) test-serial
+	$(MAKE) test-mpi
+	$(MAKE) test-notebooks
+
+test-serial: $(VENV)/.installed
+	$(PY) -m pytest -q tests
+
+test-mpi: $(VENV)/.installed
+	$(MPIEXEC) -n 2 $(PY) -m pytest -q -m mpi -p no:cacheprovider tests
+
+test-notebooks: $(VENV)/.installed
+	@if ls notebooks/*.ipynb >/dev/null 2>&1; then \
+		$(PY) -m pytest -q --nbmake notebooks; \
+	else echo "no notebooks yet"; fi
+
+bench: $(VENV)/.installed
+	$(PY) bench/quadrature.py
+
+lint: $(VENV)/.installed
+	$(VENV)/bin/ruff check xfem_contact tests demos bench
+
+clean:
+	rm -rf $(VENV) build *.egg-info

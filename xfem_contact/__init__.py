@@ -1,0 +1,18 @@
+"""xfem_contact: X-FEM contact mechanics with quadratic elements on curved interfaces.
+
+A FEniCSx (DOLFINx 0.11) plugin. Import it before or after ``dolfinx``: the
+PyPI wheel ``dolfinx-solver-real`` needs ``dolfinx_solver`` imported first, which
+is done here when that wheel is installed.
+"""
+
+try:  # The PyPI wheel loads its MPI/PETSc libraries through this module.
+    import dolfinx_solver  # noqa: F401
+except ImportError:  # conda/apt DOLFINx: nothing to do
+    pass
+
+__version__ = "0.1.0"
+
+from xfem_contact.forms import form  # noqa: E402
+from xfem_contact.runtime import CellRules  # noqa: E402
+
+__all__ = ["CellRules", "form"]

@@ -1,0 +1,5 @@
+"""Expression code generation: FFCx's C generator, unchanged."""
+
+from ffcx.codegeneration.C.expression import generator
+
+__all__ = ["generator"]

@@ -1,0 +1,195 @@
+"""Turn UFL forms with cut-cell measures into DOLFINx forms.
+
+Measures whose ``subdomain_data`` provides ``integration_parts(subdomain_id)``
+(:class:`~xfem_contact.runtime.CellRules`, :class:`~xfem_contact.cutmesh.CutMesh`)
+are rewritten into a standard cell integral over the cells their part covers
+with the standard rule, and a runtime integral (integrand times the marker) over
+the cells with per-cell rules. Forms are compiled once per signature with the
+:mod:`xfem_contact.codegen` back end and re-created cheaply for new rules.
+"""
+
+from __future__ import annotations
+
+import collections.abc
+import typing
+
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import ufl
+from dolfinx.fem import IntegralType
+from dolfinx.fem.forms import compile_form, create_form, get_integration_domains
+from ffcx.analysis import analyze_ufl_objects
+from ffcx.ir.representation import compute_ir
+from ffcx.options import get_options
+
+from xfem_contact.codegen import LANGUAGE
+from xfem_contact.codegen.tables import RuntimeIntegral, runtime_integral
+from xfem_contact.runtime import CellRules
+
+_STANDARD_ID0 = 1000
+_RUNTIME_ID0 = 2000
+_TYPES = {
+    "cell": IntegralType.cell,
+    "exterior_facet": IntegralType.exterior_facet,
+    "interior_facet": IntegralType.interior_facet,
+    "vertex": IntegralType.vertex,
+}
+
+
+class _Compiled(typing.NamedTuple):
+    form: dolfinx.fem.CompiledForm
+    kernels: dict[int, RuntimeIntegral]
+
+
+_cache: dict[tuple, _Compiled] = {}
+
+
+def _is_cut_source(data) -> bool:
+    return hasattr(data, "integration_parts")
+
+
+class _Rewrite(typing.NamedTuple):
+    form: ufl.Form
+    cell_domains: list[tuple[int, np.ndarray]]
+    rules: dict[int, CellRules]
+
+
+def _rewrite(ufl_form: ufl.Form) -> _Rewrite:
+    """Split every cut-cell integral into a standard and a runtime integral."""
+    sources = {}
+    for itg in ufl_form.integrals():
+        data = itg.subdomain_data()
+        if _is_cut_source(data):
+            if itg.integral_type() != "cell":
+                raise ValueError(f"Cut-cell rules serve cell integrals, not {itg.integral_type()}")
+            sources[(data.id, itg.subdomain_id())] = (data, itg.subdomain_id())
+        elif itg.integral_type() == "cell" and data is not None and sources is not None:
+            foreign = data
+            if any(_is_cut_source(i.subdomain_data()) for i in ufl_form.integrals()):
+                raise ValueError(
+                    "A form cannot mix cut-cell measures with dx measures carrying other "
+                    f"subdomain data ({type(foreign).__name__}); use plain ufl.dx or the cut measures"
+                )
+    index = {key: k for k, key in enumerate(sorted(sources))}
+    integrals, cell_domains, rules = [], {}, {}
+    for itg in ufl_form.integrals():
+        data = itg.subdomain_data()
+        if not _is_cut_source(data):
+            integrals.append(itg)
+            continue
+        k = index[(data.id, itg.subdomain_id())]
+        standard, runtime = data.integration_parts(itg.subdomain_id())
+        if standard is not None:
+            sid = _STANDARD_ID0 + k
+            cell_domains[sid] = np.asarray(standard, dtype=np.int32)
+            integrals.append(itg.reconstruct(subdomain_id=sid, subdomain_data=None))
+        if runtime is not None:
+            sid = _RUNTIME_ID0 + k
+            cell_domains[sid] = runtime.cells
+            rules[sid] = runtime
+            integrand = itg.integrand() * runtime.marker
+            integrals.append(
+                itg.reconstruct(integrand=integrand, subdomain_id=sid, subdomain_data=None)
+            )
+    return _Rewrite(ufl.Form(integrals), sorted(cell_domains.items()), rules)
+
+
+def _runtime_kernels(ufl_form: ufl.Form, options: dict, cell) -> dict[int, RuntimeIntegral]:
+    """Runtime-table layout of each runtime cell integral, by subdomain id."""
+    analysis = analyze_ufl_objects([ufl_form], options["scalar_type"])
+    ir = compute_ir(analysis, {}, "", options, False)
+    by_name = {integral.expression.name: integral for integral in ir.integrals}
+    (form_ir,) = ir.forms
+    kernels = {}
+    for name, sid in zip(form_ir.integral_names["cell"], form_ir.subdomain_ids["cell"]):
+        kernel = runtime_integral(by_name[name].expression, cell)
+        if kernel is not None:
+            kernels[sid] = kernel
+    return kernels
+
+
+def _compile(comm, ufl_form: ufl.Form, options: dict, jit_options: dict | None) -> _Compiled:
+    key = (ufl_form.signature(), tuple(sorted((k, str(v)) for k, v in options.items())),
+           str(jit_options), comm.size)
+    if key not in _cache:
+        compiled = compile_form(comm, ufl_form, form_compiler_options=options,
+                                jit_options=jit_options)
+        cell = ufl_form.ufl_domain().ufl_coordinate_element().cell_type
+        kernels = _runtime_kernels(ufl_form, get_options(options), cell)
+        _cache[key] = _Compiled(compiled, kernels)
+    return _cache[key]
+
+
+def _other_domains(ufl_form: ufl.Form, ids: dict[str, list[int]]) -> dict:
+    """Integration entities of the non-rewritten integral types (as dolfinx.fem.form does)."""
+    domain = ufl_form.ufl_domain()
+    data = ufl_form.subdomain_data().get(domain, {})
+    out = {}
+    for name, itype in _TYPES.items():
+        if name == "cell":
+            continue
+        sd = [d for d in data.get(name, []) if d is not None]
+        out[itype] = get_integration_domains(itype, sd[0] if sd else None, ids.get(name, []))
+    return out
+
+
+def form(
+    ufl_form: ufl.Form | collections.abc.Iterable,
+    form_compiler_options: dict | None = None,
+    jit_options: dict | None = None,
+):
+    """Create a DOLFINx form from a UFL form that may use cut-cell measures.
+
+    Collective. The form is compiled once per UFL signature (FFCx with the
+    :mod:`xfem_contact.codegen` back end) and bound to the *current* rules of
+    its measures: after :meth:`CutMesh.update`, call :func:`form` again (cheap)
+    to integrate on the new cut. The returned form keeps its rules alive.
+
+    Args:
+        ufl_form: A UFL form, or a (nested) list of them.
+        form_compiler_options: FFCx options (``scalar_type`` defaults to
+            ``dolfinx.default_scalar_type``; ``language`` is set here).
+        jit_options: DOLFINx JIT options.
+
+    Returns:
+        A :class:`dolfinx.fem.Form` (or a nested list of them) for
+        ``dolfinx.fem.assemble_*`` and ``dolfinx.fem.petsc``.
+    """
+    if not isinstance(ufl_form, ufl.Form):
+        if isinstance(ufl_form, collections.abc.Iterable):
+            return [form(f, form_compiler_options, jit_options) for f in ufl_form]
+        return ufl_form
+    options = {"scalar_type": dolfinx.default_scalar_type, **(form_compiler_options or {})}
+    options["language"] = LANGUAGE
+    rewrite = _rewrite(ufl_form)
+    domain = ufl_form.ufl_domain()
+    mesh = dolfinx.mesh.Mesh(domain.ufl_cargo(), domain)
+    compiled = _compile(mesh.comm, rewrite.form, options, jit_options)
+
+    ffcx_options = get_options(options)
+    for sid, rules in rewrite.rules.items():
+        rules.register(compiled.kernels[sid], domain.ufl_cell(),
+                       ffcx_options["table_rtol"], ffcx_options["table_atol"])
+
+    ufcx = compiled.form.ufcx_form
+    offsets = [ufcx.form_integral_offsets[i] for i in range(len(IntegralType) + 1)]
+    ids: dict[str, list[int]] = {}
+    for itype in IntegralType:
+        if itype.value + 1 < len(offsets):
+            ids[itype.name] = [ufcx.form_integral_ids[j]
+                               for j in range(offsets[itype.value], offsets[itype.value + 1])]
+    subdomains = _other_domains(rewrite.form, ids)
+    subdomains[IntegralType.cell] = [(sid, cells) for sid, cells in rewrite.cell_domains]
+
+    compiled_coeffs = ufl.algorithms.extract_coefficients(compiled.form.ufl_form)
+    coeffs = ufl.algorithms.extract_coefficients(rewrite.form)
+    consts_c = ufl.algorithms.analysis.extract_constants(compiled.form.ufl_form)
+    consts = ufl.algorithms.analysis.extract_constants(rewrite.form)
+    spaces = [arg.ufl_function_space() for arg in rewrite.form.arguments()]
+    result = create_form(
+        compiled.form, spaces, mesh, subdomains,
+        dict(zip(compiled_coeffs, coeffs)), dict(zip(consts_c, consts)),
+    )
+    result._xfem_rules = list(rewrite.rules.values())
+    return result
