@@ -49,6 +49,11 @@ def _is_cut_source(data) -> bool:
     return hasattr(data, "integration_parts")
 
 
+def _source_key(data, integral) -> tuple[str, int, int]:
+    """Deterministic order of the cut-cell measures of a form (so of its signature)."""
+    return (type(data).__name__, data.id, integral.subdomain_id())
+
+
 class _Rewrite(typing.NamedTuple):
     form: ufl.Form
     cell_domains: list[tuple[int, np.ndarray]]
@@ -63,7 +68,7 @@ def _rewrite(ufl_form: ufl.Form) -> _Rewrite:
         if _is_cut_source(data):
             if itg.integral_type() != "cell":
                 raise ValueError(f"Cut-cell rules serve cell integrals, not {itg.integral_type()}")
-            sources[(data.id, itg.subdomain_id())] = (data, itg.subdomain_id())
+            sources[_source_key(data, itg)] = (data, itg.subdomain_id())
         elif itg.integral_type() == "cell" and data is not None and sources is not None:
             foreign = data
             if any(_is_cut_source(i.subdomain_data()) for i in ufl_form.integrals()):
@@ -78,7 +83,7 @@ def _rewrite(ufl_form: ufl.Form) -> _Rewrite:
         if not _is_cut_source(data):
             integrals.append(itg)
             continue
-        k = index[(data.id, itg.subdomain_id())]
+        k = index[_source_key(data, itg)]
         standard, runtime = data.integration_parts(itg.subdomain_id())
         if standard is not None:
             sid = _STANDARD_ID0 + k

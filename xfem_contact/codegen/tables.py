@@ -87,7 +87,7 @@ def runtime_integral(expression_ir, domain) -> RuntimeIntegral | None:
         element, avg, derivatives, component = get_modified_terminal_element(mt)
         if avg is not None:
             raise NotImplementedError("Cell/facet averages inside runtime integrals")
-        cell = mt.terminal.ufl_domain().ufl_cell()
+        cell = ufl.domain.extract_unique_domain(mt.terminal).ufl_cell()
         codim = cell.topological_dimension - element.cell.topological_dimension
         spec = TableSpec(
             tr.name, element, avg, tuple(derivatives), component, codim, tr.values.shape[-1]

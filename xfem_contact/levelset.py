@@ -1,0 +1,138 @@
+"""Level sets on a mesh: interpolation, per-cell nodal values, and maps between
+reference and physical coordinates evaluated per point (vectorised over cells).
+"""
+
+from __future__ import annotations
+
+import typing
+from collections.abc import Callable
+
+import basix
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+
+#: A level set given as a function of physical points ``x`` of shape
+#: ``(gdim, n)`` (or ``(3, n)`` as DOLFINx passes them) returning ``(n,)``.
+LevelSetCallable = Callable[[np.ndarray], np.ndarray]
+
+
+class LevelSet(typing.NamedTuple):
+    """A level set interpolated into Lagrange degree 1 or 2.
+
+    Attributes:
+        function: The interpolant ``phi_h`` (scalar Lagrange, degree 1 or 2).
+        exact: The callable it was interpolated from, or ``None`` when given
+            only as nodal values (a DOLFINx Function).
+    """
+
+    function: dolfinx.fem.Function
+    exact: LevelSetCallable | None
+
+    @property
+    def degree(self) -> int:
+        return self.function.function_space.ufl_element().embedded_superdegree
+
+
+def interpolate(
+    mesh: dolfinx.mesh.Mesh,
+    levelset: LevelSetCallable | dolfinx.fem.Function,
+    degree: int,
+) -> LevelSet:
+    """Interpolate a level set into scalar Lagrange of ``degree`` (1 or 2). Collective.
+
+    Args:
+        mesh: The mesh.
+        levelset: A callable ``phi(x)`` with ``x`` of shape ``(3, n)``, or a
+            scalar DOLFINx Function on ``mesh`` (its nodal values are the data).
+        degree: 1 or 2.
+
+    Raises:
+        ValueError: for a degree other than 1 or 2, NaN/inf values, or a level
+            set that does not change sign on the mesh (no interface).
+    """
+    if degree not in (1, 2):
+        raise ValueError(f"Level-set degree must be 1 or 2, got {degree}")
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree))
+    phi = dolfinx.fem.Function(V, name="levelset")
+    if isinstance(levelset, dolfinx.fem.Function):
+        if levelset.function_space.mesh is not mesh:
+            raise ValueError("The level-set Function lives on another mesh")
+        if levelset.function_space.value_size != 1:
+            raise ValueError("The level-set Function must be scalar")
+        phi.interpolate(levelset)
+        exact = None
+    elif callable(levelset):
+        phi.interpolate(lambda x: np.asarray(levelset(x), dtype=np.float64))
+        exact = levelset
+    else:
+        raise ValueError(f"A level set is a callable or a dolfinx Function, not {type(levelset)}")
+    values = phi.x.array
+    bad = np.flatnonzero(~np.isfinite(values))
+    comm = mesh.comm
+    if comm.allreduce(bad.size, op=MPI.SUM):
+        where = V.tabulate_dof_coordinates()[bad[:1]] if bad.size else None
+        raise ValueError(f"The level set has NaN/inf values (first at x = {where})")
+    lo = comm.allreduce(values.min(initial=np.inf), op=MPI.MIN)
+    hi = comm.allreduce(values.max(initial=-np.inf), op=MPI.MAX)
+    if not (lo < 0.0 <= hi):
+        raise ValueError(
+            f"The level set never crosses zero on the mesh (its nodal values lie in "
+            f"[{lo:.6g}, {hi:.6g}]): there is no interface; the side phi < 0 is side -1"
+        )
+    return LevelSet(phi, exact)
+
+
+class CellMaps:
+    """Evaluate geometry and level-set data at reference points of given cells.
+
+    All methods take ``cells`` (m,) local cell indices and ``X`` (m, tdim)
+    reference points, one point per row, and are vectorised.
+    """
+
+    def __init__(self, mesh: dolfinx.mesh.Mesh, levelset: LevelSet):
+        self.mesh = mesh
+        cmap = mesh.geometry.cmap
+        self._cmap = basix.create_element(
+            basix.ElementFamily.P, mesh.basix_cell(), cmap.degree, cmap.variant
+        )
+        self._gdim = mesh.geometry.dim
+        self._geom = mesh.geometry.x[mesh.geometry.dofmap, : self._gdim]
+        space = levelset.function.function_space
+        self._phi_element = space.element.basix_element
+        self._phi = levelset.function.x.array[space.dofmap.list]
+        self._exact = levelset.exact
+
+    def nodal_values(self, cells: npt.NDArray[np.int32]) -> npt.NDArray[np.float64]:
+        """Level-set nodal values in basix order, shape ``(len(cells), ndofs)``."""
+        return self._phi[cells]
+
+    def push_forward(self, cells, X) -> npt.NDArray[np.float64]:
+        """Physical points ``x = F_cell(X)``, shape ``(m, gdim)``."""
+        basis = self._cmap.tabulate(0, X)[0, :, :, 0]
+        return np.einsum("pi,pid->pd", basis, self._geom[cells])
+
+    def jacobian(self, cells, X) -> npt.NDArray[np.float64]:
+        """Jacobians ``dx/dX`` of the cell maps, shape ``(m, gdim, tdim)``."""
+        tab = self._cmap.tabulate(1, X)[1:, :, :, 0]  # (tdim, m, ndofs)
+        return np.einsum("kpi,pid->pdk", tab, self._geom[cells])
+
+    def grad_ref(self, cells, X) -> npt.NDArray[np.float64]:
+        """Reference gradient of the interpolated level set, shape ``(m, tdim)``."""
+        tab = self._phi_element.tabulate(1, X)[1:, :, :, 0]
+        return np.einsum("kpi,pi->pk", tab, self._phi[cells])
+
+    def exact(self, cells) -> Callable | None:
+        """The exact level set as a function of ``(rows, X)`` for the given cells, if known."""
+        if self._exact is None:
+            return None
+
+        def phi(rows: np.ndarray, X: np.ndarray) -> np.ndarray:
+            x = self.push_forward(cells[rows], X)
+            x3 = np.zeros((3, x.shape[0]))
+            x3[: self._gdim] = x.T
+            return np.asarray(self._exact(x3), dtype=np.float64)
+
+        return phi
