@@ -1,0 +1,117 @@
+"""Cut-cell integration through UFL forms against exact geometry."""
+
+import dolfinx.fem
+import numpy as np
+import pytest
+import ufl
+from conftest import unit_square
+from dolfinx.fem import assemble_scalar
+from mpi4py import MPI
+
+import xfem_contact
+from xfem_contact import moment_fitting
+
+CENTRE, RADIUS = np.array([0.51, 0.47]), 0.3
+
+
+def distance(x):
+    """Signed distance to the circle (not a polynomial)."""
+    return np.hypot(x[0] - CENTRE[0], x[1] - CENTRE[1]) - RADIUS
+
+
+def integrate(expr_measure):
+    form = xfem_contact.form(expr_measure)
+    return form.mesh.comm.allreduce(assemble_scalar(form), op=MPI.SUM)
+
+
+def one(mesh):
+    return dolfinx.fem.Constant(mesh, 1.0)
+
+
+def disc_errors(cell, distorted, degree, as_function, sizes):
+    errors = []
+    for n in sizes:
+        mesh = unit_square(n, cell, distorted)
+        levelset = distance
+        if as_function:
+            levelset = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", degree)))
+            levelset.interpolate(distance)
+        cut = xfem_contact.CutMesh(mesh, levelset, degree=degree)
+        c = one(mesh)
+        inside, outside = integrate(c * cut.dx(-1)), integrate(c * cut.dx(1))
+        length = integrate(c * cut.dGamma)
+        assert abs(inside + outside - 1.0) < 1e-12
+        errors.append((abs(inside - np.pi * RADIUS**2), abs(length - 2 * np.pi * RADIUS)))
+    return np.array(errors)
+
+
+def rate(sizes, errors):
+    """Least-squares slope of log(error) against log(h)."""
+    return -np.polyfit(np.log(sizes), np.log(errors), 1)[0]
+
+
+SIZES = [8, 16, 32, 64, 128, 256]
+
+
+@pytest.mark.parametrize(
+    "degree, as_function, min_rate",
+    [(1, False, 1.9), (2, False, 3.5), (2, True, 2.8)],
+    ids=["degree1", "degree2-callable", "degree2-function"],
+)
+@pytest.mark.parametrize(
+    "cell, distorted",
+    [("quadrilateral", False), ("quadrilateral", True), ("triangle", False)],
+    ids=["quad", "distorted-quad", "triangle"],
+)
+def test_disc_area_and_circle_length_rates(cell, distorted, degree, as_function, min_rate):
+    errors = disc_errors(cell, distorted, degree, as_function, SIZES)
+    area_rate, length_rate = rate(SIZES, errors[:, 0]), rate(SIZES, errors[:, 1])
+    print(f"\n{cell} distorted={distorted} degree={degree} function={as_function}")
+    for n, (ea, el) in zip(SIZES, errors):
+        print(f"  N={n:4d}  area error {ea:.3e}  length error {el:.3e}")
+    print(f"  rates: area {area_rate:.2f}, length {length_rate:.2f} (required {min_rate})")
+    assert area_rate >= min_rate
+    assert length_rate >= min_rate
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("degree", [1, 2])
+def test_straight_interface_exact(cell, degree):
+    """A straight interface: areas, a polynomial integral and the length exact."""
+    mesh = unit_square(5, cell, distorted=False)
+    a, b, c0 = 0.3, 1.0, -0.61  # phi = a x + b y + c0: the line y = 0.61 - 0.3 x
+    cut = xfem_contact.CutMesh(mesh, lambda x: a * x[0] + b * x[1] + c0, degree=degree)
+    x = ufl.SpatialCoordinate(mesh)
+    c = one(mesh)
+    below = integrate(c * cut.dx(-1))
+    assert below == pytest.approx(0.61 - 0.15, abs=1e-13)
+    assert integrate(c * cut.dGamma) == pytest.approx(np.hypot(1.0, a), abs=1e-13)
+    # int_{below} x^2 y dx dy with y < 0.61 - 0.3 x
+    exact = sum(
+        k * v for k, v in [(0.61**2 / 2 / 3, 1), (-2 * 0.61 * 0.3 / 2 / 4, 1), (0.09 / 2 / 5, 1)]
+    )
+    assert integrate(x[0] ** 2 * x[1] * cut.dx(-1)) == pytest.approx(exact, abs=1e-13)
+    n = cut.normal
+    # The normal points from side -1 to side +1: (a, b)/|(a, b)|
+    nx = integrate(n[0] * cut.dGamma) / np.hypot(1.0, a)
+    assert nx == pytest.approx(a / np.hypot(a, b), abs=1e-13)
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+def test_runtime_rules_match_moment_fitting(cell, degree):
+    """Runtime rules equal the moment-fitting oracle for polynomials on affine cells."""
+    mesh = unit_square(6, cell, distorted=False)
+    cut = xfem_contact.CutMesh(mesh, distance, degree=degree, quadrature_degree=8)
+    x = ufl.SpatialCoordinate(mesh)
+    integrand = 1 + x[0] ** 3 - 2 * x[0] * x[1] ** 2 + x[1] ** 4
+    for side in (-1, 1):
+        rules = cut.rules[1 if side == -1 else 2]
+        weight, measure = moment_fitting.measure_and_weight(mesh, cut.cut_cells, rules, 4)
+        oracle = mesh.comm.allreduce(
+            assemble_scalar(dolfinx.fem.form(integrand * weight * measure)), op=MPI.SUM
+        )
+        runtime_only = xfem_contact.CellRules(
+            mesh, cut.cut_cells, rules.points, rules.weights, rules.offsets
+        )
+        runtime = integrate(integrand * runtime_only.measure())
+        assert runtime == pytest.approx(oracle, abs=1e-12)
