@@ -67,7 +67,7 @@ def test_disc_area_and_circle_length_rates(cell, distorted, degree, as_function,
     errors = disc_errors(cell, distorted, degree, as_function, SIZES)
     area_rate, length_rate = rate(SIZES, errors[:, 0]), rate(SIZES, errors[:, 1])
     print(f"\n{cell} distorted={distorted} degree={degree} function={as_function}")
-    for n, (ea, el) in zip(SIZES, errors):
+    for n, (ea, el) in zip(SIZES, errors, strict=False):
         print(f"  N={n:4d}  area error {ea:.3e}  length error {el:.3e}")
     print(f"  rates: area {area_rate:.2f}, length {length_rate:.2f} (required {min_rate})")
     assert area_rate >= min_rate

@@ -19,7 +19,10 @@ def standard_rules(mesh):
     ncell = mesh.topology.index_map(2).size_local
     X, W = basix.make_quadrature(mesh.basix_cell(), DEGREE)
     return xfem_contact.CellRules(
-        mesh, np.arange(ncell), np.tile(X, (ncell, 1)), np.tile(W, ncell),
+        mesh,
+        np.arange(ncell),
+        np.tile(X, (ncell, 1)),
+        np.tile(W, ncell),
         np.arange(ncell + 1) * W.size,
     )
 

@@ -54,50 +54,70 @@ def _source_key(data, integral) -> tuple[str, int, int]:
     return (type(data).__name__, data.id, integral.subdomain_id())
 
 
+def _integral(itg: ufl.Integral, integrand, integral_type: str, sid: int) -> ufl.Integral:
+    """``itg`` with a new integrand, type and id, and no subdomain data."""
+    return ufl.Integral(integrand, integral_type, itg.ufl_domain(), sid, itg.metadata(), None)
+
+
 class _Rewrite(typing.NamedTuple):
     form: ufl.Form
-    cell_domains: list[tuple[int, np.ndarray]]
+    domains: dict[str, list[tuple[int, np.ndarray]]]
     rules: dict[int, CellRules]
 
 
 def _rewrite(ufl_form: ufl.Form) -> _Rewrite:
-    """Split every cut-cell integral into a standard and a runtime integral."""
-    sources = {}
-    for itg in ufl_form.integrals():
-        data = itg.subdomain_data()
-        if _is_cut_source(data):
-            if itg.integral_type() != "cell":
-                raise ValueError(f"Cut-cell rules serve cell integrals, not {itg.integral_type()}")
-            sources[_source_key(data, itg)] = (data, itg.subdomain_id())
-        elif itg.integral_type() == "cell" and data is not None and sources is not None:
-            foreign = data
-            if any(_is_cut_source(i.subdomain_data()) for i in ufl_form.integrals()):
+    """Split every cut integral into its standard and runtime parts."""
+    ours = [i for i in ufl_form.integrals() if _is_cut_source(i.subdomain_data())]
+    if ours:
+        for itg in ufl_form.integrals():
+            data = itg.subdomain_data()
+            if (
+                not _is_cut_source(data)
+                and data is not None
+                and itg.integral_type() in ("cell", *{i.integral_type() for i in ours})
+            ):
                 raise ValueError(
-                    "A form cannot mix cut-cell measures with dx measures carrying other "
-                    f"subdomain data ({type(foreign).__name__}); use plain ufl.dx or the cut measures"
+                    f"A form cannot mix cut measures with {itg.integral_type()} measures "
+                    f"carrying other subdomain data ({type(data).__name__}); use the plain "
+                    "measure (no subdomain data) or the cut measures"
                 )
-    index = {key: k for k, key in enumerate(sorted(sources))}
-    integrals, cell_domains, rules = [], {}, {}
+    keys = sorted({_source_key(i.subdomain_data(), i) for i in ours})
+    parts = {}
+    for key in keys:
+        itg = next(i for i in ours if _source_key(i.subdomain_data(), i) == key)
+        parts[key] = list(itg.subdomain_data().integration_parts(itg.subdomain_id()))
+    ids, next_standard, next_runtime = {}, _STANDARD_ID0, _RUNTIME_ID0
+    for key in keys:
+        for j, part in enumerate(parts[key]):
+            if part.rules is None:
+                ids[key, j], next_standard = next_standard, next_standard + 1
+            else:
+                ids[key, j], next_runtime = next_runtime, next_runtime + 1
+
+    integrals, domains, rules = [], {}, {}
     for itg in ufl_form.integrals():
         data = itg.subdomain_data()
         if not _is_cut_source(data):
             integrals.append(itg)
             continue
-        k = index[_source_key(data, itg)]
-        standard, runtime = data.integration_parts(itg.subdomain_id())
-        if standard is not None:
-            sid = _STANDARD_ID0 + k
-            cell_domains[sid] = np.asarray(standard, dtype=np.int32)
-            integrals.append(itg.reconstruct(subdomain_id=sid, subdomain_data=None))
-        if runtime is not None:
-            sid = _RUNTIME_ID0 + k
-            cell_domains[sid] = runtime.cells
-            rules[sid] = runtime
-            integrand = itg.integrand() * runtime.marker
-            integrals.append(
-                itg.reconstruct(integrand=integrand, subdomain_id=sid, subdomain_data=None)
-            )
-    return _Rewrite(ufl.Form(integrals), sorted(cell_domains.items()), rules)
+        key = _source_key(data, itg)
+        for j, part in enumerate(parts[key]):
+            sid = ids[key, j]
+            if part.rules is None:
+                domains.setdefault(part.integral_type, {})[sid] = part.entities
+                integrals.append(_integral(itg, itg.integrand(), part.integral_type, sid))
+            else:
+                integrand = itg.integrand()
+                if part.replace:
+                    integrand = ufl.replace(integrand, part.replace)
+                domains.setdefault("cell", {})[sid] = part.rules.cells
+                rules[sid] = part.rules
+                integrals.append(_integral(itg, integrand * part.rules.marker, "cell", sid))
+    return _Rewrite(
+        ufl.Form(integrals),
+        {t: sorted(d.items()) for t, d in domains.items()},
+        rules,
+    )
 
 
 def _runtime_kernels(ufl_form: ufl.Form, options: dict, cell) -> dict[int, RuntimeIntegral]:
@@ -107,7 +127,9 @@ def _runtime_kernels(ufl_form: ufl.Form, options: dict, cell) -> dict[int, Runti
     by_name = {integral.expression.name: integral for integral in ir.integrals}
     (form_ir,) = ir.forms
     kernels = {}
-    for name, sid in zip(form_ir.integral_names["cell"], form_ir.subdomain_ids["cell"]):
+    for name, sid in zip(
+        form_ir.integral_names["cell"], form_ir.subdomain_ids["cell"], strict=False
+    ):
         kernel = runtime_integral(by_name[name].expression, cell)
         if kernel is not None:
             kernels[sid] = kernel
@@ -115,11 +137,16 @@ def _runtime_kernels(ufl_form: ufl.Form, options: dict, cell) -> dict[int, Runti
 
 
 def _compile(comm, ufl_form: ufl.Form, options: dict, jit_options: dict | None) -> _Compiled:
-    key = (ufl_form.signature(), tuple(sorted((k, str(v)) for k, v in options.items())),
-           str(jit_options), comm.size)
+    key = (
+        ufl_form.signature(),
+        tuple(sorted((k, str(v)) for k, v in options.items())),
+        str(jit_options),
+        comm.size,
+    )
     if key not in _cache:
-        compiled = compile_form(comm, ufl_form, form_compiler_options=options,
-                                jit_options=jit_options)
+        compiled = compile_form(
+            comm, ufl_form, form_compiler_options=options, jit_options=jit_options
+        )
         cell = ufl_form.ufl_domain().ufl_coordinate_element().cell_type
         kernels = _runtime_kernels(ufl_form, get_options(options), cell)
         _cache[key] = _Compiled(compiled, kernels)
@@ -132,8 +159,6 @@ def _other_domains(ufl_form: ufl.Form, ids: dict[str, list[int]]) -> dict:
     data = ufl_form.subdomain_data().get(domain, {})
     out = {}
     for name, itype in _TYPES.items():
-        if name == "cell":
-            continue
         sd = [d for d in data.get(name, []) if d is not None]
         out[itype] = get_integration_domains(itype, sd[0] if sd else None, ids.get(name, []))
     return out
@@ -174,18 +199,26 @@ def form(
 
     ffcx_options = get_options(options)
     for sid, rules in rewrite.rules.items():
-        rules.register(compiled.kernels[sid], domain.ufl_cell(),
-                       ffcx_options["table_rtol"], ffcx_options["table_atol"])
+        rules.register(
+            compiled.kernels[sid],
+            domain.ufl_cell(),
+            ffcx_options["table_rtol"],
+            ffcx_options["table_atol"],
+        )
 
     ufcx = compiled.form.ufcx_form
     offsets = [ufcx.form_integral_offsets[i] for i in range(len(IntegralType) + 1)]
     ids: dict[str, list[int]] = {}
     for itype in IntegralType:
         if itype.value + 1 < len(offsets):
-            ids[itype.name] = [ufcx.form_integral_ids[j]
-                               for j in range(offsets[itype.value], offsets[itype.value + 1])]
+            ids[itype.name] = [
+                ufcx.form_integral_ids[j]
+                for j in range(offsets[itype.value], offsets[itype.value + 1])
+            ]
     subdomains = _other_domains(rewrite.form, ids)
-    subdomains[IntegralType.cell] = [(sid, cells) for sid, cells in rewrite.cell_domains]
+    for name, entries in rewrite.domains.items():
+        itype = _TYPES[name]
+        subdomains[itype] = sorted(subdomains.get(itype, []) + entries, key=lambda e: e[0])
 
     compiled_coeffs = ufl.algorithms.extract_coefficients(compiled.form.ufl_form)
     coeffs = ufl.algorithms.extract_coefficients(rewrite.form)
@@ -193,8 +226,12 @@ def form(
     consts = ufl.algorithms.analysis.extract_constants(rewrite.form)
     spaces = [arg.ufl_function_space() for arg in rewrite.form.arguments()]
     result = create_form(
-        compiled.form, spaces, mesh, subdomains,
-        dict(zip(compiled_coeffs, coeffs)), dict(zip(consts_c, consts)),
+        compiled.form,
+        spaces,
+        mesh,
+        subdomains,
+        dict(zip(compiled_coeffs, coeffs, strict=False)),
+        dict(zip(consts_c, consts, strict=False)),
     )
     result._xfem_rules = list(rewrite.rules.values())
     return result

@@ -70,6 +70,7 @@ def measure_and_weight(
     weight = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, element), name="mf_weight")
     dofs = weight.function_space.dofmap.list[cells]
     weight.x.array[dofs] = fitted / std_weights
-    measure = ufl.Measure("dx", domain=mesh, subdomain_data=[(1, np.asarray(cells, np.int32))],
-                          subdomain_id=1)
+    measure = ufl.Measure(
+        "dx", domain=mesh, subdomain_data=[(1, np.asarray(cells, np.int32))], subdomain_id=1
+    )
     return weight, measure

@@ -10,6 +10,7 @@ one block of tabulated basis tables per kernel. Rules are local to a process.
 from __future__ import annotations
 
 import itertools
+import typing
 
 import dolfinx.fem
 import numpy as np
@@ -25,6 +26,25 @@ _counter = itertools.count()
 
 def _address(array: np.ndarray) -> int:
     return int(array.ctypes.data)
+
+
+class IntegrationPart(typing.NamedTuple):
+    """One piece of a cut measure, as the ``integration_parts`` of its source lists it.
+
+    Attributes:
+        integral_type: ``"cell"`` or ``"exterior_facet"`` for a standard part;
+            runtime parts are always cell integrals.
+        entities: Standard-rule entities: cells ``(n,)`` or flattened
+            ``(cell, local facet)`` pairs ``(2 n,)``; ``None`` for a runtime part.
+        rules: Runtime rules, or ``None`` for a standard part.
+        replace: UFL replacements applied to the runtime integrand (e.g. the
+            facet normal of a boundary piece integrated as a cell integral).
+    """
+
+    integral_type: str
+    entities: np.ndarray | None = None
+    rules: CellRules | None = None
+    replace: dict | None = None
 
 
 class CellRules:
@@ -81,7 +101,9 @@ class CellRules:
     def marker(self) -> dolfinx.fem.Function:
         """The marker coefficient that routes runtime kernels to these rules."""
         if self._marker is None:
-            space = dolfinx.fem.functionspace(self.mesh, marker_element(self.mesh.basix_cell().name))
+            space = dolfinx.fem.functionspace(
+                self.mesh, marker_element(self.mesh.basix_cell().name)
+            )
             self._marker = dolfinx.fem.Function(space, name="xfem_marker")
             self._write_marker()
         return self._marker
@@ -121,6 +143,6 @@ class CellRules:
         """A UFL cell measure that integrates with these rules (``expr * rules.measure()``)."""
         return ufl.Measure("dx", domain=self.mesh, subdomain_data=self, subdomain_id=0, **kwargs)
 
-    def integration_parts(self, subdomain_id: int) -> tuple[np.ndarray | None, CellRules | None]:
-        """(cells integrated with the standard rule, runtime rules) of a measure id."""
-        return None, self
+    def integration_parts(self, subdomain_id: int) -> list:
+        """The one part of :meth:`measure`: these runtime rules (for :func:`xfem_contact.form`)."""
+        return [IntegrationPart("cell", rules=self)]

@@ -107,8 +107,9 @@ def runtime_integral(expression_ir, domain) -> RuntimeIntegral | None:
 
 def _descriptor(spec: TableSpec) -> str:
     """Process-independent description of a table (names excluded)."""
-    return repr((repr(spec.element), spec.local_derivatives, spec.flat_component,
-                 spec.codim, spec.ncols))
+    return repr(
+        (repr(spec.element), spec.local_derivatives, spec.flat_component, spec.codim, spec.ncols)
+    )
 
 
 def tabulate(
@@ -121,10 +122,19 @@ def tabulate(
         its static tables (so a standard rule fed at run time reproduces FFCx).
     """
     values = get_ffcx_table_values(
-        points, cell, "cell", spec.element, spec.averaged, "cell",
-        spec.local_derivatives, spec.flat_component, spec.codim,
+        points,
+        cell,
+        "cell",
+        spec.element,
+        spec.averaged,
+        "cell",
+        spec.local_derivatives,
+        spec.flat_component,
+        spec.codim,
     )["array"]
     table = clamp_table_small_numbers(values, rtol=rtol, atol=atol)[0, 0]
     if table.shape[1] != spec.ncols:
-        raise RuntimeError(f"Table {spec.name}: {table.shape[1]} columns, kernel expects {spec.ncols}")
+        raise RuntimeError(
+            f"Table {spec.name}: {table.shape[1]} columns, kernel expects {spec.ncols}"
+        )
     return np.ascontiguousarray(table, dtype=np.float64)
