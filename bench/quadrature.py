@@ -10,6 +10,9 @@ excluded (both forms are compiled on a small mesh first).
 Run: ``python bench/quadrature.py [--sizes 32 64 128 256 512] [--json out.json]``.
 """
 
+import xfem_contact  # noqa: F401  (before dolfinx with the PyPI wheel)
+
+# isort: split
 import argparse
 import json
 import time
@@ -20,8 +23,6 @@ import dolfinx.mesh
 import numpy as np
 import ufl
 from mpi4py import MPI
-
-import xfem_contact  # noqa: F401  (before dolfinx with the PyPI wheel)
 
 
 def levelset(x):

@@ -1,11 +1,12 @@
 """Shared fixtures: small meshes, affine and distorted, on 1 or more ranks."""
 
+import xfem_contact  # noqa: F401  (loads DOLFINx's MPI first when the wheel is used)
+
+# isort: split
 import dolfinx.mesh
 import numpy as np
 import pytest
 from mpi4py import MPI
-
-import xfem_contact  # noqa: F401  (loads DOLFINx's MPI first when the wheel is used)
 
 CELLS = {
     "quadrilateral": dolfinx.mesh.CellType.quadrilateral,
