@@ -16,3 +16,6 @@ from xfem_contact.forms import form  # noqa: E402
 from xfem_contact.runtime import CellRules  # noqa: E402
 
 __all__ = ["CellRules", "form"]
+from xfem_contact.cutmesh import CutMesh  # noqa: E402
+
+__all__ += ["CutMesh"]

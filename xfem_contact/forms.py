@@ -186,6 +186,8 @@ def form(
         A :class:`dolfinx.fem.Form` (or a nested list of them) for
         ``dolfinx.fem.assemble_*`` and ``dolfinx.fem.petsc``.
     """
+    if isinstance(ufl_form, ufl.ZeroBaseForm):
+        return dolfinx.fem.form(ufl_form)
     if not isinstance(ufl_form, ufl.Form):
         if isinstance(ufl_form, collections.abc.Iterable):
             return [form(f, form_compiler_options, jit_options) for f in ufl_form]
@@ -198,12 +200,14 @@ def form(
     compiled = _compile(mesh.comm, rewrite.form, options, jit_options)
 
     ffcx_options = get_options(options)
+    dropped = set()
     for sid, rules in rewrite.rules.items():
+        kernel = compiled.kernels.get(sid)
+        if kernel is None:  # FFCx removed the integral (a zero integrand)
+            dropped.add(sid)
+            continue
         rules.register(
-            compiled.kernels[sid],
-            domain.ufl_cell(),
-            ffcx_options["table_rtol"],
-            ffcx_options["table_atol"],
+            kernel, domain.ufl_cell(), ffcx_options["table_rtol"], ffcx_options["table_atol"]
         )
 
     ufcx = compiled.form.ufcx_form
@@ -218,6 +222,7 @@ def form(
     subdomains = _other_domains(rewrite.form, ids)
     for name, entries in rewrite.domains.items():
         itype = _TYPES[name]
+        entries = [(sid, e) for sid, e in entries if sid not in dropped]
         subdomains[itype] = sorted(subdomains.get(itype, []) + entries, key=lambda e: e[0])
 
     compiled_coeffs = ufl.algorithms.extract_coefficients(compiled.form.ufl_form)

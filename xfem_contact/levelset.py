@@ -94,12 +94,12 @@ class CellMaps:
 
     def __init__(self, mesh: dolfinx.mesh.Mesh, levelset: LevelSet):
         self.mesh = mesh
-        cmap = mesh.geometry.cmap
+        cmap = mesh.geometry.cmaps[0]
         self._cmap = basix.create_element(
             basix.ElementFamily.P, mesh.basix_cell(), cmap.degree, cmap.variant
         )
         self._gdim = mesh.geometry.dim
-        self._geom = mesh.geometry.x[mesh.geometry.dofmap, : self._gdim]
+        self._geom = mesh.geometry.x[mesh.geometry.dofmaps[0], : self._gdim]
         space = levelset.function.function_space
         self._phi_element = space.element.basix_element
         self._phi = levelset.function.x.array[space.dofmap.list]

@@ -121,6 +121,8 @@ def tabulate(
         C-contiguous array of shape ``(n, spec.ncols)``, clamped like FFCx clamps
         its static tables (so a standard rule fed at run time reproduces FFCx).
     """
+    if points.shape[0] == 0:
+        return np.zeros((0, spec.ncols))
     values = get_ffcx_table_values(
         points,
         cell,

@@ -1,0 +1,253 @@
+"""Linear elasticity on a cut mesh with an enriched displacement per side.
+
+Interface conditions (per interface): ``"free"`` (traction-free lips: an open
+crack or gap) and ``"bonded"`` (displacement continuity enforced by a vector
+multiplier ``lambda`` on the interface, P1 on the vertices of cut cells;
+``lambda`` is the traction ``sigma n`` on side -1, ``n`` from side -1 to +1).
+Units: SI (Pa, m, N/m^2 for tractions).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from xfem_contact.cutmesh import CutMesh
+from xfem_contact.enrichment import EnrichedSpace
+from xfem_contact.forms import form
+from xfem_contact.linear_solver import solve_restricted
+from xfem_contact.materials import Material
+
+INTERFACE_LAWS = ("free", "bonded")
+SIDES = (-1, 1)
+
+#: A boundary part: local facet indices, or a locator ``x -> bool`` of shape (3, n) -> (n,)
+Facets = np.ndarray | Callable[[np.ndarray], np.ndarray]
+#: A load: a number, a UFL expression, or a callable of the UFL coordinate ``x``
+Load = float | ufl.core.expr.Expr | Callable
+
+
+@dataclasses.dataclass
+class Solution:
+    """Displacements per side (m) and, for bonded interfaces, the multiplier (Pa)."""
+
+    w: dolfinx.fem.Function
+    space: EnrichedSpace
+
+    def field(self, i: int) -> dolfinx.fem.Function:
+        """Collapsed copy of field ``i``: 0 side -1, 1 side +1, 2 multiplier."""
+        return self.w.sub(i).collapse()
+
+
+class ElasticityProblem:
+    """Small-strain elasticity of the two sides of a cut mesh.
+
+    Args:
+        cut: The cut mesh (interface and sides).
+        degree: Displacement degree (1 or 2).
+        materials: One :class:`Material` for both sides, or ``{-1: m1, 1: m2}``.
+        interface: ``"free"`` or ``"bonded"``.
+        min_support_fraction: See :class:`EnrichedSpace`. Default: keep every
+            dof when the ghost penalty is on (it defines the field's extension
+            over empty supports), else drop dofs with no support on their side.
+        ghost_penalty: Dimensionless weight ``gamma`` of the ghost penalty that
+            keeps the operator well conditioned under tiny cuts: for each side,
+            ``gamma * 2 mu * sum_k h^(2k-1) [d^k u][d^k v]`` on the interior facets
+            of cut cells, k = 1..degree (zero for smooth solutions: exact
+            polynomial fields stay exact). 0 disables it.
+    """
+
+    def __init__(
+        self,
+        cut: CutMesh,
+        degree: int,
+        materials: Material | dict[int, Material],
+        interface: str = "free",
+        min_support_fraction: float | None = None,
+        ghost_penalty: float = 0.01,
+    ):
+        if interface not in INTERFACE_LAWS:
+            raise ValueError(f"Unknown interface law {interface!r}; valid: {INTERFACE_LAWS}")
+        if isinstance(materials, Material):
+            materials = {-1: materials, 1: materials}
+        missing = [s for s in SIDES if s not in materials]
+        if missing or not all(isinstance(m, Material) for m in materials.values()):
+            raise ValueError(f"Give a Material for sides -1 and +1 (missing: {missing})")
+        if ghost_penalty < 0:
+            raise ValueError(f"ghost_penalty must be >= 0, got {ghost_penalty}")
+        self.ghost_penalty = ghost_penalty
+        if min_support_fraction is None:
+            min_support_fraction = 0.0 if ghost_penalty > 0 else 1e-12
+        self.cut, self.interface, self.materials = cut, interface, materials
+        self.space = EnrichedSpace(
+            cut,
+            degree,
+            multiplier=(interface == "bonded"),
+            min_support_fraction=min_support_fraction,
+        )
+        self.mesh = cut.mesh
+        self._bcs: list[dolfinx.fem.DirichletBC] = []
+        self._rhs: list = []
+        self._x = ufl.SpatialCoordinate(self.mesh)
+
+    # -- boundary parts and loads ---------------------------------------------------
+    def facets(self, part: Facets) -> np.ndarray:
+        """Local exterior facet indices of a boundary part; error if it is empty."""
+        fdim = self.mesh.topology.dim - 1
+        if callable(part):
+            facets = dolfinx.mesh.locate_entities_boundary(self.mesh, fdim, part)
+        else:
+            facets = np.asarray(part, dtype=np.int32)
+        if self.mesh.comm.allreduce(facets.size, op=MPI.SUM) == 0:
+            raise ValueError("The boundary part holds no boundary facet (does it exist?)")
+        return facets
+
+    def _ufl(self, value: Load):
+        if isinstance(value, ufl.core.expr.Expr) or not callable(value):
+            return ufl.as_ufl(value)
+        return value(self._x)
+
+    def add_displacement(self, part: Facets, value, component: int | None = None) -> None:
+        """Prescribe the displacement (m) on a boundary part, on both sides' fields.
+
+        ``value``: a number or a callable of ``x`` (shape ``(3, n)``) returning
+        ``(n,)`` for one component or ``(gdim, n)`` for the vector.
+        """
+        fdim = self.mesh.topology.dim - 1
+        facets = self.facets(part)
+        for field in (0, 1):
+            sub = self.space.W.sub(field)
+            if component is not None:
+                sub = sub.sub(component)
+            V, _ = sub.collapse()
+            g = dolfinx.fem.Function(V)
+            if callable(value):
+                g.interpolate(value)
+            else:
+                g.x.array[:] = value
+            dofs = dolfinx.fem.locate_dofs_topological((sub, V), fdim, facets)
+            self._bcs.append(dolfinx.fem.dirichletbc(g, dofs, sub))
+
+    def add_point_displacement(self, point, value: float, component: int) -> None:
+        """Fix one displacement component at a mesh node (e.g. to remove rigid modes)."""
+        point = np.asarray(point, dtype=float)
+
+        def at_point(x):
+            return np.isclose(x[0], point[0]) & np.isclose(x[1], point[1])
+
+        found = 0
+        for field in (0, 1):
+            sub = self.space.W.sub(field).sub(component)
+            V, _ = sub.collapse()
+            dofs = dolfinx.fem.locate_dofs_geometrical((sub, V), at_point)
+            found += self.mesh.comm.allreduce(dofs[0].size, op=MPI.SUM)
+            g = dolfinx.fem.Function(V)
+            g.x.array[:] = value
+            self._bcs.append(dolfinx.fem.dirichletbc(g, dofs, sub))
+        if found == 0:
+            raise ValueError(f"No mesh node at {point.tolist()} to fix")
+
+    def add_traction(self, part: Facets, traction: Load, side: int | None = None) -> None:
+        """Surface traction (Pa) on a boundary part; ``side`` restricts it to one side."""
+        facets = self.facets(part)
+        t = self._ufl(traction)
+        for s in SIDES if side is None else (side,):
+            v = self.space.test()[0 if s == -1 else 1]
+            self._rhs.append(ufl.inner(t, v) * self.cut.ds(s, facets))
+
+    def add_pressure(self, part: Facets, pressure: Load, side: int | None = None) -> None:
+        """Pressure (Pa, positive pushes into the body) on a boundary part: t = -p n."""
+        n = ufl.FacetNormal(self.mesh)
+        p = self._ufl(pressure)
+        self.add_traction(part, -p * n, side)
+
+    def add_body_force(self, force: Load, side: int | None = None) -> None:
+        """Body force density (N/m^3) on one side or both."""
+        f = self._ufl(force)
+        for s in SIDES if side is None else (side,):
+            v = self.space.test()[0 if s == -1 else 1]
+            self._rhs.append(ufl.inner(f, v) * self.cut.dx(s))
+
+    # -- forms and solve -----------------------------------------------------------
+    def bilinear_form(self) -> ufl.Form:
+        trial, test = self.space.trial(), self.space.test()
+        a = sum(
+            ufl.inner(self.materials[s].stress(trial[i]), ufl.sym(ufl.grad(test[i])))
+            * self.cut.dx(s)
+            for i, s in enumerate(SIDES)
+        )
+        if self.ghost_penalty > 0:
+            a += self._ghost_penalty(trial, test)
+        if self.interface == "bonded":
+            lam, mu = trial[2], test[2]
+            jump_v, jump_u = test[1] - test[0], trial[1] - trial[0]
+            a += (ufl.inner(lam, jump_v) + ufl.inner(mu, jump_u)) * self.cut.dGamma
+        return a
+
+    def _ghost_penalty(self, trial, test) -> ufl.Form:
+        dS = ufl.Measure("dS", domain=self.mesh, subdomain_data=ghost_penalty_facets(self.cut))
+        h = ufl.avg(ufl.CellDiameter(self.mesh))
+        terms = []
+        for i, s in enumerate(SIDES):
+            scale = self.ghost_penalty * 2.0 * self.materials[s].mu
+            du, dv = ufl.grad(trial[i]), ufl.grad(test[i])
+            for k in range(1, self.space.degree + 1):
+                terms.append(
+                    scale * h ** (2 * k - 1) * ufl.inner(ufl.jump(du), ufl.jump(dv)) * dS(i + 1)
+                )
+                du, dv = ufl.grad(du), ufl.grad(dv)
+        return sum(terms[1:], terms[0])
+
+    def linear_form(self) -> ufl.Form:
+        if not self._rhs:
+            return ufl.ZeroBaseForm((ufl.TestFunction(self.space.W),))
+        return sum(self._rhs[1:], self._rhs[0])
+
+    def solve(self, petsc_options: dict | None = None) -> Solution:
+        """Assemble and solve (one KSP solve on the active dofs). Collective."""
+        a, L = form(self.bilinear_form()), form(self.linear_form())
+        w, _ = solve_restricted(a, L, self._bcs, self.space, petsc_options)
+        return Solution(w, self.space)
+
+
+def ghost_penalty_facets(cut: CutMesh) -> list[tuple[int, np.ndarray]]:
+    """Interior-facet integration entities of the ghost penalty: id 1 (side -1) and
+    2 (side +1) hold the owned interior facets with a cut cell on one side and a
+    cell touching that side on the other."""
+    mesh, tdim = cut.mesh, cut.mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    num_facets = mesh.topology.index_map(tdim - 1).size_local
+    counts = np.diff(f2c.offsets[: num_facets + 1])
+    interior = np.flatnonzero(counts == 2).astype(np.int32)
+    cells = f2c.array[f2c.offsets[interior][:, None] + np.arange(2)]
+    sides = _all_cell_sides(cut)[cells]
+    entries = []
+    for sid, side in ((1, -1), (2, 1)):
+        touches = (sides == side) | (sides == 0)
+        chosen = interior[np.all(touches, axis=1) & np.any(sides == 0, axis=1)]
+        entries.append(
+            (
+                sid,
+                dolfinx.fem.compute_integration_domains(
+                    dolfinx.fem.IntegralType.interior_facet, mesh.topology, chosen
+                ),
+            )
+        )
+    return entries
+
+
+def _all_cell_sides(cut: CutMesh) -> np.ndarray:
+    """Side (-1, 0 = cut, +1) of owned and ghost cells (ghosts via a DG0 scatter)."""
+    V0 = dolfinx.fem.functionspace(cut.mesh, ("DG", 0))
+    f = dolfinx.fem.Function(V0)
+    owned = cut.cell_sides.size
+    f.x.array[V0.dofmap.list[:owned, 0]] = cut.cell_sides
+    f.x.scatter_forward()
+    return np.rint(f.x.array[V0.dofmap.list[:, 0]]).astype(np.int8)

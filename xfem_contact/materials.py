@@ -1,0 +1,49 @@
+"""Linear elastic materials (SI units: Pa, m)."""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+
+import ufl
+
+
+@dataclasses.dataclass(frozen=True)
+class Material:
+    """Isotropic linear elasticity in 2D.
+
+    Args:
+        E: Young's modulus (Pa), > 0.
+        nu: Poisson's ratio, in (-1, 0.5).
+        plane: ``"strain"`` or ``"stress"``.
+    """
+
+    E: float
+    nu: float
+    plane: typing.Literal["strain", "stress"] = "strain"
+
+    def __post_init__(self):
+        if not self.E > 0:
+            raise ValueError(f"Young's modulus E must be > 0 Pa, got {self.E}")
+        if not -1.0 < self.nu < 0.5:
+            raise ValueError(f"Poisson's ratio nu must be in (-1, 0.5), got {self.nu}")
+        if self.plane not in ("strain", "stress"):
+            raise ValueError(f"plane must be 'strain' or 'stress', got {self.plane!r}")
+
+    @property
+    def mu(self) -> float:
+        """Shear modulus (Pa)."""
+        return self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def lmbda(self) -> float:
+        """Lamé's first parameter of the 2D law (Pa); plane stress uses the reduced one."""
+        lmbda = self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
+        if self.plane == "stress":
+            return 2.0 * self.mu * lmbda / (lmbda + 2.0 * self.mu)
+        return lmbda
+
+    def stress(self, u) -> ufl.core.expr.Expr:
+        """Cauchy stress (Pa) of displacement ``u`` (m), small strain."""
+        eps = ufl.sym(ufl.grad(u))
+        return 2.0 * self.mu * eps + self.lmbda * ufl.tr(eps) * ufl.Identity(len(u))
