@@ -71,6 +71,7 @@ class ElasticityProblem:
         interface: str = "free",
         min_support_fraction: float | None = None,
         ghost_penalty: float = 0.01,
+        multiplier_stabilization: float = 0.1,
     ):
         if interface not in INTERFACE_LAWS:
             raise ValueError(f"Unknown interface law {interface!r}; valid: {INTERFACE_LAWS}")
@@ -82,6 +83,7 @@ class ElasticityProblem:
         if ghost_penalty < 0:
             raise ValueError(f"ghost_penalty must be >= 0, got {ghost_penalty}")
         self.ghost_penalty = ghost_penalty
+        self.multiplier_stabilization = multiplier_stabilization
         if min_support_fraction is None:
             min_support_fraction = 0.0 if ghost_penalty > 0 else 1e-12
         self.cut, self.interface, self.materials = cut, interface, materials
@@ -188,7 +190,31 @@ class ElasticityProblem:
             lam, mu = trial[2], test[2]
             jump_v, jump_u = test[1] - test[0], trial[1] - trial[0]
             a += (ufl.inner(lam, jump_v) + ufl.inner(mu, jump_u)) * self.cut.dGamma
+            if self.multiplier_stabilization > 0:
+                a -= self._multiplier_stabilization(trial, test)
         return a
+
+    def _multiplier_stabilization(self, trial, test) -> ufl.Form:
+        """Barbosa-Hughes term ``gamma h / (2 mu) int (lambda - t(u)).(mu - t(v))``,
+        ``t(u)`` the average interface traction: consistent, and LBB-stable for any
+        multiplier space."""
+        n = self.cut.normal
+        h = ufl.CellDiameter(self.mesh)
+        mu_avg = 0.5 * (self.materials[-1].mu + self.materials[1].mu)
+
+        def traction(fields):
+            return (
+                0.5
+                * (self.materials[-1].stress(fields[0]) + self.materials[1].stress(fields[1]))
+                * n
+            )
+
+        scale = self.multiplier_stabilization * h / (2.0 * mu_avg)
+        return (
+            scale
+            * ufl.inner(trial[2] - traction(trial), test[2] - traction(test))
+            * self.cut.dGamma
+        )
 
     def _ghost_penalty(self, trial, test) -> ufl.Form:
         dS = ufl.Measure("dS", domain=self.mesh, subdomain_data=ghost_penalty_facets(self.cut))

@@ -114,7 +114,12 @@ class EnrichedSpace:
                 support &= fraction >= self.min_support_fraction
             active |= support
         if self.has_multiplier:
-            active |= self._mark(2, cut.cut_cells) > 0
+            rules = cut.rules[3]  # interface
+            length = np.zeros(cut.cut_cells.size)
+            rows = np.repeat(np.arange(length.size), np.diff(rules.offsets))
+            np.add.at(length, rows, rules.weights * _abs_det_at(cut, rules))
+            carrying = cut.cut_cells[length > 0.0]
+            active |= self._mark(2, carrying) > 0
         return active
 
     def _side_fraction(self, field: int, side: int) -> np.ndarray:

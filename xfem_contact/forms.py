@@ -199,16 +199,13 @@ def form(
     mesh = dolfinx.mesh.Mesh(domain.ufl_cargo(), domain)
     compiled = _compile(mesh.comm, rewrite.form, options, jit_options)
 
-    ffcx_options = get_options(options)
     dropped = set()
     for sid, rules in rewrite.rules.items():
         kernel = compiled.kernels.get(sid)
         if kernel is None:  # FFCx removed the integral (a zero integrand)
             dropped.add(sid)
             continue
-        rules.register(
-            kernel, domain.ufl_cell(), ffcx_options["table_rtol"], ffcx_options["table_atol"]
-        )
+        rules.register(kernel, domain.ufl_cell())
 
     ufcx = compiled.form.ufcx_form
     offsets = [ufcx.form_integral_offsets[i] for i in range(len(IntegralType) + 1)]

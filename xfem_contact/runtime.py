@@ -115,11 +115,11 @@ class CellRules:
         values[dofs[:, 0]] = np.arange(self.cells.size, dtype=np.float64)
         values[dofs[:, 1]] = np.array([_address(self._registry)], np.int64).view(np.float64)[0]
 
-    def register(self, kernel: RuntimeIntegral, cell: ufl.Cell, rtol: float, atol: float) -> None:
+    def register(self, kernel: RuntimeIntegral, cell: ufl.Cell) -> None:
         """Tabulate a kernel's runtime tables at all points and register them (once per kernel)."""
         if kernel.key in self._blocks:
             return
-        tables = [tabulate(spec, self.points, cell, rtol, atol) for spec in kernel.tables]
+        tables = [tabulate(spec, self.points, cell) for spec in kernel.tables]
         block = np.concatenate(
             [
                 [self.cells.size],

@@ -13,7 +13,6 @@ import numpy as np
 import numpy.typing as npt
 import ufl
 from ffcx.ir.elementtables import (
-    clamp_table_small_numbers,
     get_ffcx_table_values,
     get_modified_terminal_element,
     piecewise_ttypes,
@@ -113,13 +112,14 @@ def _descriptor(spec: TableSpec) -> str:
 
 
 def tabulate(
-    spec: TableSpec, points: npt.NDArray[np.float64], cell: ufl.Cell, rtol: float, atol: float
+    spec: TableSpec, points: npt.NDArray[np.float64], cell: ufl.Cell
 ) -> npt.NDArray[np.float64]:
     """Values of one runtime table at reference ``points`` (shape ``(n, tdim)``).
 
     Returns:
-        C-contiguous array of shape ``(n, spec.ncols)``, clamped like FFCx clamps
-        its static tables (so a standard rule fed at run time reproduces FFCx).
+        C-contiguous array of shape ``(n, spec.ncols)``. Unlike FFCx's static
+        tables, values are not clamped: tiny basis values at points near a
+        vertex are real data on cut cells.
     """
     if points.shape[0] == 0:
         return np.zeros((0, spec.ncols))
@@ -134,7 +134,7 @@ def tabulate(
         spec.flat_component,
         spec.codim,
     )["array"]
-    table = clamp_table_small_numbers(values, rtol=rtol, atol=atol)[0, 0]
+    table = values[0, 0]
     if table.shape[1] != spec.ncols:
         raise RuntimeError(
             f"Table {spec.name}: {table.shape[1]} columns, kernel expects {spec.ncols}"
