@@ -1,0 +1,175 @@
+"""Heaviside-enriched elasticity: paper case 1 (open straight interface), a
+bonded inclusion, conditioning under tiny cuts, dof counts, input errors."""
+
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import pytest
+import ufl
+from mpi4py import MPI
+
+import xfem_contact
+from xfem_contact.elasticity import ElasticityProblem
+from xfem_contact.linear_solver import assemble_restricted
+from xfem_contact.materials import Material
+
+
+def integrate(expr):
+    form = xfem_contact.form(expr)
+    return form.mesh.comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM)
+
+
+# -- paper case 1 -----------------------------------------------------------------
+def case1(nx, ny, cell, degree):
+    """Rectangle 3 m x 2 m, interface y = 1, plane stress, free interface."""
+    mesh = dolfinx.mesh.create_rectangle(
+        MPI.COMM_WORLD, [[-1.5, 0.0], [1.5, 2.0]], [nx, ny], dolfinx.mesh.CellType[cell]
+    )
+    cut = xfem_contact.CutMesh(mesh, lambda x: x[1] - 1.0, degree=1)
+    problem = ElasticityProblem(cut, degree, Material(10e9, 0.2, "stress"), "free")
+    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
+    top = lambda x: np.isclose(x[1], 2.0)  # noqa: E731
+    problem.add_displacement(top, 0.0, component=0)
+    problem.add_displacement(top, lambda x: -2.5e-6 * x[0] ** 2 + 1e-5, component=1)
+    problem.add_pressure(
+        lambda x: np.isclose(np.abs(x[0]), 1.5), lambda x: 1e5 - 5e4 * x[1], side=1
+    )
+    solution = problem.solve()
+    x = ufl.SpatialCoordinate(mesh)
+    exact = ufl.as_vector(
+        [5e-6 * x[0] * (x[1] - 2.0), -2.5e-6 * x[0] ** 2 - 5e-7 * x[1] ** 2 + 2e-6 * x[1] + 8e-6]
+    )
+    lower, upper = ufl.split(solution.w)[:2]
+    e_interface = np.sqrt(
+        integrate(ufl.inner(upper - exact, upper - exact) * cut.dGamma)
+        / integrate(ufl.inner(exact, exact) * cut.dGamma)
+    )
+    e_upper = np.sqrt(
+        integrate(ufl.inner(upper - exact, upper - exact) * cut.dx(1))
+        / integrate(ufl.inner(exact, exact) * cut.dx(1))
+    )
+    lower_norm = np.sqrt(integrate(ufl.inner(lower, lower) * cut.dx(-1)))
+    gap = _interface_values(cut, solution.w, 1)[:, 1] - _interface_values(cut, solution.w, 0)[:, 1]
+    min_gap = mesh.comm.allreduce(np.min(gap, initial=np.inf), op=MPI.MIN)
+    return e_interface, e_upper, lower_norm, min_gap, problem.space.dof_counts()
+
+
+def _interface_values(cut, w, field):
+    """Field values at the interface quadrature points, shape (npoints, 2)."""
+    from xfem_contact.evaluation import evaluate_at_rules
+
+    return evaluate_at_rules(w.sub(field), cut, cut.rules[3])
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("cell", ["quadrilateral", "triangle"])
+def test_case1_quadratic_is_exact(cell):
+    e_interface, e_upper, lower_norm, min_gap, dofs = case1(20, 29, cell, 2)
+    assert e_interface < 1e-10
+    assert e_upper < 1e-10
+    assert lower_norm < 1e-20
+    assert min_gap >= 3.875e-6 * (1 - 1e-8)
+    # Enriched dofs: both components of the 3 node rows of the cut cell row (Q2/P2)
+    assert dofs.enriched == 2 * 3 * 41
+    assert dofs.multiplier == 0
+
+
+def test_case1_linear_converges():
+    sizes = [(10, 15), (20, 29), (40, 59), (80, 119)]
+    errors = np.array([case1(nx, ny, "quadrilateral", 1)[:2] for nx, ny in sizes])
+    h = np.array([1.0 / nx for nx, _ in sizes])
+    rates = [np.polyfit(np.log(h), np.log(errors[:, k]), 1)[0] for k in range(2)]
+    print("\ncase 1, Q1: interface / upper-block L2 errors", errors.tolist(), "rates", rates)
+    assert rates[0] > 1.8 and rates[1] > 1.8
+
+
+# -- bonded inclusion (paper case 2 geometry) ------------------------------------------
+CENTRE, RADIUS = np.array([0.5, 0.5]), 0.2
+SIGMA = np.diag([-1.0, -2.0])
+
+
+def bonded_inclusion(n, degree, cell="quadrilateral"):
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType[cell])
+    cut = xfem_contact.CutMesh(mesh, lambda x: np.hypot(x[0] - 0.5, x[1] - 0.5) - RADIUS)
+    problem = ElasticityProblem(cut, degree, Material(100e6, 0.0), "bonded")
+    problem.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 2.0)
+    problem.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), 1.0)
+    problem.add_point_displacement([0.5, 0.0], 0.0, 0)
+    problem.add_point_displacement([0.5, 1.0], 0.0, 0)
+    problem.add_point_displacement([0.0, 0.5], 0.0, 1)
+    w = problem.solve().w
+    x = ufl.SpatialCoordinate(mesh)
+    r = x - ufl.as_vector(CENTRE.tolist())
+    n = r / ufl.sqrt(ufl.inner(r, r))
+    sigma = ufl.as_matrix(SIGMA.tolist())
+    pressure = ufl.dot(n, sigma * n)
+    lam = ufl.split(w)[2]
+    e_lam = np.sqrt(
+        integrate((ufl.dot(lam, n) - pressure) ** 2 * cut.dGamma)
+        / integrate(pressure**2 * cut.dGamma)
+    )
+    exact = ufl.as_vector([-1e-8 * (x[0] - 0.5), -2e-8 * (x[1] - 0.5)])
+    um, up = ufl.split(w)[:2]
+    e_u = np.sqrt(
+        (
+            integrate(ufl.inner(um - exact, um - exact) * cut.dx(-1))
+            + integrate(ufl.inner(up - exact, up - exact) * cut.dx(1))
+        )
+        / integrate(ufl.inner(exact, exact) * (cut.dx(-1) + cut.dx(1)))
+    )
+    return e_lam, e_u
+
+
+@pytest.mark.parametrize("degree, min_rate", [(1, 1.0), (2, 1.5)])
+def test_bonded_inclusion_multiplier_rate(degree, min_rate):
+    sizes = [10, 20, 40, 80]
+    errors = np.array([bonded_inclusion(n, degree) for n in sizes])
+    rate = -np.polyfit(np.log(sizes), np.log(errors[:, 0]), 1)[0]
+    print(
+        f"\nbonded inclusion degree {degree}: multiplier errors {errors[:, 0]}, rate {rate:.2f};"
+        f" displacement errors {errors[:, 1]}"
+    )
+    assert rate >= min_rate
+    assert errors[-1, 1] < 1e-4
+
+
+# -- conditioning under tiny cuts ------------------------------------------------------
+def condition_number(eta, degree, n=6):
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_SELF, n, n, dolfinx.mesh.CellType.quadrilateral)
+    y0 = (3 + eta) / n
+    cut = xfem_contact.CutMesh(mesh, lambda x: x[1] - y0, degree=1)
+    problem = ElasticityProblem(cut, degree, Material(1.0, 0.3), "free")
+    problem.add_displacement(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 0.0)
+    A, b, index_set = assemble_restricted(
+        xfem_contact.form(problem.bilinear_form()),
+        xfem_contact.form(problem.linear_form()),
+        problem._bcs,
+        problem.space,
+    )
+    dense = A.convert("dense").getDenseArray().copy()
+    for obj in (A, b, index_set):
+        obj.destroy()
+    return np.linalg.cond(dense)
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+def test_condition_number_bounded_under_tiny_cuts(degree):
+    reference = condition_number(0.5, degree)
+    ratios = [condition_number(eta, degree) / reference for eta in 10.0 ** -np.arange(1, 11)]
+    print(f"\ndegree {degree}: cond(eta)/cond(0.5) for eta = 1e-1..1e-10:", np.round(ratios, 2))
+    assert max(ratios) < 10.0
+
+
+# -- input errors --------------------------------------------------------------------
+def test_bad_input_raises():
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    cut = xfem_contact.CutMesh(mesh, lambda x: x[1] - 0.55, degree=1)
+    with pytest.raises(ValueError, match="Unknown interface law"):
+        ElasticityProblem(cut, 1, Material(1.0, 0.3), "glued")
+    with pytest.raises(ValueError, match="Young's modulus"):
+        Material(-1.0, 0.3)
+    with pytest.raises(ValueError, match="Poisson"):
+        Material(1.0, 0.5)
+    problem = ElasticityProblem(cut, 1, Material(1.0, 0.3), "free")
+    with pytest.raises(ValueError, match="no boundary facet"):
+        problem.add_pressure(lambda x: np.isclose(x[0], 7.0), 1.0)
