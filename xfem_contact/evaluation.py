@@ -1,4 +1,4 @@
-"""Point values of finite element functions at the quadrature points of cut cells."""
+"""Point values of finite element functions at reference points of given cells."""
 
 from __future__ import annotations
 
@@ -11,39 +11,48 @@ from xfem_contact.cutmesh import CutMesh
 from xfem_contact.quadrature import RuleSet
 
 
-def evaluate_at_rules(
-    u: dolfinx.fem.Function, cut: CutMesh, rules: RuleSet
+def evaluate_reference(
+    u: dolfinx.fem.Function, cells: npt.NDArray[np.int32], X: npt.NDArray[np.float64]
 ) -> npt.NDArray[np.float64]:
-    """Values of a (sub-)function at every point of per-cut-cell rules (local, no communication).
+    """Values of a Lagrange function at reference points, one point per cell entry (local).
 
     Args:
         u: A Lagrange function, or a sub-function ``w.sub(i)`` of a mixed one.
-        cut: The cut mesh the rules belong to (rule ``k`` lives in ``cut.cut_cells[k]``).
-        rules: The rules (reference points).
+        cells: Local cell of each point, shape ``(m,)``.
+        X: Reference coordinates, shape ``(m, tdim)``.
 
     Returns:
-        Values of shape ``(npoints, value_size)``.
+        Values of shape ``(m, value_size)``.
     """
     if u.function_space.component():  # a view into a mixed function
         u = u.collapse()
     V = u.function_space
-    element = V.ufl_element()
-    scalar = basix.create_element(
+    element = basix.create_element(
         basix.ElementFamily.P,
-        cut.mesh.basix_cell(),
-        element.embedded_superdegree,
+        V.mesh.basix_cell(),
+        V.ufl_element().embedded_superdegree,
         basix.LagrangeVariant.gll_warped,
     )
-    rows = np.repeat(np.arange(rules.offsets.size - 1), np.diff(rules.offsets))
-    basis = scalar.tabulate(0, rules.points)[0, :, :, 0]  # (npoints, ndofs)
+    basis = element.tabulate(0, X)[0, :, :, 0]  # (m, ndofs)
     bs = V.dofmap.bs
-    dofs = V.dofmap.list[cut.cut_cells[rows]]  # (npoints, ndofs)
-    values = u.x.array[(dofs[:, :, None] * bs + np.arange(bs)).reshape(dofs.shape[0], -1)]
-    return np.einsum("pi,pic->pc", basis, values.reshape(dofs.shape[0], dofs.shape[1], bs))
+    dofs = V.dofmap.list[cells]  # (m, ndofs)
+    values = u.x.array[dofs[:, :, None] * bs + np.arange(bs)]  # (m, ndofs, bs)
+    return np.einsum("pi,pic->pc", basis, values)
+
+
+def rule_cells(cut: CutMesh, rules: RuleSet) -> npt.NDArray[np.int32]:
+    """Local cell of every point of per-cut-cell ``rules``, shape ``(npoints,)``."""
+    return cut.cut_cells[np.repeat(np.arange(rules.offsets.size - 1), np.diff(rules.offsets))]
+
+
+def evaluate_at_rules(
+    u: dolfinx.fem.Function, cut: CutMesh, rules: RuleSet
+) -> npt.NDArray[np.float64]:
+    """Values of ``u`` at every point of per-cut-cell ``rules``, shape ``(npoints, value_size)``."""
+    return evaluate_reference(u, rule_cells(cut, rules), rules.points)
 
 
 def interface_points(cut: CutMesh) -> npt.NDArray[np.float64]:
     """Physical coordinates of the interface quadrature points, shape ``(npoints, gdim)``."""
     rules = cut.rules[3]
-    rows = np.repeat(np.arange(rules.offsets.size - 1), np.diff(rules.offsets))
-    return cut.maps.push_forward(cut.cut_cells[rows], rules.points)
+    return cut.maps.push_forward(rule_cells(cut, rules), rules.points)
