@@ -73,8 +73,8 @@ class ElasticityProblem:
         ghost_penalty: float = 0.01,
         multiplier_stabilization: float = 0.1,
     ):
-        if interface not in INTERFACE_LAWS:
-            raise ValueError(f"Unknown interface law {interface!r}; valid: {INTERFACE_LAWS}")
+        if interface not in self.LAWS:
+            raise ValueError(f"Unknown interface law {interface!r}; valid: {self.LAWS}")
         if isinstance(materials, Material):
             materials = {-1: materials, 1: materials}
         missing = [s for s in SIDES if s not in materials]
@@ -90,13 +90,21 @@ class ElasticityProblem:
         self.space = EnrichedSpace(
             cut,
             degree,
-            multiplier=(interface == "bonded"),
+            multiplier=self.multiplier_components(interface, cut.mesh.geometry.dim),
             min_support_fraction=min_support_fraction,
         )
         self.mesh = cut.mesh
         self._bcs: list[dolfinx.fem.DirichletBC] = []
         self._rhs: list = []
         self._x = ufl.SpatialCoordinate(self.mesh)
+
+    #: Interface laws this problem solves
+    LAWS = INTERFACE_LAWS
+
+    @staticmethod
+    def multiplier_components(law: str, gdim: int) -> int:
+        """Number of interface multiplier components a law needs."""
+        return gdim if law == "bonded" else 0
 
     # -- boundary parts and loads ---------------------------------------------------
     def facets(self, part: Facets) -> np.ndarray:
@@ -177,44 +185,41 @@ class ElasticityProblem:
             self._rhs.append(ufl.inner(f, v) * self.cut.dx(s))
 
     # -- forms and solve -----------------------------------------------------------
-    def bilinear_form(self) -> ufl.Form:
-        trial, test = self.space.trial(), self.space.test()
+    def bulk_form(self, u, v) -> ufl.Form:
+        """Elastic energy of both sides plus the ghost penalty, ``u``, ``v``: field tuples."""
         a = sum(
-            ufl.inner(self.materials[s].stress(trial[i]), ufl.sym(ufl.grad(test[i])))
-            * self.cut.dx(s)
+            ufl.inner(self.materials[s].stress(u[i]), ufl.sym(ufl.grad(v[i]))) * self.cut.dx(s)
             for i, s in enumerate(SIDES)
         )
         if self.ghost_penalty > 0:
-            a += self._ghost_penalty(trial, test)
+            a += self._ghost_penalty(u, v)
+        return a
+
+    def bilinear_form(self) -> ufl.Form:
+        trial, test = self.space.trial(), self.space.test()
+        a = self.bulk_form(trial, test)
         if self.interface == "bonded":
             lam, mu = trial[2], test[2]
             jump_v, jump_u = test[1] - test[0], trial[1] - trial[0]
             a += (ufl.inner(lam, jump_v) + ufl.inner(mu, jump_u)) * self.cut.dGamma
             if self.multiplier_stabilization > 0:
-                a -= self._multiplier_stabilization(trial, test)
+                a -= self.multiplier_stabilization_form(lam, mu, trial, test)
         return a
 
-    def _multiplier_stabilization(self, trial, test) -> ufl.Form:
-        """Barbosa-Hughes term ``gamma h / (2 mu) int (lambda - t(u)).(mu - t(v))``,
-        ``t(u)`` the average interface traction: consistent, and LBB-stable for any
-        multiplier space."""
+    def interface_traction(self, u) -> ufl.core.expr.Expr:
+        """Average traction ``{sigma(u)} n`` (Pa) on the interface."""
         n = self.cut.normal
+        return 0.5 * (self.materials[-1].stress(u[0]) + self.materials[1].stress(u[1])) * n
+
+    def multiplier_stabilization_form(self, lam, mu, u, v) -> ufl.Form:
+        """Barbosa-Hughes term ``gamma h / (2 mu) int (lambda - t(u)).(mu - t(v))``
+        (``t`` the average interface traction; ``lam``, ``mu`` Cartesian vectors):
+        consistent, and LBB-stable for any multiplier space."""
         h = ufl.CellDiameter(self.mesh)
-        mu_avg = 0.5 * (self.materials[-1].mu + self.materials[1].mu)
-
-        def traction(fields):
-            return (
-                0.5
-                * (self.materials[-1].stress(fields[0]) + self.materials[1].stress(fields[1]))
-                * n
-            )
-
-        scale = self.multiplier_stabilization * h / (2.0 * mu_avg)
-        return (
-            scale
-            * ufl.inner(trial[2] - traction(trial), test[2] - traction(test))
-            * self.cut.dGamma
-        )
+        shear = 0.5 * (self.materials[-1].mu + self.materials[1].mu)
+        scale = self.multiplier_stabilization * h / (2.0 * shear)
+        t_u, t_v = self.interface_traction(u), self.interface_traction(v)
+        return scale * ufl.inner(lam - t_u, mu - t_v) * self.cut.dGamma
 
     def _ghost_penalty(self, trial, test) -> ufl.Form:
         dS = ufl.Measure("dS", domain=self.mesh, subdomain_data=ghost_penalty_facets(self.cut))

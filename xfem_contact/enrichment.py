@@ -38,12 +38,14 @@ class DofCounts(typing.NamedTuple):
 
 class EnrichedSpace:
     """Displacement per side (Lagrange ``degree``, vector) and an optional
-    interface multiplier (vector P1 on the vertices of cut cells).
+    interface multiplier (P1 on the vertices of cut cells, scalar or vector).
 
     Args:
         cut: The cut mesh.
         degree: Displacement degree, 1 or 2 (P1/P2 on triangles, Q1/Q2 on quads).
-        multiplier: Add the interface multiplier field.
+        multiplier: Number of multiplier components: 0 (none), 1 (a scalar,
+            e.g. the normal contact pressure) or ``gdim`` (a vector: the
+            interface traction, Cartesian or normal/tangential).
         min_support_fraction: A side's dofs whose support holds less than this
             fraction of the support's area on that side are dropped (set
             inactive) to keep the operator well conditioned; 0 keeps all.
@@ -53,7 +55,7 @@ class EnrichedSpace:
         self,
         cut: CutMesh,
         degree: int,
-        multiplier: bool = False,
+        multiplier: int = 0,
         min_support_fraction: float = 0.0,
     ):
         if degree not in (1, 2):
@@ -66,9 +68,13 @@ class EnrichedSpace:
         cell = mesh.basix_cell()
         displacement = basix.ufl.element("Lagrange", cell, degree, shape=(gdim,))
         elements = [displacement, displacement]
+        if multiplier not in (0, 1, gdim):
+            raise ValueError(f"multiplier must have 0, 1 or {gdim} components, got {multiplier}")
         if multiplier:
-            elements.append(basix.ufl.element("Lagrange", cell, 1, shape=(gdim,)))
-        self.has_multiplier = multiplier
+            shape = () if multiplier == 1 else (gdim,)
+            elements.append(basix.ufl.element("Lagrange", cell, 1, shape=shape))
+        self.multiplier_components = multiplier
+        self.has_multiplier = multiplier > 0
         self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
         self.min_support_fraction = min_support_fraction
         self._active = self._active_dofs()
