@@ -266,7 +266,7 @@ def vital_vertex_prolongation(cut: CutMesh, space) -> MultiplierProlongation:
     on_edge = np.isin(cut_vertices, rows)
     pairs = {
         (f, nb)
-        for cell, mask in zip(cut_vertices, on_edge)
+        for cell, mask in zip(cut_vertices, on_edge, strict=True)
         for f in cell[~mask]
         for nb in cell[mask]
     }
