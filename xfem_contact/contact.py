@@ -164,28 +164,53 @@ class ContactProblem(ElasticityProblem):
             return None
         return vital_vertex_prolongation(self.cut, self.space)
 
-    def interface_status(self, w: dolfinx.fem.Function) -> dict:
-        """Counts of interface quadrature points in contact / stick / slip (global)."""
+    def interface_state(self, w: dolfinx.fem.Function) -> dict[str, np.ndarray]:
+        """Point values at this process's interface quadrature points.
+
+        Returns arrays of shape ``(npoints,)``: ``gap`` and ``slip`` (m), the
+        multipliers ``lambda_n``, ``lambda_t`` and the augmented (applied)
+        tractions ``P_n``, ``P_t`` (Pa; tangential ones zero when frictionless),
+        and ``r`` (Pa/m).
+        """
         cut = self.cut
         rules = cut.rules[3]
         jump = evaluate_at_rules(w.sub(1), cut, rules) - evaluate_at_rules(w.sub(0), cut, rules)
         lam = evaluate_at_rules(w.sub(2), cut, rules)
         normals = rules.normals
-        r = (
-            self.augmentation
-            * 0.5
-            * (self.materials[-1].E + self.materials[1].E)
-            / _diameters(cut, rules)
-        )
-        g_n = np.sum(jump * normals, axis=1)
-        p_n = np.minimum(0.0, lam[:, 0] + r * g_n)
-        contact = p_n < 0.0
+        tangents = np.c_[-normals[:, 1], normals[:, 0]]
+        E = 0.5 * (self.materials[-1].E + self.materials[1].E)
+        r = self.augmentation * E / _diameters(cut, rules)
+        gap = np.sum(jump * normals, axis=1)
+        slip = np.sum(jump * tangents, axis=1)
+        lam_n = lam[:, 0]
+        lam_t = lam[:, 1] if lam.shape[1] > 1 else np.zeros_like(lam_n)
+        P_n = np.minimum(0.0, lam_n + r * gap)
+        trial = lam_t + r * slip
+        if self.law == "frictionless":
+            P_t = np.zeros_like(P_n)
+        elif self.law == "sticking":
+            P_t = trial
+        else:
+            P_t = np.clip(trial, self.friction * P_n, -self.friction * P_n)
+        return {
+            "gap": gap,
+            "slip": slip,
+            "lambda_n": lam_n,
+            "lambda_t": lam_t,
+            "P_n": P_n,
+            "P_t": P_t,
+            "r": r,
+            "trial_t": trial,
+        }
+
+    def interface_status(self, w: dolfinx.fem.Function) -> dict:
+        """Global counts of interface quadrature points in contact / stick / slip."""
+        state = self.interface_state(w)
+        contact = state["P_n"] < 0.0
         counts = {"contact": int(contact.sum())}
         if self.law != "frictionless":
-            tangents = np.c_[-normals[:, 1], normals[:, 0]]
-            trial = lam[:, 1] + r * np.sum(jump * tangents, axis=1)
-            bound = np.inf if self.law == "sticking" else -self.friction * p_n
-            stick = contact & (np.abs(trial) <= bound)
+            bound = np.inf if self.law == "sticking" else -self.friction * state["P_n"]
+            stick = contact & (np.abs(state["trial_t"]) <= bound)
             counts |= {"stick": int(stick.sum()), "slip": int((contact & ~stick).sum())}
         comm = self.mesh.comm
         return {k: comm.allreduce(v, op=MPI.SUM) for k, v in counts.items()}

@@ -1,0 +1,115 @@
+"""The paper's validation cases as ready problems with their exact solutions.
+
+Shared by the demos, the tests and the benchmarks (SI units, tension positive).
+"""
+
+from __future__ import annotations
+
+import typing
+
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from xfem_contact.contact import ContactProblem
+from xfem_contact.cutmesh import CutMesh
+from xfem_contact.elasticity import ElasticityProblem
+from xfem_contact.forms import form
+from xfem_contact.materials import Material
+
+#: Paper case 2: inclusion centre (m), radius (m), Young's modulus (Pa)
+INCLUSION_CENTRE, INCLUSION_RADIUS, INCLUSION_E = (0.5, 0.5), 0.2, 100e6
+
+#: Far-field loadings of the inclusion plate: (sigma_xx, sigma_yy) in Pa
+LOADINGS = {
+    "paper": (-1.0, -2.0),  # compression -1 Pa lateral, -2 Pa top/bottom
+    "hydrostatic": (-1.0, -1.0),
+    "pull": (1.0, -2.0),  # pulled in x: part of the interface opens
+}
+
+
+def inclusion_problem(
+    n: int,
+    degree: int,
+    law: str,
+    cell: str = "quadrilateral",
+    loading: str = "paper",
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    **options,
+) -> ElasticityProblem:
+    """Paper case 2: unit square with a circular inclusion (R = 0.2 m), E = 100 MPa,
+    nu = 0, far-field stress ``LOADINGS[loading]`` applied as boundary tractions,
+    rigid modes removed by u_x = 0 at (0.5, 0), (0.5, 1) and u_y = 0 at (0, 0.5).
+
+    Args:
+        n: Cells per side (even, so the three points are mesh nodes).
+        degree: Displacement degree.
+        law: Interface law (``free``, ``bonded``, ``frictionless``, ``coulomb``, ``sticking``).
+        cell: ``quadrilateral`` or ``triangle``.
+        loading: A key of :data:`LOADINGS`.
+        comm: Communicator of the mesh.
+        options: Passed to the problem (``friction``, ``lbb``, ``augmentation``, ...).
+    """
+    if loading not in LOADINGS:
+        raise ValueError(f"Unknown loading {loading!r}; valid: {sorted(LOADINGS)}")
+    mesh = dolfinx.mesh.create_unit_square(comm, n, n, dolfinx.mesh.CellType[cell])
+    cx, cy = INCLUSION_CENTRE
+    cut = CutMesh(mesh, lambda x: np.hypot(x[0] - cx, x[1] - cy) - INCLUSION_RADIUS, degree=2)
+    material = Material(INCLUSION_E, 0.0)
+    cls = ContactProblem if law in ContactProblem.LAWS else ElasticityProblem
+    problem = cls(cut, degree, material, law, **options)
+    sxx, syy = LOADINGS[loading]
+    problem.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), -sxx)
+    problem.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), -syy)
+    problem.add_point_displacement([0.5, 0.0], 0.0, 0)
+    problem.add_point_displacement([0.5, 1.0], 0.0, 0)
+    problem.add_point_displacement([0.0, 0.5], 0.0, 1)
+    problem.loading = loading
+    return problem
+
+
+class InterfaceErrors(typing.NamedTuple):
+    """Relative L2 errors on the interface (the paper's norm)."""
+
+    pressure: float  # || lambda_n - n.sigma.n || / || n.sigma.n ||
+    tangential: float  # || lambda_t - t.sigma.n || / || t.sigma.n || (nan if not computed)
+
+
+def inclusion_exact_traction(mesh, loading: str = "paper"):
+    """Exact (n.sigma.n, t.sigma.n) on the circle as UFL expressions of x (uniform stress)."""
+    x = ufl.SpatialCoordinate(mesh)
+    r = x - ufl.as_vector(INCLUSION_CENTRE)
+    n = r / ufl.sqrt(ufl.inner(r, r))
+    t = ufl.as_vector([-n[1], n[0]])
+    sigma = ufl.as_matrix(np.diag(LOADINGS[loading]).tolist())
+    return ufl.dot(n, sigma * n), ufl.dot(t, sigma * n)
+
+
+def integrate(expr) -> float:
+    """Global value of a functional (collective)."""
+    f = form(expr)
+    return f.mesh.comm.allreduce(dolfinx.fem.assemble_scalar(f), op=MPI.SUM)
+
+
+def inclusion_errors(problem: ElasticityProblem, w: dolfinx.fem.Function) -> InterfaceErrors:
+    """Interface pressure and tangential traction errors of a solved inclusion problem."""
+    cut = problem.cut
+    p_ex, t_ex = inclusion_exact_traction(cut.mesh, problem.loading)
+    fields = ufl.split(w)
+    if isinstance(problem, ContactProblem):
+        lam_n, lam_t = problem.multipliers(fields)
+    else:
+        x = ufl.SpatialCoordinate(cut.mesh)
+        r = x - ufl.as_vector(INCLUSION_CENTRE)
+        n = r / ufl.sqrt(ufl.inner(r, r))
+        lam_n, lam_t = ufl.dot(fields[2], n), ufl.dot(fields[2], ufl.as_vector([-n[1], n[0]]))
+    dG = cut.dGamma
+    e_n = np.sqrt(integrate((lam_n - p_ex) ** 2 * dG) / integrate(p_ex**2 * dG))
+    e_t = np.nan
+    if lam_t is not None:
+        norm_t = integrate(t_ex**2 * dG)
+        diff_t = integrate((lam_t - t_ex) ** 2 * dG)
+        e_t = np.sqrt(diff_t / norm_t) if norm_t > 0 else np.sqrt(diff_t)
+    return InterfaceErrors(float(e_n), float(e_t))
