@@ -27,15 +27,9 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from xfem_contact.elasticity import ElasticityProblem
 from xfem_contact.evaluation import evaluate_at_rules, interface_points
-from xfem_contact.materials import Material
 from xfem_contact.output import write_fields, write_json, write_lips
-
-
-def exact_upper(x):
-    """Exact displacement (m) of the upper block at points x (2, n) or UFL x."""
-    return [5e-6 * x[0] * (x[1] - 2.0), -2.5e-6 * x[0] ** 2 - 5e-7 * x[1] ** 2 + 2e-6 * x[1] + 8e-6]
+from xfem_contact.paper_cases import straight_interface_exact, straight_interface_problem
 
 
 def main():
@@ -54,23 +48,12 @@ def main():
     timings = {}
 
     t0 = time.perf_counter()
-    mesh = dolfinx.mesh.create_rectangle(
-        comm, [[-1.5, 0.0], [1.5, 2.0]], [args.nx, args.ny], dolfinx.mesh.CellType[args.cell]
-    )
-    cut = xfem_contact.CutMesh(mesh, lambda x: x[1] - 1.0, degree=1)
-    timings["cut"] = time.perf_counter() - t0
+    problem = straight_interface_problem(args.nx, args.ny, args.degree, args.cell, comm)
+    cut, mesh = problem.cut, problem.mesh
+    timings["setup"] = time.perf_counter() - t0
     say(f"mesh {args.nx}x{args.ny} {args.cell}, {cut.num_cut_cells_global} cut cells")
 
     t0 = time.perf_counter()
-    problem = ElasticityProblem(cut, args.degree, Material(10e9, 0.2, "stress"), "free")
-    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
-    problem.add_displacement(lambda x: np.isclose(x[1], 2.0), 0.0, component=0)
-    problem.add_displacement(
-        lambda x: np.isclose(x[1], 2.0), lambda x: -2.5e-6 * x[0] ** 2 + 1e-5, component=1
-    )
-    problem.add_pressure(
-        lambda x: np.isclose(np.abs(x[0]), 1.5), lambda x: 1e5 - 5e4 * x[1], side=1
-    )
     solution = problem.solve()
     timings["assemble_and_solve"] = time.perf_counter() - t0
     dofs = problem.space.dof_counts()
@@ -79,13 +62,13 @@ def main():
     xi = interface_points(cut)
     lower = evaluate_at_rules(solution.w.sub(0), cut, cut.rules[3])
     upper = evaluate_at_rules(solution.w.sub(1), cut, cut.rules[3])
-    exact = np.array(exact_upper(xi.T)).T
+    exact = np.array(straight_interface_exact(xi.T)).T
     umax = comm.allreduce(np.max(np.abs(exact), initial=0.0), op=MPI.MAX)
     err_upper = comm.allreduce(np.max(np.abs(upper - exact), initial=0.0), op=MPI.MAX) / umax
     err_lower = comm.allreduce(np.max(np.abs(lower), initial=0.0), op=MPI.MAX)
     gap = comm.allreduce(np.min(upper[:, 1] - lower[:, 1], initial=np.inf), op=MPI.MIN)
     x = ufl.SpatialCoordinate(mesh)
-    u_ex = ufl.as_vector(exact_upper(x))
+    u_ex = ufl.as_vector(straight_interface_exact(x))
     up = ufl.split(solution.w)[1]
     l2 = np.sqrt(
         comm.allreduce(

@@ -12,6 +12,12 @@ import xfem_contact
 from xfem_contact.elasticity import ElasticityProblem
 from xfem_contact.linear_solver import assemble_restricted
 from xfem_contact.materials import Material
+from xfem_contact.paper_cases import (
+    inclusion_errors,
+    inclusion_problem,
+    straight_interface_exact,
+    straight_interface_problem,
+)
 
 
 def integrate(expr):
@@ -21,24 +27,13 @@ def integrate(expr):
 
 # -- paper case 1 -----------------------------------------------------------------
 def case1(nx, ny, cell, degree):
-    """Rectangle 3 m x 2 m, interface y = 1, plane stress, free interface."""
-    mesh = dolfinx.mesh.create_rectangle(
-        MPI.COMM_WORLD, [[-1.5, 0.0], [1.5, 2.0]], [nx, ny], dolfinx.mesh.CellType[cell]
-    )
-    cut = xfem_contact.CutMesh(mesh, lambda x: x[1] - 1.0, degree=1)
-    problem = ElasticityProblem(cut, degree, Material(10e9, 0.2, "stress"), "free")
-    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
-    top = lambda x: np.isclose(x[1], 2.0)  # noqa: E731
-    problem.add_displacement(top, 0.0, component=0)
-    problem.add_displacement(top, lambda x: -2.5e-6 * x[0] ** 2 + 1e-5, component=1)
-    problem.add_pressure(
-        lambda x: np.isclose(np.abs(x[0]), 1.5), lambda x: 1e5 - 5e4 * x[1], side=1
-    )
+    """Paper case 1 errors: interface and upper block (relative L2), lower block
+    norm, minimum gap, dof counts."""
+    problem = straight_interface_problem(nx, ny, degree, cell)
+    cut, mesh = problem.cut, problem.mesh
     solution = problem.solve()
     x = ufl.SpatialCoordinate(mesh)
-    exact = ufl.as_vector(
-        [5e-6 * x[0] * (x[1] - 2.0), -2.5e-6 * x[0] ** 2 - 5e-7 * x[1] ** 2 + 2e-6 * x[1] + 8e-6]
-    )
+    exact = ufl.as_vector(straight_interface_exact(x))
     lower, upper = ufl.split(solution.w)[:2]
     e_interface = np.sqrt(
         integrate(ufl.inner(upper - exact, upper - exact) * cut.dGamma)
@@ -84,32 +79,14 @@ def test_case1_linear_converges():
 
 
 # -- bonded inclusion (paper case 2 geometry) ------------------------------------------
-CENTRE, RADIUS = np.array([0.5, 0.5]), 0.2
-SIGMA = np.diag([-1.0, -2.0])
-
-
-def bonded_inclusion(n, degree, cell="quadrilateral"):
-    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType[cell])
-    cut = xfem_contact.CutMesh(mesh, lambda x: np.hypot(x[0] - 0.5, x[1] - 0.5) - RADIUS)
-    problem = ElasticityProblem(cut, degree, Material(100e6, 0.0), "bonded")
-    problem.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 2.0)
-    problem.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), 1.0)
-    problem.add_point_displacement([0.5, 0.0], 0.0, 0)
-    problem.add_point_displacement([0.5, 1.0], 0.0, 0)
-    problem.add_point_displacement([0.0, 0.5], 0.0, 1)
+def bonded_inclusion(n, degree):
+    """Multiplier (pressure) and displacement relative errors of the bonded inclusion."""
+    problem = inclusion_problem(n, degree, "bonded")
     w = problem.solve().w
-    x = ufl.SpatialCoordinate(mesh)
-    r = x - ufl.as_vector(CENTRE.tolist())
-    n = r / ufl.sqrt(ufl.inner(r, r))
-    sigma = ufl.as_matrix(SIGMA.tolist())
-    pressure = ufl.dot(n, sigma * n)
-    lam = ufl.split(w)[2]
-    e_lam = np.sqrt(
-        integrate((ufl.dot(lam, n) - pressure) ** 2 * cut.dGamma)
-        / integrate(pressure**2 * cut.dGamma)
-    )
+    x = ufl.SpatialCoordinate(problem.mesh)
     exact = ufl.as_vector([-1e-8 * (x[0] - 0.5), -2e-8 * (x[1] - 0.5)])
     um, up = ufl.split(w)[:2]
+    cut = problem.cut
     e_u = np.sqrt(
         (
             integrate(ufl.inner(um - exact, um - exact) * cut.dx(-1))
@@ -117,7 +94,7 @@ def bonded_inclusion(n, degree, cell="quadrilateral"):
         )
         / integrate(ufl.inner(exact, exact) * (cut.dx(-1) + cut.dx(1)))
     )
-    return e_lam, e_u
+    return inclusion_errors(problem, w).pressure, e_u
 
 
 @pytest.mark.parametrize("degree, min_rate", [(1, 1.0), (2, 1.5)])

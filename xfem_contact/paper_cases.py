@@ -113,3 +113,35 @@ def inclusion_errors(problem: ElasticityProblem, w: dolfinx.fem.Function) -> Int
         diff_t = integrate((lam_t - t_ex) ** 2 * dG)
         e_t = np.sqrt(diff_t / norm_t) if norm_t > 0 else np.sqrt(diff_t)
     return InterfaceErrors(float(e_n), float(e_t))
+
+
+def straight_interface_exact(x):
+    """Paper case 1: exact displacement (m) of the upper block, as a list of two
+    components, for numpy points ``x`` (shape (>=2, n)) or the UFL coordinate."""
+    return [
+        5e-6 * x[0] * (x[1] - 2.0),
+        -2.5e-6 * x[0] ** 2 - 5e-7 * x[1] ** 2 + 2e-6 * x[1] + 8e-6,
+    ]
+
+
+def straight_interface_problem(
+    nx: int, ny: int, degree: int, cell: str = "quadrilateral", comm: MPI.Comm = MPI.COMM_WORLD
+) -> ElasticityProblem:
+    """Paper case 1: 3 m x 2 m plate (x in [-1.5, 1.5], y in [0, 2]) cut by y = 1,
+    plane stress, E = 10 GPa, nu = 0.2; bottom clamped; top u_x = 0 and
+    u_y = -2.5e-6 x^2 + 1e-5 m; pressure 0.1 - 0.05 y MPa on the upper block's
+    sides; free interface. Use an odd ``ny`` to keep y = 1 off the mesh lines."""
+    mesh = dolfinx.mesh.create_rectangle(
+        comm, [[-1.5, 0.0], [1.5, 2.0]], [nx, ny], dolfinx.mesh.CellType[cell]
+    )
+    cut = CutMesh(mesh, lambda x: x[1] - 1.0, degree=1)
+    problem = ElasticityProblem(cut, degree, Material(10e9, 0.2, "stress"), "free")
+    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
+    problem.add_displacement(lambda x: np.isclose(x[1], 2.0), 0.0, component=0)
+    problem.add_displacement(
+        lambda x: np.isclose(x[1], 2.0), lambda x: -2.5e-6 * x[0] ** 2 + 1e-5, component=1
+    )
+    problem.add_pressure(
+        lambda x: np.isclose(np.abs(x[0]), 1.5), lambda x: 1e5 - 5e4 * x[1], side=1
+    )
+    return problem
