@@ -10,6 +10,7 @@ whole history.
 from __future__ import annotations
 
 import dataclasses
+import time
 from collections.abc import Callable
 
 import dolfinx.fem
@@ -39,6 +40,9 @@ class NewtonReport:
     residuals: list[float] = dataclasses.field(default_factory=list)
     status: list[dict] = dataclasses.field(default_factory=list)
     reason: int = 0
+    #: Wall time (s) of residual/Jacobian assembly and of the whole solve
+    assembly_time: float = 0.0
+    total_time: float = 0.0
 
     @property
     def iterations(self) -> int:
@@ -115,6 +119,7 @@ class RestrictedNewton:
         self.w.x.scatter_forward()
 
     def _residual(self, snes, y, F_r):
+        start = time.perf_counter()
         self._update(y)
         x = self.w.x.petsc_vec
         with self.b.localForm() as local:
@@ -124,6 +129,7 @@ class RestrictedNewton:
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         dolfinx.fem.petsc.set_bc(self.b, self.bcs, x, -1.0)
         self.R.multTranspose(self.b, F_r)
+        self.report.assembly_time += time.perf_counter() - start
 
     def _assemble_jacobian(self):
         self.A.zeroEntries()
@@ -131,14 +137,13 @@ class RestrictedNewton:
         self.A.assemble()
 
     def _jacobian(self, snes, y, J_r, P_r):
+        start = time.perf_counter()
         self._update(y)
         self._assemble_jacobian()
         self.A.PtAP(self.R, result=J_r)
+        self.report.assembly_time += time.perf_counter() - start
 
     def _monitor(self, snes, it, norm):
-        if it == 0:
-            self.report.residuals.clear()
-            self.report.status.clear()
         self.report.residuals.append(float(norm))
         status = self.status(self.w) if self.status else {}
         self.report.status.append(status)
@@ -150,7 +155,10 @@ class RestrictedNewton:
 
     def solve(self) -> NewtonReport:
         """Run SNES from the current reduced iterate. Raises :class:`NewtonFailure`."""
+        self.report = NewtonReport()
+        start = time.perf_counter()
         self.snes.solve(None, self.y)
+        self.report.total_time = time.perf_counter() - start
         self._update(self.y)
         self.report.reason = self.snes.getConvergedReason()
         if self.report.reason <= 0:
