@@ -20,6 +20,14 @@ values. Two exceptions keep exact zeros from creating spurious topology:
 * a dip of an edge polynomial to the other side by at most ``64 eps`` times
   the largest nodal magnitude of the cell counts as tangency, not as a double
   crossing (the same bound applies to the interior sample check).
+
+:func:`topology` also flags the cells whose zero line one SEG3 cannot represent
+(:data:`TWICE`, :data:`MANY`, :data:`INTERIOR`, :data:`CORNER`). Cells with
+only :data:`CORNER` lie wholly on side -1 with the interface along their zero
+edges (:func:`zero_edges`); the others are cut after splitting them into
+sub-cells (:func:`split_parameters`, :func:`split_cells`), on which the level
+set is again a degree-1 or 2 Lagrange interpolant (:func:`lagrange_basis`
+evaluates it at their nodes).
 """
 
 from __future__ import annotations
@@ -31,9 +39,27 @@ import basix
 import numpy as np
 import numpy.typing as npt
 
-_REMEDY = "refine the mesh near the interface"
 _TANGENCY = 64.0 * np.finfo(np.float64).eps
 _LATTICE = 8  # interior sample lattice: (_LATTICE + 1) points per direction
+_SPLIT_MARGIN = 1.0 / 16.0  # adaptive split parameters stay in [margin, 1 - margin]
+
+# Cuts that one SEG3 cannot represent (bit flags in the ``kind`` of :func:`topology`).
+TWICE = 1
+"""An edge crossed twice (a cap on one edge, or two interface pieces through it)."""
+MANY = 2
+"""More than two boundary crossings (several pieces, e.g. at a saddle)."""
+INTERIOR = 4
+"""A sign change inside but none on the boundary (a closed interface piece)."""
+CORNER = 8
+"""The interpolant vanishes on two (or more) whole edges of a cut cell and is
+positive at no vertex, e.g. at a corner of a mesh-aligned polygonal interface
+or where two branches cross."""
+KIND_NAMES = {
+    TWICE: "crosses an edge twice",
+    MANY: "crosses the boundary more than twice",
+    INTERIOR: "changes sign inside without crossing the boundary",
+    CORNER: "vanishes along two edges",
+}
 
 
 @dataclass(frozen=True)
@@ -51,8 +77,11 @@ class CellData:
         face_normals: Outward normals ``n`` of the cell's half-planes
             ``n . X <= c``, shape ``(nv, 2)``.
         face_offsets: The matching ``c``, shape ``(nv,)``.
-        lattice_basis: Basis values at the interior check lattice,
-            shape ``(npoints, ndofs)``.
+        lattice: Interior check lattice, shape ``(npoints, 2)``.
+        lattice_basis: Basis values at the lattice, shape ``(npoints, ndofs)``.
+        vertices: Vertex coordinates in Basix order, shape ``(nv, 2)``.
+        node_weights: Coordinates of the level-set nodes as exact affine (or
+            bilinear) combinations of the vertices, shape ``(ndofs, nv)``.
     """
 
     cell_type: str
@@ -63,7 +92,10 @@ class CellData:
     loop_mid: npt.NDArray[np.int64]
     face_normals: npt.NDArray[np.float64]
     face_offsets: npt.NDArray[np.float64]
+    lattice: npt.NDArray[np.float64]
     lattice_basis: npt.NDArray[np.float64]
+    vertices: npt.NDArray[np.float64]
+    node_weights: npt.NDArray[np.float64]
 
     @property
     def nv(self) -> int:
@@ -90,7 +122,8 @@ def cell_data(cell_type: str, degree: int) -> CellData:
         basix.ElementFamily.P, ctype, degree, basix.LagrangeVariant.gll_warped
     )
     loop = np.array(loops[cell_type], dtype=np.int64)
-    coords = basix.geometry(ctype)[loop]
+    vertices = basix.geometry(ctype)
+    coords = vertices[loop]
     edges = [sorted(e) for e in basix.topology(ctype)[1]]
     loop_mid = np.full(loop.size, -1, dtype=np.int64)
     if degree == 2:
@@ -106,7 +139,54 @@ def cell_data(cell_type: str, degree: int) -> CellData:
     keep = (i + j <= n) if cell_type == "triangle" else np.ones_like(i, dtype=bool)
     lattice = np.stack([i[keep], j[keep]], axis=1) / n
     basis = element.tabulate(0, lattice)[0, :, :, 0]
-    return CellData(cell_type, degree, element, loop, coords, loop_mid, normals, offsets, basis)
+    weights = lagrange_basis(cell_type, 1, element.points)  # exact multiples of 1/4
+    return CellData(
+        cell_type,
+        degree,
+        element,
+        loop,
+        coords,
+        loop_mid,
+        normals,
+        offsets,
+        lattice,
+        basis,
+        vertices,
+        weights,
+    )
+
+
+def lagrange_basis(cell_type: str, degree: int, X: np.ndarray) -> npt.NDArray[np.float64]:
+    """Basix's degree-1 or 2 Lagrange basis (equispaced, node order of Basix) at
+    points ``X`` ``(m, 2)``, shape ``(m, ndofs)``, in closed form: exactly 0 or 1
+    at the nodes, so values at nodes shared with a parent cell are reproduced
+    bitwise (Basix's tabulation differs by rounding)."""
+    x, y = X[:, 0], X[:, 1]
+    if cell_type == "triangle":
+        lam = [1.0 - x - y, x, y]
+        if degree == 1:
+            return np.stack(lam, axis=1)
+        return np.stack(
+            [l * (2.0 * l - 1.0) for l in lam]  # noqa: E741
+            + [4.0 * lam[i] * lam[j] for i, j in ((1, 2), (0, 2), (0, 1))],
+            axis=1,
+        )
+    if degree == 1:
+        lx, ly = [1.0 - x, x], [1.0 - y, y]
+        return np.stack([lx[0] * ly[0], lx[1] * ly[0], lx[0] * ly[1], lx[1] * ly[1]], axis=1)
+    # 1D nodes 0, 1, 1/2; tensor order: vertices, edges (0,1), (0,2), (1,3), (2,3), interior
+    lx = [2.0 * (x - 0.5) * (x - 1.0), 2.0 * x * (x - 0.5), 4.0 * x * (1.0 - x)]
+    ly = [2.0 * (y - 0.5) * (y - 1.0), 2.0 * y * (y - 0.5), 4.0 * y * (1.0 - y)]
+    order = [(0, 0), (1, 0), (0, 1), (1, 1), (2, 0), (0, 2), (1, 2), (2, 1), (2, 2)]
+    return np.stack([lx[i] * ly[j] for i, j in order], axis=1)
+
+
+def seg3_basis(s: np.ndarray) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """SEG3 shape functions and their derivatives at ``s`` ``(nq,)`` in ``[0, 1]``,
+    node order (a, b, mid) (Basix interval order); each of shape ``(nq, 3)``."""
+    N = np.stack([2 * (s - 0.5) * (s - 1), 2 * s * (s - 0.5), 4 * s * (1 - s)], axis=1)
+    dN = np.stack([4 * s - 3, 4 * s - 1, 4 - 8 * s], axis=1)
+    return N, dN
 
 
 def check_values(data: CellData, phi: npt.ArrayLike) -> npt.NDArray[np.float64]:
@@ -152,21 +232,20 @@ def describe_cells(cells: np.ndarray) -> str:
     return f"cell(s) [{shown}{', ...' if cells.size > 10 else ''}] ({cells.size} in all)"
 
 
-def topology(data: CellData, phi: np.ndarray) -> npt.NDArray[np.bool_]:
-    """Side of every vertex for the cut topology (``True``: side -1), in loop order.
+def topology(data: CellData, phi: np.ndarray) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.int8]]:
+    """Side of every vertex for the cut topology, and the cuts one SEG3 cannot represent.
 
     Args:
         data: Reference-cell data.
         phi: Checked nodal values, shape ``(ncells, ndofs)``.
 
     Returns:
-        Boolean array ``(ncells, nv)``; a cell is cut iff its row is mixed.
-
-    Raises:
-        ValueError: For cells whose interpolant crosses one edge twice, whose
-            boundary has more than two crossings (e.g. a saddle), or which are
-            uncut at the boundary but change sign inside (a closed interface
-            piece). The message names the cells and the remedy.
+        ``neg``: boolean ``(ncells, nv)``, ``True`` for loop vertices on side -1;
+        a cell with ``kind == 0`` is cut iff its row is mixed. ``kind``: ``int8``
+        ``(ncells,)``, the bitwise or of :data:`TWICE`, :data:`MANY`,
+        :data:`INTERIOR` and :data:`CORNER` (0: uncut, or one simple cut).
+        :data:`INTERIOR` is checked for degree 2 only (a bilinear or linear
+        interpolant has no closed zero line).
     """
     start, end, A, B = _loop_edges(data, phi)
     neg = start < 0
@@ -176,50 +255,200 @@ def topology(data: CellData, phi: np.ndarray) -> npt.NDArray[np.bool_]:
     in_neg = (slope_end > 0) | ((slope_end == 0) & (A < 0))  # g < 0 just before t = 1
     trig = (start == 0) & (((end >= 0) & out_neg) | (np.roll((start >= 0) & in_neg, 1, axis=1)))
     neg = neg | trig
-    neg_end = np.roll(neg, -1, axis=1)
-    tol = _TANGENCY * np.abs(phi).max(axis=1, keepdims=True)
+    tol = _TANGENCY * np.abs(phi).max(axis=1)
+    double, _ = _double_crossings(start, A, B, neg, tol)
+    changes = (neg != np.roll(neg, -1, axis=1)).sum(axis=1)
+    mixed = changes > 0
+    corner = mixed & (_zero_edges(start, A, B).sum(axis=1) >= 2) & ~(start > 0).any(axis=1)
+    kind = (
+        np.where(double.any(axis=1), TWICE, 0)
+        | np.where(changes > 2, MANY, 0)
+        | np.where(corner, CORNER, 0)
+    ).astype(np.int8)
+    if data.degree == 2:  # uncut at the boundary, or wholly -1 there: a sign change inside?
+        rows = np.flatnonzero(~mixed | corner)
+        kind[_interior_sign_changes(data, phi, neg, rows, tol)] |= INTERIOR
+    return neg, kind
+
+
+def _zero_edges(start: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Loop edges on which the interpolant vanishes identically, ``(ncells, nv)``."""
+    return (start == 0) & (A == 0) & (B == 0)
+
+
+def zero_edges(data: CellData, phi: np.ndarray) -> npt.NDArray[np.bool_]:
+    """Loop edges ``(ncells, nv)`` on which the interpolant of ``phi`` vanishes identically."""
+    start, _, A, B = _loop_edges(data, phi)
+    return _zero_edges(start, A, B)
+
+
+def _double_crossings(
+    start: np.ndarray, A: np.ndarray, B: np.ndarray, neg: np.ndarray, tol: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Loop edges whose polynomial dips beyond ``tol`` ``(ncells,)`` to the side
+    opposite to both (topological) end signs, ``(ncells, nv)``, and the parameter
+    of each edge's extremum ``-B / 2A`` (meaningful where dipping)."""
     with np.errstate(divide="ignore", invalid="ignore"):
         tstar = -B / (2.0 * A)
         gstar = start + 0.5 * B * tstar  # g(t*) = C - B^2 / (4A)
     inside = (tstar > 0) & (tstar < 1)
+    tol = tol[:, None]
     dip = inside & np.where(neg, (A < 0) & (gstar > tol), (A > 0) & (gstar < -tol))
-    double = np.flatnonzero((dip & (neg == neg_end)).any(axis=1))
-    if double.size:
-        raise ValueError(
-            f"the interpolated level set crosses an edge twice in {describe_cells(double)} "
-            f"(two interface pieces, or a cap on one edge: unsupported); {_REMEDY}"
-        )
-    changes = (neg != neg_end).sum(axis=1)
-    many = np.flatnonzero(changes > 2)
-    if many.size:
-        raise ValueError(
-            "more than two interface crossings on the boundary (saddle) of "
-            f"{describe_cells(many)}; {_REMEDY}"
-        )
-    if data.degree == 2:
-        _check_interior(data, phi, neg, changes == 0, tol[:, 0])
-    return neg
+    return dip & (neg == np.roll(neg, -1, axis=1)), tstar
 
 
-def _check_interior(
-    data: CellData, phi: np.ndarray, neg: np.ndarray, uncut: np.ndarray, tol: np.ndarray
-) -> None:
-    """Raise if a cell uncut at its boundary changes sign at the interior lattice."""
-    rows = np.flatnonzero(uncut)
-    bad: list[np.ndarray] = []
+def _interior_values(data: CellData, phi: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Interpolant at the interior lattice for cells ``rows``, ``(rows.size, npoints)``."""
+    return phi[rows] @ data.lattice_basis.T
+
+
+def _interior_sign_changes(
+    data: CellData, phi: np.ndarray, neg: np.ndarray, rows: np.ndarray, tol: np.ndarray
+) -> np.ndarray:
+    """The cells among ``rows`` (uncut at the boundary, or with no vertex on side
+    +1) whose interpolant takes the other side's sign beyond ``tol`` at an
+    interior lattice point."""
+    found = [np.zeros(0, dtype=np.int64)]
     chunk = 65536
     for k in range(0, rows.size, chunk):  # bounded memory, vectorised within a chunk
         r = rows[k : k + chunk]
-        values = phi[r] @ data.lattice_basis.T
-        minus = neg[r, 0]
+        values = _interior_values(data, phi, r)
+        minus = neg[r].any(axis=1)
         wrong = np.where(minus, values.max(axis=1) > tol[r], values.min(axis=1) < -tol[r])
-        bad.append(r[wrong])
-    found = np.concatenate(bad) if bad else np.zeros(0, dtype=np.int64)
-    if found.size:
-        raise ValueError(
-            f"the interpolated level set changes sign inside {describe_cells(found)} without "
-            f"crossing its boundary (a closed interface piece); {_REMEDY}"
+        found.append(r[wrong])
+    return np.concatenate(found)
+
+
+def describe_kinds(kind: np.ndarray) -> str:
+    """What the flags in ``kind`` say, e.g. ``"crosses an edge twice"`` (for errors)."""
+    present = int(np.bitwise_or.reduce(kind, initial=0))
+    return " / ".join(text for flag, text in KIND_NAMES.items() if present & flag)
+
+
+def split_parameters(
+    data: CellData,
+    phi: np.ndarray,
+    neg: np.ndarray,
+    kind: np.ndarray,
+    through: np.ndarray | None = None,
+    across: np.ndarray | None = None,
+) -> npt.NDArray[np.float64]:
+    """Where to split each loop edge of cells that need subdividing, ``(ncells, nv)``.
+
+    By default the mid-point (1/2). An edge crossed twice (:data:`TWICE`) is
+    split at the extremum of its polynomial, between the two crossings, so that
+    a cap of any width is separated in one step. Otherwise a cell with a point
+    ``through`` is split by a line through it: an uncut cell with an interior
+    sign change (:data:`INTERIOR`) through the lattice point of largest
+    opposite value, inside the closed piece (both lines for quadrilaterals,
+    the one parallel to edge (1, 2) for triangles); with a direction ``across``
+    given, by the one available line most transversal to it. Adaptive parameters are clamped
+    to ``[1/16, 15/16]``. Quadrilaterals split along one ``X`` and one ``Y``
+    line, so opposite loop edges get matching parameters (``t_2 = 1 - t_0``,
+    ``t_3 = 1 - t_1``).
+
+    Args:
+        data: Reference-cell data.
+        phi: Nodal values, shape ``(ncells, ndofs)``.
+        neg: Topological vertex sides from :func:`topology`, ``(ncells, nv)``.
+        kind: Flags from :func:`topology`, ``(ncells,)``.
+        through: Optional points to split through, ``(ncells, 2)``, NaN rows: none.
+        across: Optional directions to cross there, ``(ncells, 2)``, NaN rows: any.
+    """
+    n, nv = neg.shape
+    P = np.full((n, 2), np.nan) if through is None else through.copy()
+    d = np.full((n, 2), np.nan) if across is None else across
+    interior = np.flatnonzero(((kind & INTERIOR) != 0) & ((kind & TWICE) == 0))
+    if interior.size:
+        values = _interior_values(data, phi, interior)
+        sign = np.where(neg[interior].any(axis=1), 1.0, -1.0)  # towards the other side
+        P[interior] = data.lattice[np.argmax(sign[:, None] * values, axis=1)]
+    P = np.clip(P, _SPLIT_MARGIN, 1.0 - _SPLIT_MARGIN)
+    t = np.full((n, nv), 0.5)
+    has, free = ~np.isnan(P[:, 0]), np.isnan(d[:, 0])
+    if data.cell_type == "triangle":
+        # Lines through P parallel to edge (1, 2), (0, 2), (0, 1): the cuts of corners 0, 1, 2
+        directions = np.array([[1.0, -1.0], [0.0, 1.0], [1.0, 0.0]])
+        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+        dd = np.nan_to_num(d)
+        cross = np.abs(dd[:, [0]] * directions[:, 1] - dd[:, [1]] * directions[:, 0])
+        line = np.where(free, 0, np.argmax(cross, axis=1))
+        x, y = P[:, 0], P[:, 1]
+        s = np.clip(x + y, _SPLIT_MARGIN, 1.0 - _SPLIT_MARGIN)
+        options = [{0: s, 2: 1.0 - s}, {0: x, 1: 1.0 - x}, {2: 1.0 - y, 1: y}]
+        for k, option in enumerate(options):
+            rows = has & (line == k)
+            for edge, value in option.items():
+                t[rows, edge] = value[rows]
+    else:
+        along_x = np.abs(d[:, 0]) >= np.abs(d[:, 1])  # cross such directions by an X = c line
+        t[:, 0] = np.where(has & (free | along_x), P[:, 0], t[:, 0])
+        t[:, 1] = np.where(has & (free | ~along_x), P[:, 1], t[:, 1])
+    start, _, A, B = _loop_edges(data, phi)
+    tol = _TANGENCY * np.abs(phi).max(axis=1)
+    double, tstar = _double_crossings(start, A, B, neg, tol)
+    tstar = np.clip(np.where(double, tstar, 0.5), _SPLIT_MARGIN, 1.0 - _SPLIT_MARGIN)
+    if data.cell_type == "triangle":
+        t = np.where(double, tstar, t)
+    else:  # per axis: the first of the two parallel edges that is crossed twice
+        for axis in (0, 1):
+            first, other = tstar[:, axis], 1.0 - tstar[:, axis + 2]
+            adaptive = np.where(double[:, axis], first, other)
+            t[:, axis] = np.where(double[:, axis] | double[:, axis + 2], adaptive, t[:, axis])
+        t[:, 2:] = 1.0 - t[:, :2]
+    return t
+
+
+def split_cells(data: CellData, vertices: np.ndarray, t: np.ndarray) -> npt.NDArray[np.float64]:
+    """Split cells into four at the loop-edge parameters ``t`` (``(m, nv)``, from
+    :func:`split_parameters`).
+
+    Triangles split into three corner triangles and a middle one; quadrilaterals
+    (axis-parallel rectangles in the coordinates of ``vertices``) into four
+    rectangles. Children keep the orientation of the parent, and vertices shared
+    by siblings are the same floating-point numbers.
+
+    Args:
+        data: Reference-cell data.
+        vertices: Vertices of the cells in Basix order, shape ``(m, nv, 2)``.
+        t: Split parameters, shape ``(m, nv)``.
+
+    Returns:
+        Vertices of the children, shape ``(m, 4, nv, 2)``.
+    """
+
+    def point(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
+        s = s[:, None]
+        return (1.0 - s) * a + s * b  # symmetric in (a, b) for s = 1/2
+
+    V = [vertices[:, i] for i in range(vertices.shape[1])]
+    if data.cell_type == "triangle":
+        p01, p12, p20 = (
+            point(V[0], V[1], t[:, 0]),
+            point(V[1], V[2], t[:, 1]),
+            point(V[2], V[0], t[:, 2]),
         )
+        children = [(V[0], p01, p20), (p01, V[1], p12), (p20, p12, V[2]), (p12, p20, p01)]
+    else:
+        x0, x1, y0, y1 = V[0][:, 0], V[1][:, 0], V[0][:, 1], V[2][:, 1]
+        xs = point(x0[:, None], x1[:, None], t[:, 0])[:, 0]
+        ys = point(y0[:, None], y1[:, None], t[:, 1])[:, 0]
+        children = []
+        for ya, yb in ((y0, ys), (ys, y1)):
+            for xa, xb in ((x0, xs), (xs, x1)):
+                corners = [(xa, ya), (xb, ya), (xa, yb), (xb, yb)]
+                children.append(tuple(np.stack(c, axis=1) for c in corners))
+    return np.stack([np.stack(c, axis=1) for c in children], axis=1)
+
+
+def straight_triangles(data: CellData, vertices: np.ndarray) -> npt.NDArray[np.float64]:
+    """Straight P2 triangles tiling cells, counter-clockwise, Basix node order:
+    shape ``(m, 1, 6, 2)`` for triangles, ``(m, 2, 6, 2)`` for quadrilaterals
+    (diagonal from vertex 0 to vertex 3), from vertices ``(m, nv, 2)`` (Basix order)."""
+    tris = [(0, 1, 2)] if data.cell_type == "triangle" else [(0, 1, 3), (0, 3, 2)]
+    v = vertices[:, np.array(tris)]  # (m, ntri, 3, 2)
+    mids = 0.5 * (v[:, :, [1, 0, 0]] + v[:, :, [2, 2, 1]])
+    return np.concatenate([v, mids], axis=2)
 
 
 def side_polygon(code: int, nv: int, side: int) -> list[int]:

@@ -27,6 +27,7 @@ import numpy as np
 import numpy.typing as npt
 
 from xfem_contact.cut import CutGeometry
+from xfem_contact.cut_topology import seg3_basis
 
 __all__ = ["RuleSet", "interface_rule", "side_rules"]
 
@@ -80,7 +81,7 @@ def side_rules(geom: CutGeometry, side: int, degree: int, ncut: int) -> RuleSet:
         geom: Sub-triangulation of the cut cells.
         side: -1 or +1.
         degree: Polynomial degree of the triangle rule.
-        ncut: Number of cut cells (rules), ``geom.seg.shape[0]``.
+        ncut: Number of cut cells (rules), ``geom.num_cells``.
 
     Returns:
         A :class:`RuleSet` (no normals); cells without sub-triangles on this
@@ -88,8 +89,7 @@ def side_rules(geom: CutGeometry, side: int, degree: int, ncut: int) -> RuleSet:
     """
     if side not in (-1, 1):
         raise ValueError(f"side must be -1 or +1, got {side!r}")
-    if ncut != geom.seg.shape[0]:
-        raise ValueError(f"ncut = {ncut} but the geometry has {geom.seg.shape[0]} cut cells")
+    _check_ncut(geom, ncut)
     tri, cell = (
         (geom.tri_minus, geom.tri_minus_cell) if side == -1 else (geom.tri_plus, geom.tri_plus_cell)
     )
@@ -105,12 +105,13 @@ def side_rules(geom: CutGeometry, side: int, degree: int, ncut: int) -> RuleSet:
     return RuleSet(X.reshape(-1, 2), weights.reshape(-1), _offsets(counts))
 
 
-def _seg3(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """SEG3 shape functions and derivatives at ``s`` in ``[0, 1]``, node order
-    (a, b, mid); each of shape ``(nq, 3)``."""
-    N = np.stack([2 * (s - 0.5) * (s - 1), 2 * s * (s - 0.5), 4 * s * (1 - s)], axis=1)
-    dN = np.stack([4 * s - 3, 4 * s - 1, 4 - 8 * s], axis=1)
-    return N, dN
+def _check_ncut(geom: CutGeometry, ncut: int) -> None:
+    """Raise unless ``ncut`` is the geometry's number of cut cells."""
+    if ncut != geom.num_cells:
+        raise ValueError(
+            f"ncut = {ncut} but the geometry has {geom.num_cells} cut cells; "
+            "pass the number of rows given to cut.subtriangulate"
+        )
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -127,6 +128,9 @@ def interface_rule(
 ) -> RuleSet:
     """Gauss-Legendre rules on the SEG3 interface pieces, with physical normals.
 
+    The rule of a cut cell concatenates those of its pieces (several in a
+    subdivided cell).
+
     A point ``s`` (weight ``w_hat``) of ``basix.make_quadrature(interval, degree)``
     maps to ``X(s)`` through the SEG3 nodes ``a, mid, b`` at ``s = 0, 1/2, 1``.
     With the parent Jacobian ``J = dx/dX`` the physical tangent is
@@ -136,12 +140,13 @@ def interface_rule(
     normal of the SEG3, i.e. the tangent ``t`` rotated by 90 degrees when
     ``gdim = 2``), oriented so that it has a non-negative component along the
     physical level-set gradient ``J (J^T J)^{-1} grad_ref(phi)``. Zero-length
-    pieces (the interface touches the cell at one point) get empty rules.
+    pieces (the interface touches the cell at one point) contribute no points;
+    a cell without other pieces gets an empty rule.
 
     Args:
         geom: Sub-triangulation of the cut cells.
         degree: Polynomial degree of the interval rule.
-        ncut: Number of cut cells, ``geom.seg.shape[0]``.
+        ncut: Number of cut cells, ``geom.num_cells``.
         jacobian: ``(rows (m,), X (m, 2)) -> (m, gdim, 2)``: the parent map's
             Jacobian at reference points of cut cells ``rows``.
         grad_phi_ref: ``(rows (m,), X (m, 2)) -> (m, 2)``: reference gradient of
@@ -150,16 +155,16 @@ def interface_rule(
     Returns:
         A :class:`RuleSet` with normals of shape ``(N, gdim)``.
     """
+    _check_ncut(geom, ncut)
     seg = geom.seg
-    if ncut != seg.shape[0]:
-        raise ValueError(f"ncut = {ncut} but the geometry has {seg.shape[0]} cut cells")
-    keep = ~(seg[:, 0] == seg[:, 1]).all(axis=1)
-    cells = np.flatnonzero(keep)
+    pieces = np.flatnonzero(~(seg[:, 0] == seg[:, 1]).all(axis=1))
+    pieces = pieces[np.argsort(geom.seg_cell[pieces], kind="stable")]
+    cells = geom.seg_cell[pieces]
     s, w_hat = basix.make_quadrature(basix.CellType.interval, degree)
     nq = s.shape[0]
-    N, dN = _seg3(s[:, 0])
-    X = np.einsum("qk,ckd->cqd", N, seg[cells]).reshape(-1, 2)
-    dX = np.einsum("qk,ckd->cqd", dN, seg[cells]).reshape(-1, 2)
+    N, dN = seg3_basis(s[:, 0])
+    X = np.einsum("qk,ckd->cqd", N, seg[pieces]).reshape(-1, 2)
+    dX = np.einsum("qk,ckd->cqd", dN, seg[pieces]).reshape(-1, 2)
     rows = np.repeat(cells, nq)
     J = np.asarray(jacobian(rows, X), dtype=np.float64)
     if J.ndim != 3 or J.shape[0] != rows.size or J.shape[2] != 2:
@@ -169,10 +174,10 @@ def interface_rule(
     Ginv = np.stack([[G[:, 1, 1], -G[:, 0, 1]], [-G[:, 1, 0], G[:, 0, 0]]]).transpose(2, 0, 1)
     Ginv = Ginv / detG[:, None, None]
     t = np.einsum("mdi,mi->md", J, dX)
-    weights = np.tile(w_hat, cells.size) * np.linalg.norm(t, axis=1) / np.sqrt(detG)
+    weights = np.tile(w_hat, pieces.size) * np.linalg.norm(t, axis=1) / np.sqrt(detG)
     n_ref = np.stack([dX[:, 1], -dX[:, 0]], axis=1)  # towards side +1 (see CutGeometry.seg)
     normal = _unit(np.einsum("mdi,mij,mj->md", J, Ginv, n_ref))
     grad = np.asarray(grad_phi_ref(rows, X), dtype=np.float64)
     grad_x = np.einsum("mdi,mij,mj->md", J, Ginv, grad)
     normal = np.where(((normal * grad_x).sum(axis=1) < 0)[:, None], -normal, normal)
-    return RuleSet(X, weights, _offsets(keep * nq), normal)
+    return RuleSet(X, weights, _offsets(np.bincount(cells, minlength=ncut) * nq), normal)
