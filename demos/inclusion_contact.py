@@ -77,13 +77,13 @@ def main():
     write_fields(out, "displacement", fields[:2])
     write_fields(out, "multiplier", fields[2:])
     write_lips(out / "lips.vtu", cut, fields[0], fields[1])
+    dofs = problem.space.dof_counts()  # collective
     gathered = comm.gather(samples, root=0)
     if comm.rank == 0:
         samples = np.concatenate(gathered)
         theta = np.arctan2(samples[:, 1] - INCLUSION_CENTRE[1], samples[:, 0] - INCLUSION_CENTRE[0])
         order = np.argsort(theta)
         plot(out / "contact_pressure.png", theta[order], samples[order, 2], args)
-        dofs = problem.space.dof_counts()
         summary = {
             "case": "paper case 2: circular inclusion, contact",
             "n": args.n,
