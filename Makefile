@@ -37,6 +37,7 @@ test-notebooks: $(VENV)/.installed
 
 bench: $(VENV)/.installed
 	$(PY) bench/quadrature.py
+	$(PY) bench/contact_convergence.py
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check xfem_contact tests demos bench
