@@ -115,3 +115,108 @@ def test_runtime_rules_match_moment_fitting(cell, degree):
         )
         runtime = integrate(integrand * runtime_only.measure())
         assert runtime == pytest.approx(oracle, abs=1e-12)
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("degree", [1, 2])
+def test_boundary_pieces_exact(cell, degree):
+    """cut.ds(side, facets): split lengths of cut boundary facets, with the facet normal."""
+    mesh = unit_square(5, cell, distorted=False)
+    cut = xfem_contact.CutMesh(mesh, lambda x: 0.3 * x[0] + x[1] - 0.61, degree=degree)
+    fdim = mesh.topology.dim - 1
+    left = dolfinx.mesh.locate_entities_boundary(mesh, fdim, lambda x: np.isclose(x[0], 0.0))
+    right = dolfinx.mesh.locate_entities_boundary(mesh, fdim, lambda x: np.isclose(x[0], 1.0))
+    c = one(mesh)
+    n = ufl.FacetNormal(mesh)
+    x = ufl.SpatialCoordinate(mesh)
+    assert integrate(c * cut.ds(-1, left)) == pytest.approx(0.61, abs=1e-13)
+    assert integrate(c * cut.ds(1, left)) == pytest.approx(0.39, abs=1e-13)
+    assert integrate(n[0] * cut.ds(-1, right)) == pytest.approx(0.31, abs=1e-13)
+    assert integrate(x[1] * cut.ds(1, right)) == pytest.approx((1 - 0.31**2) / 2, abs=1e-13)
+    tags = dolfinx.mesh.meshtags(mesh, fdim, np.sort(left), np.full(left.size, 7, np.int32))
+    assert integrate(c * cut.ds(1, tags, 7)) == pytest.approx(0.39, abs=1e-13)
+    with pytest.raises(ValueError, match="No facet carries"):
+        cut.ds(1, tags, 8)
+
+
+def test_update_reuses_compiled_forms():
+    """A moved interface: new rules, same compiled kernels."""
+    from xfem_contact import forms
+
+    mesh = unit_square(8, "quadrilateral")
+    cut = xfem_contact.CutMesh(mesh, lambda x: np.hypot(x[0] - 0.5, x[1] - 0.5) - 0.2)
+    c = one(mesh)
+    area = integrate(c * cut.dx(-1))
+    compiled = len(forms._cache)
+    cut.update(lambda x: np.hypot(x[0] - 0.45, x[1] - 0.5) - 0.3)
+    moved = integrate(c * cut.dx(-1))
+    assert len(forms._cache) == compiled
+    assert area == pytest.approx(np.pi * 0.04, rel=1e-3)
+    assert moved == pytest.approx(np.pi * 0.09, rel=1e-3)
+
+
+def test_bad_level_sets_raise():
+    mesh = unit_square(4, "triangle")
+    with pytest.raises(ValueError, match="never crosses"):
+        xfem_contact.CutMesh(mesh, lambda x: 1.0 + x[0])
+    with pytest.raises(ValueError, match="NaN"):
+        xfem_contact.CutMesh(mesh, lambda x: np.where(x[0] > 0.5, np.nan, x[0] - 0.3))
+    with pytest.raises(ValueError, match="degree"):
+        xfem_contact.CutMesh(mesh, lambda x: x[0] - 0.3, degree=3)
+
+
+def curved_square(n: int):
+    """Unit square meshed by n x n curved 9-node quadrilaterals (Q2 geometry)."""
+    import basix.ufl
+
+    m = 2 * n + 1
+    s = np.linspace(0.0, 1.0, m)
+    X, Y = np.meshgrid(s, s, indexing="xy")
+    x = np.c_[X.ravel(), Y.ravel()]
+    bump = 0.05 * np.sin(np.pi * x[:, 0]) * np.sin(np.pi * x[:, 1])
+    x = x + np.c_[bump * np.cos(3 * x[:, 1]), bump * np.sin(2 * x[:, 0])]
+    node = lambda i, j: i + m * j  # noqa: E731
+    cells = []
+    for j in range(0, m - 1, 2):
+        for i in range(0, m - 1, 2):
+            cells.append(
+                [
+                    node(i, j),
+                    node(i + 2, j),
+                    node(i, j + 2),
+                    node(i + 2, j + 2),
+                    node(i + 1, j),
+                    node(i, j + 1),
+                    node(i + 2, j + 1),
+                    node(i + 1, j + 2),
+                    node(i + 1, j + 1),
+                ]
+            )
+    element = basix.ufl.element("Lagrange", "quadrilateral", 2, shape=(2,))
+    comm = MPI.COMM_WORLD
+    if comm.rank != 0:
+        x, cells = np.zeros((0, 2)), np.zeros((0, 9), dtype=np.int64)
+    return dolfinx.mesh.create_mesh(comm, np.array(cells, dtype=np.int64), element, x)
+
+
+def test_curved_q2_cells_disc_area():
+    """Curved 9-node parent cells: disc area and circle length converge at high order."""
+    sizes = [8, 16, 32, 64]
+    errors = []
+    for n in sizes:
+        mesh = curved_square(n)
+        cut = xfem_contact.CutMesh(mesh, distance, degree=2)
+        c = one(mesh)
+        assert integrate(c * cut.dx(-1)) + integrate(c * cut.dx(1)) == pytest.approx(
+            integrate(c * ufl.dx(domain=mesh)), abs=1e-12
+        )
+        errors.append(
+            (
+                abs(integrate(c * cut.dx(-1)) - np.pi * RADIUS**2),
+                abs(integrate(c * cut.dGamma) - 2 * np.pi * RADIUS),
+            )
+        )
+    errors = np.array(errors)
+    print("\ncurved Q2 cells: area/length errors", errors.tolist())
+    assert rate(sizes, errors[:, 0]) >= 3.5
+    assert rate(sizes, errors[:, 1]) >= 3.5
