@@ -54,8 +54,9 @@ def main():
     if args.law == "coulomb":
         options["friction"] = args.friction
     problem = inclusion_problem(args.n, args.degree, args.law, args.cell, **options)
-    timings["cut_and_quadrature"] = time.perf_counter() - t0
     cut = problem.cut
+    timings |= cut.timings  # "cut" and "quadrature"
+    timings["spaces_and_forms"] = time.perf_counter() - t0 - sum(cut.timings.values())
     say(f"  {cut.num_cut_cells_global} cut cells; dofs {problem.space.dof_counts()._asdict()}")
 
     report = problem.solve(log=say)

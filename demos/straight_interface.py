@@ -60,8 +60,8 @@ def main():
     say(f"degree {args.degree}: dofs {dofs.standard} standard + {dofs.enriched} enriched")
 
     xi = interface_points(cut)
-    lower = evaluate_at_rules(solution.w.sub(0), cut, cut.rules[3])
-    upper = evaluate_at_rules(solution.w.sub(1), cut, cut.rules[3])
+    lower = evaluate_at_rules(solution.w.sub(0), cut, cut.interface_rules)
+    upper = evaluate_at_rules(solution.w.sub(1), cut, cut.interface_rules)
     exact = np.array(straight_interface_exact(xi.T)).T
     umax = comm.allreduce(np.max(np.abs(exact), initial=0.0), op=MPI.MAX)
     err_upper = comm.allreduce(np.max(np.abs(upper - exact), initial=0.0), op=MPI.MAX) / umax

@@ -53,7 +53,7 @@ def _interface_values(cut, w, field):
     """Field values at the interface quadrature points, shape (npoints, 2)."""
     from xfem_contact.evaluation import evaluate_at_rules
 
-    return evaluate_at_rules(w.sub(field), cut, cut.rules[3])
+    return evaluate_at_rules(w.sub(field), cut, cut.interface_rules)
 
 
 @pytest.mark.mpi

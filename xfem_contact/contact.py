@@ -173,7 +173,7 @@ class ContactProblem(ElasticityProblem):
         and ``r`` (Pa/m).
         """
         cut = self.cut
-        rules = cut.rules[3]
+        rules = cut.interface_rules
         jump = evaluate_at_rules(w.sub(1), cut, rules) - evaluate_at_rules(w.sub(0), cut, rules)
         lam = evaluate_at_rules(w.sub(2), cut, rules)
         normals = rules.normals

@@ -5,6 +5,7 @@ and for the interface.
 from __future__ import annotations
 
 import itertools
+import time
 
 import dolfinx.fem
 import dolfinx.mesh
@@ -73,6 +74,7 @@ class CutMesh:
         mesh = self.mesh
         tdim = mesh.topology.dim
         cell_name = mesh.topology.cell_name()
+        start = time.perf_counter()
         self.levelset: LevelSet = interpolate(mesh, levelset, self.degree)
         maps = CellMaps(mesh, self.levelset)
         num_owned = mesh.topology.index_map(tdim).size_local
@@ -86,6 +88,7 @@ class CutMesh:
         )
         self.geometry = geometry
         self.cut_cells = cut_cells
+        cut_time = time.perf_counter() - start
         q = self.quadrature_degree
         rules = {
             _SIDE_MINUS: quadrature.side_rules(geometry, -1, q, ncut),
@@ -98,7 +101,7 @@ class CutMesh:
                 lambda rows, X: maps.grad_ref(cut_cells[rows], X),
             ),
         }
-        self.rules = {sid: rules[sid] for sid in rules}
+        self.rules = rules
         self._cell_rules = {
             sid: CellRules(mesh, cut_cells, r.points, r.weights, r.offsets)
             for sid, r in rules.items()
@@ -107,6 +110,20 @@ class CutMesh:
         self.maps = maps
         self._boundary_parts = {}
         self.num_cut_cells_global = mesh.comm.allreduce(ncut, op=MPI.SUM)
+        #: Wall time (s) of the last update: level set + classification +
+        #: sub-triangulation ("cut"), and per-cell rules ("quadrature")
+        self.timings = {"cut": cut_time, "quadrature": time.perf_counter() - start - cut_time}
+
+    def side_rules(self, side: int) -> quadrature.RuleSet:
+        """Per-cut-cell rules of side -1 or +1 (reference points, weights)."""
+        if side not in (-1, 1):
+            raise ValueError(f"side must be -1 or +1, got {side!r}")
+        return self.rules[_SIDE_MINUS if side == -1 else _SIDE_PLUS]
+
+    @property
+    def interface_rules(self) -> quadrature.RuleSet:
+        """Per-cut-cell interface rules (weights ``ds / |det J|``, physical normals)."""
+        return self.rules[_INTERFACE]
 
     # -- measures -----------------------------------------------------------
     def dx(self, side: int, metadata: dict | None = None) -> ufl.Measure:

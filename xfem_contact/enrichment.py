@@ -120,7 +120,7 @@ class EnrichedSpace:
                 support &= fraction >= self.min_support_fraction
             active |= support
         if self.has_multiplier:
-            rules = cut.rules[3]  # interface
+            rules = cut.interface_rules  # interface
             length = np.zeros(cut.cut_cells.size)
             rows = np.repeat(np.arange(length.size), np.diff(rules.offsets))
             np.add.at(length, rows, rules.weights * _abs_det_at(cut, rules))
@@ -133,7 +133,7 @@ class EnrichedSpace:
         cut = self.cut
         areas = _cell_areas(cut)
         side_area = np.where(cut.cell_sides == side, areas, 0.0)
-        rules = cut.rules[1 if side == -1 else 2]
+        rules = cut.side_rules(side)
         cut_area = (
             np.add.reduceat(rules.weights * _abs_det_at(cut, rules), rules.offsets[:-1])
             if rules.weights.size

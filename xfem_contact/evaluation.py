@@ -54,5 +54,5 @@ def evaluate_at_rules(
 
 def interface_points(cut: CutMesh) -> npt.NDArray[np.float64]:
     """Physical coordinates of the interface quadrature points, shape ``(npoints, gdim)``."""
-    rules = cut.rules[3]
+    rules = cut.interface_rules
     return cut.maps.push_forward(rule_cells(cut, rules), rules.points)
