@@ -220,3 +220,23 @@ def test_curved_q2_cells_disc_area():
     print("\ncurved Q2 cells: area/length errors", errors.tolist())
     assert rate(sizes, errors[:, 0]) >= 3.5
     assert rate(sizes, errors[:, 1]) >= 3.5
+
+
+@pytest.mark.mpi
+def test_parallel_equals_serial_integrals():
+    """Disc area, circle length and a polynomial moment: this communicator vs each
+    process alone, to 1e-12."""
+    values = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        mesh = dolfinx.mesh.create_unit_square(comm, 16, 16, dolfinx.mesh.CellType.quadrilateral)
+        cut = xfem_contact.CutMesh(mesh, distance, degree=2)
+        x = ufl.SpatialCoordinate(mesh)
+        c = one(mesh)
+        values.append(
+            [
+                integrate(c * cut.dx(-1)),
+                integrate(c * cut.dGamma),
+                integrate(x[0] * x[1] ** 2 * cut.dx(1)),
+            ]
+        )
+    assert np.allclose(values[0], values[1], rtol=0, atol=1e-12)
