@@ -26,6 +26,7 @@ from mpi4py import MPI
 from xfem_contact.evaluation import interface_points
 from xfem_contact.output import write_fields, write_json, write_lips
 from xfem_contact.paper_cases import INCLUSION_CENTRE, inclusion_errors, inclusion_problem
+from xfem_contact.plots import Series, line_plot
 
 
 def main():
@@ -107,22 +108,17 @@ def main():
 
 
 def plot(path, theta, pressure, args):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     t = np.linspace(-np.pi, np.pi, 400)
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(np.degrees(theta), pressure, ".", ms=3, label="X-FEM multiplier $\\lambda_n$")
-    ax.plot(np.degrees(t), -1.5 + 0.5 * np.cos(2 * t), "k--", label="exact $n\\cdot\\sigma n$")
-    ax.set_xlabel("angle (degrees)")
-    ax.set_ylabel("contact pressure (Pa)")
-    ax.set_title(f"Case 2, {args.n}x{args.n}, degree {args.degree}, {args.law}")
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    line_plot(
+        path,
+        [
+            Series(np.degrees(theta), pressure, ".", "X-FEM multiplier $\\lambda_n$"),
+            Series(np.degrees(t), -1.5 + 0.5 * np.cos(2 * t), "k--", "exact $n\\cdot\\sigma n$"),
+        ],
+        "angle (degrees)",
+        "contact pressure (Pa)",
+        f"Case 2, {args.n}x{args.n}, degree {args.degree}, {args.law}",
+    )
 
 
 if __name__ == "__main__":

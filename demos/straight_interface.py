@@ -30,6 +30,7 @@ from mpi4py import MPI
 from xfem_contact.evaluation import evaluate_at_rules, interface_points
 from xfem_contact.output import write_fields, write_json, write_lips
 from xfem_contact.paper_cases import straight_interface_exact, straight_interface_problem
+from xfem_contact.plots import Series, line_plot
 
 
 def main():
@@ -121,23 +122,18 @@ def main():
 
 
 def plot(path, upper, lower, args):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     x = np.linspace(-1.5, 1.5, 200)
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(upper[:, 0], upper[:, 3] * 1e6, "o", ms=3, label="upper lip (X-FEM)")
-    ax.plot(lower[:, 0], lower[:, 3] * 1e6, "s", ms=3, label="lower lip (X-FEM)")
-    ax.plot(x, (9.5e-6 - 2.5e-6 * x**2) * 1e6, "k--", label="exact upper lip")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("u_y on the interface (µm)")
-    ax.set_title(f"Case 1, degree {args.degree}, {args.cell}")
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    line_plot(
+        path,
+        [
+            Series(upper[:, 0], upper[:, 3] * 1e6, "o", "upper lip (X-FEM)"),
+            Series(lower[:, 0], lower[:, 3] * 1e6, "s", "lower lip (X-FEM)"),
+            Series(x, (9.5e-6 - 2.5e-6 * x**2) * 1e6, "k--", "exact upper lip"),
+        ],
+        "x (m)",
+        "u_y on the interface (µm)",
+        f"Case 1, degree {args.degree}, {args.cell}",
+    )
 
 
 if __name__ == "__main__":
