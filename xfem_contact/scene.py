@@ -1,0 +1,294 @@
+"""Scenes: a declarative description of a simulation, loadable from TOML.
+
+A scene names the mesh, the interfaces (level sets) with their laws, the
+materials of each side, boundary conditions and loads, and the discretisation.
+:func:`load_scene` validates everything before anything is built; errors name
+the key and the valid choices. :func:`xfem_contact.simulate.run` then builds
+*only the effects the scene names* (no interface: plain elasticity, no cut;
+``free``/``bonded``: one linear solve; contact laws: SNES).
+
+Example (TOML)::
+
+    [mesh]
+    corners = [[0.0, 0.0], [1.0, 1.0]]
+    cells = [20, 20]
+    cell = "quadrilateral"
+
+    [materials.rubber]
+    E = 100e6
+    nu = 0.0
+
+    [[interfaces]]
+    shape = "circle"
+    centre = [0.5, 0.5]
+    radius = 0.2
+    law = "sticking"
+    inside = "rubber"
+    outside = "rubber"
+
+    [[loads]]
+    part = "top"
+    type = "pressure"
+    value = 2.0
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import pathlib
+import tomllib
+
+from xfem_contact.contact import CONTACT_LAWS
+from xfem_contact.elasticity import INTERFACE_LAWS
+from xfem_contact.expressions import compile_expression
+from xfem_contact.materials import Material
+
+LAWS = INTERFACE_LAWS + CONTACT_LAWS
+SHAPES = ("circle", "ellipse", "line", "half-plane", "expression")
+LOAD_TYPES = ("pressure", "traction", "displacement", "point_displacement", "body_force")
+KINEMATICS = ("small", "large")
+CELLS = ("quadrilateral", "triangle")
+BUILTIN_PARTS = ("left", "right", "bottom", "top", "boundary")
+
+#: Allowed keys of each table, with their meaning (the schema in one place)
+SCHEMA = {
+    "scene": {"name": "scene name", "description": "free text"},
+    "mesh": {"corners": "[[x0, y0], [x1, y1]] (m)", "cells": "[nx, ny]", "cell": f"one of {CELLS}"},
+    "discretisation": {
+        "degree": "displacement degree 1 or 2",
+        "levelset_degree": "1 or 2",
+        "quadrature_degree": ">= 1",
+    },
+    "interface": {
+        "name": "label",
+        "shape": f"one of {SHAPES}",
+        "centre": "[x, y] (m)",
+        "radius": "(m)",
+        "axes": "[a, b] (m)",
+        "angle": "(rad)",
+        "point": "[x, y]",
+        "normal": "[nx, ny]",
+        "expression": "phi(x, y), negative inside",
+        "law": f"one of {LAWS}",
+        "friction": "Coulomb coefficient >= 0",
+        "augmentation": "> 0",
+        "lbb": "stabilized | restriction",
+        "kinematics": f"one of {KINEMATICS}",
+        "inside": "material of side -1",
+        "outside": "material of side +1",
+    },
+    "material": {
+        "E": "Young's modulus (Pa) > 0",
+        "nu": "Poisson ratio in (-1, 0.5)",
+        "plane": "strain | stress",
+    },
+    "part": {"where": "boolean expression of x, y selecting boundary facets"},
+    "load": {
+        "part": "a boundary part name",
+        "type": f"one of {LOAD_TYPES}",
+        "value": "number, [vx, vy], or expression(s) of x, y",
+        "side": "-1 or +1 (default both)",
+        "component": "0 or 1 (displacement)",
+        "point": "[x, y] (point_displacement)",
+    },
+    "outputs": {"vtx": "write VTX fields (bool)", "png": "write pictures (bool)"},
+}
+TOP_LEVEL = (
+    "scene",
+    "mesh",
+    "discretisation",
+    "materials",
+    "interfaces",
+    "parts",
+    "loads",
+    "outputs",
+)
+
+
+@dataclasses.dataclass(frozen=True)
+class InterfaceSpec:
+    shape: str
+    law: str
+    inside: str
+    outside: str
+    params: dict
+    name: str = "interface"
+    friction: float | None = None
+    augmentation: float = 1.0
+    lbb: str = "stabilized"
+    kinematics: str = "small"
+
+
+@dataclasses.dataclass(frozen=True)
+class LoadSpec:
+    part: str | None
+    type: str
+    value: object
+    side: int | None = None
+    component: int | None = None
+    point: tuple | None = None
+
+
+@dataclasses.dataclass(frozen=True)
+class Scene:
+    """A validated scene (see the module docstring for the TOML form)."""
+
+    name: str
+    corners: tuple
+    cells: tuple
+    cell: str
+    degree: int
+    levelset_degree: int
+    quadrature_degree: int
+    materials: dict[str, Material]
+    interfaces: tuple[InterfaceSpec, ...]
+    parts: dict[str, str]
+    loads: tuple[LoadSpec, ...]
+    outputs: dict
+
+
+def _check_keys(table: dict, allowed, where: str) -> None:
+    unknown = sorted(set(table) - set(allowed))
+    if unknown:
+        raise ValueError(f"Unknown key(s) {unknown} in [{where}]; valid: {sorted(allowed)}")
+
+
+def _choice(value, choices, where: str):
+    if value not in choices:
+        raise ValueError(f"{where} = {value!r} is not valid; choose one of {list(choices)}")
+    return value
+
+
+def load_scene(source: str | pathlib.Path | dict) -> Scene:
+    """Read and validate a scene from a TOML file path or an already parsed dict."""
+    if isinstance(source, dict):
+        data = source
+    else:
+        with open(source, "rb") as f:
+            data = tomllib.load(f)
+    _check_keys(data, TOP_LEVEL, "top level")
+    head = data.get("scene", {})
+    _check_keys(head, SCHEMA["scene"], "scene")
+    mesh = data.get("mesh", {})
+    _check_keys(mesh, SCHEMA["mesh"], "mesh")
+    disc = data.get("discretisation", {})
+    _check_keys(disc, SCHEMA["discretisation"], "discretisation")
+    degree = _choice(disc.get("degree", 2), (1, 2), "discretisation.degree")
+    ls_degree = _choice(disc.get("levelset_degree", 2), (1, 2), "discretisation.levelset_degree")
+    q_degree = int(disc.get("quadrature_degree", 6))
+    if q_degree < 1:
+        raise ValueError(f"discretisation.quadrature_degree must be >= 1, got {q_degree}")
+
+    materials = {}
+    for name, table in data.get("materials", {}).items():
+        _check_keys(table, SCHEMA["material"], f"materials.{name}")
+        try:
+            materials[name] = Material(
+                float(table["E"]), float(table["nu"]), table.get("plane", "strain")
+            )
+        except KeyError as missing:
+            raise ValueError(f"materials.{name} needs {missing}") from None
+    if not materials:
+        raise ValueError("The scene defines no material ([materials.NAME] with E and nu)")
+
+    interfaces = []
+    for k, table in enumerate(data.get("interfaces", [])):
+        where = f"interfaces[{k}]"
+        _check_keys(table, SCHEMA["interface"], where)
+        shape = _choice(table.get("shape"), SHAPES, f"{where}.shape")
+        law = _choice(table.get("law", "bonded"), LAWS, f"{where}.law")
+        kinematics = _choice(table.get("kinematics", "small"), KINEMATICS, f"{where}.kinematics")
+        if kinematics == "large":
+            raise NotImplementedError(
+                f"{where}.kinematics = 'large' (large sliding with slave/master pairing) is "
+                "not available yet; use 'small'"
+            )
+        for side_key in ("inside", "outside"):
+            name = table.get(side_key, next(iter(materials)))
+            if name not in materials:
+                raise ValueError(
+                    f"{where}.{side_key} = {name!r}: no such material; defined: {sorted(materials)}"
+                )
+        if shape == "expression":
+            compile_expression(table.get("expression", ""), f"{where}.expression")
+        params = {
+            k2: v
+            for k2, v in table.items()
+            if k2 in ("centre", "radius", "axes", "angle", "point", "normal", "expression")
+        }
+        interfaces.append(
+            InterfaceSpec(
+                shape=shape,
+                law=law,
+                params=params,
+                name=table.get("name", f"interface{k}"),
+                inside=table.get("inside", next(iter(materials))),
+                outside=table.get("outside", next(iter(materials))),
+                friction=table.get("friction"),
+                augmentation=float(table.get("augmentation", 1.0)),
+                lbb=table.get("lbb", "stabilized"),
+                kinematics=kinematics,
+            )
+        )
+    if len(interfaces) > 1:
+        raise NotImplementedError("Several interfaces in one scene are not available yet")
+
+    parts = {}
+    for name, table in data.get("parts", {}).items():
+        _check_keys(table, SCHEMA["part"], f"parts.{name}")
+        compile_expression(table.get("where", ""), f"parts.{name}.where")
+        parts[name] = table["where"]
+
+    loads = []
+    known_parts = set(BUILTIN_PARTS) | set(parts)
+    for k, table in enumerate(data.get("loads", [])):
+        where = f"loads[{k}]"
+        _check_keys(table, SCHEMA["load"], where)
+        kind = _choice(table.get("type"), LOAD_TYPES, f"{where}.type")
+        part = table.get("part")
+        if kind not in ("point_displacement", "body_force"):
+            if part not in known_parts:
+                raise ValueError(
+                    f"{where}.part = {part!r}: no such boundary part; known: {sorted(known_parts)}"
+                )
+        side = table.get("side")
+        if side is not None:
+            _choice(side, (-1, 1), f"{where}.side")
+        if "value" not in table:
+            raise ValueError(f"{where} needs a value")
+        loads.append(
+            LoadSpec(
+                part,
+                kind,
+                table["value"],
+                side,
+                table.get("component"),
+                tuple(table["point"]) if "point" in table else None,
+            )
+        )
+
+    outputs = data.get("outputs", {})
+    _check_keys(outputs, SCHEMA["outputs"], "outputs")
+    cells = tuple(mesh.get("cells", [20, 20]))
+    if len(cells) != 2 or min(cells) < 1:
+        raise ValueError(f"mesh.cells must be [nx, ny] with positive entries, got {cells}")
+    return Scene(
+        name=head.get("name", "scene"),
+        corners=tuple(tuple(map(float, c)) for c in mesh.get("corners", [[0, 0], [1, 1]])),
+        cells=cells,
+        cell=_choice(mesh.get("cell", "quadrilateral"), CELLS, "mesh.cell"),
+        degree=degree,
+        levelset_degree=ls_degree,
+        quadrature_degree=q_degree,
+        materials=materials,
+        interfaces=tuple(interfaces),
+        parts=parts,
+        loads=tuple(loads),
+        outputs={"vtx": True, "png": True, **outputs},
+    )
+
+
+def bundled_scenes() -> dict[str, pathlib.Path]:
+    """The scenes shipped with the package, by name."""
+    folder = pathlib.Path(__file__).parent / "scenes"
+    return {p.stem: p for p in sorted(folder.glob("*.toml"))}
