@@ -113,3 +113,17 @@ def test_bad_contact_input_raises():
         ContactProblem(cut, 1, material, "sticking", augmentation=0.0)
     with pytest.raises(ValueError, match="LBB"):
         ContactProblem(cut, 1, material, "sticking", lbb="magic")
+
+
+def test_solved_problems_are_freed():
+    """No reference cycle through PETSc callbacks or the compile cache keeps a
+    solved problem, its cut or its mesh alive (each holds MPI communicators)."""
+    import gc
+    import weakref
+
+    problem = inclusion_problem(6, 1, "sticking")
+    problem.solve()
+    refs = [weakref.ref(o) for o in (problem, problem.cut, problem.mesh)]
+    del problem
+    gc.collect()
+    assert all(r() is None for r in refs)

@@ -18,7 +18,7 @@ import dolfinx.mesh
 import numpy as np
 import ufl
 from dolfinx.fem import IntegralType
-from dolfinx.fem.forms import compile_form, create_form, get_integration_domains
+from dolfinx.fem.forms import CompiledForm, compile_form, create_form, get_integration_domains
 from ffcx.analysis import analyze_ufl_objects
 from ffcx.ir.representation import compute_ir
 from ffcx.options import get_options
@@ -38,7 +38,13 @@ _TYPES = {
 
 
 class _Compiled(typing.NamedTuple):
-    form: dolfinx.fem.CompiledForm
+    """What is kept per form signature: the JIT-compiled module and the runtime
+    table layouts. No UFL form is kept, so no mesh or function stays alive."""
+
+    ufcx_form: typing.Any
+    module: typing.Any
+    code: typing.Any
+    dtype: typing.Any
     kernels: dict[int, RuntimeIntegral]
 
 
@@ -131,12 +137,14 @@ def _runtime_kernels(ufl_form: ufl.Form, options: dict, cell) -> dict[int, Runti
         form_ir.integral_names["cell"], form_ir.subdomain_ids["cell"], strict=False
     ):
         kernel = runtime_integral(by_name[name].expression, cell)
-        if kernel is not None:
-            kernels[sid] = kernel
+        if kernel is not None:  # drop the marker: the cache must not keep meshes alive
+            kernels[sid] = kernel._replace(marker=None)
     return kernels
 
 
-def _compile(comm, ufl_form: ufl.Form, options: dict, jit_options: dict | None) -> _Compiled:
+def _compile(
+    comm, ufl_form: ufl.Form, options: dict, jit_options: dict | None
+) -> tuple[_Compiled, CompiledForm]:
     key = (
         ufl_form.signature(),
         tuple(sorted((k, str(v)) for k, v in options.items())),
@@ -149,8 +157,14 @@ def _compile(comm, ufl_form: ufl.Form, options: dict, jit_options: dict | None) 
         )
         cell = ufl_form.ufl_domain().ufl_coordinate_element().cell_type
         kernels = _runtime_kernels(ufl_form, get_options(options), cell)
-        _cache[key] = _Compiled(compiled, kernels)
-    return _cache[key]
+        _cache[key] = _Compiled(
+            compiled.ufcx_form, compiled.module, compiled.code, compiled.dtype, kernels
+        )
+    cached = _cache[key]
+    # Equal signatures: the compiled kernels serve this form (same coefficient order).
+    return cached, CompiledForm(
+        ufl_form, cached.ufcx_form, cached.module, cached.code, cached.dtype
+    )
 
 
 def _other_domains(ufl_form: ufl.Form, ids: dict[str, list[int]]) -> dict:
@@ -197,7 +211,7 @@ def form(
     rewrite = _rewrite(ufl_form)
     domain = ufl_form.ufl_domain()
     mesh = dolfinx.mesh.Mesh(domain.ufl_cargo(), domain)
-    compiled = _compile(mesh.comm, rewrite.form, options, jit_options)
+    compiled, compiled_form = _compile(mesh.comm, rewrite.form, options, jit_options)
 
     dropped = set()
     for sid, rules in rewrite.rules.items():
@@ -207,7 +221,7 @@ def form(
             continue
         rules.register(kernel, domain.ufl_cell())
 
-    ufcx = compiled.form.ufcx_form
+    ufcx = compiled.ufcx_form
     offsets = [ufcx.form_integral_offsets[i] for i in range(len(IntegralType) + 1)]
     ids: dict[str, list[int]] = {}
     for itype in IntegralType:
@@ -222,18 +236,11 @@ def form(
         entries = [(sid, e) for sid, e in entries if sid not in dropped]
         subdomains[itype] = sorted(subdomains.get(itype, []) + entries, key=lambda e: e[0])
 
-    compiled_coeffs = ufl.algorithms.extract_coefficients(compiled.form.ufl_form)
     coeffs = ufl.algorithms.extract_coefficients(rewrite.form)
-    consts_c = ufl.algorithms.analysis.extract_constants(compiled.form.ufl_form)
     consts = ufl.algorithms.analysis.extract_constants(rewrite.form)
     spaces = [arg.ufl_function_space() for arg in rewrite.form.arguments()]
     result = create_form(
-        compiled.form,
-        spaces,
-        mesh,
-        subdomains,
-        dict(zip(compiled_coeffs, coeffs, strict=False)),
-        dict(zip(consts_c, consts, strict=False)),
+        compiled_form, spaces, mesh, subdomains, {c: c for c in coeffs}, {c: c for c in consts}
     )
     result._xfem_rules = list(rewrite.rules.values())
     return result

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+import weakref
 from collections.abc import Callable
 
 import dolfinx.fem
@@ -108,9 +109,12 @@ class RestrictedNewton:
         for key, value in {**DEFAULT_SNES_OPTIONS, **(petsc_options or {})}.items():
             opts[f"{petsc_options_prefix}{key}"] = value
         self.snes.setFromOptions()
-        self.snes.setFunction(self._residual, self.F_r)
-        self.snes.setJacobian(self._jacobian, self.J_r)
-        self.snes.setMonitor(self._monitor)
+        # PETSc keeps its callbacks alive, and the garbage collector cannot see through
+        # PETSc objects: callbacks hold this object weakly, or it would never be freed.
+        this = weakref.ref(self)
+        self.snes.setFunction(lambda snes, y, F: this()._residual(snes, y, F), self.F_r)
+        self.snes.setJacobian(lambda snes, y, J, P: this()._jacobian(snes, y, J, P), self.J_r)
+        self.snes.setMonitor(lambda snes, it, norm: this()._monitor(snes, it, norm))
         self.report = NewtonReport()
 
     def _update(self, y: PETSc.Vec) -> None:

@@ -38,7 +38,7 @@ class RuntimeIntegral(typing.NamedTuple):
 
     key: int
     tables: tuple[TableSpec, ...]
-    marker: ufl.Coefficient
+    marker: ufl.Coefficient | None  # the marker coefficient (code generation only)
 
 
 def _modified_terminals(integrand: dict):
