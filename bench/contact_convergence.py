@@ -43,12 +43,12 @@ def oscillation(problem) -> float:
     return comm.bcast(tv, root=0)
 
 
-def run(n, degree, law, lbb):
+def run(n, degree, law, lbb, cell):
     t0 = time.perf_counter()
     options = {"lbb": lbb}
     if law == "coulomb":
         options["friction"] = 1.0
-    problem = inclusion_problem(n, degree, law, **options)
+    problem = inclusion_problem(n, degree, law, cell, **options)
     setup = time.perf_counter() - t0
     row = {
         "N": n,
@@ -78,28 +78,29 @@ def main():
     parser.add_argument("--degrees", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--laws", nargs="+", default=["sticking", "coulomb"])
     parser.add_argument("--lbb", nargs="+", default=["stabilized", "restriction", "none"])
+    parser.add_argument("--cells", nargs="+", default=["quadrilateral", "triangle"])
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
     root = MPI.COMM_WORLD.rank == 0
     rows = []
     if root:
         print(
-            f"{'deg':>3} {'law':>9} {'lbb':>11} {'N':>4} {'dofs':>7} {'e_pressure':>10} "
+            f"{'cell':>4} {'deg':>3} {'law':>9} {'lbb':>11} {'N':>4} {'dofs':>7} {'e_pressure':>10} "
             f"{'rate':>5} {'e_tangent':>10} {'rate':>5} {'newton':>6} {'osc':>6} "
             f"{'setup s':>8} {'solve s':>8}"
         )
-    for degree in args.degrees:
+    for cell, degree in ((c, d) for c in args.cells for d in args.degrees):
         for law in args.laws:
             for lbb in args.lbb:
                 previous = None
                 for n in args.sizes:
-                    r = run(n, degree, law, lbb)
+                    r = run(n, degree, law, lbb, cell)
                     rows.append(r)
                     if not root:
                         continue
                     if "failed" in r:
                         print(
-                            f"{degree:3d} {law:>9} {lbb:>11} {n:4d} {r['dofs']:7d}  "
+                            f"{cell[:4]:>4} {degree:3d} {law:>9} {lbb:>11} {n:4d} {r['dofs']:7d}  "
                             f"{r['failed']} (residuals {np.round(r['residuals'], 3)})"
                         )
                         previous = None
@@ -111,7 +112,7 @@ def main():
                                 f"{np.log(previous[key] / r[key]) / np.log(n / previous['N']):5.2f}"
                             )
                     print(
-                        f"{degree:3d} {law:>9} {lbb:>11} {n:4d} {r['dofs']:7d} "
+                        f"{cell[:4]:>4} {degree:3d} {law:>9} {lbb:>11} {n:4d} {r['dofs']:7d} "
                         f"{r['pressure_error']:10.3e} {rates[0]:>5} {r['tangential_error']:10.3e} "
                         f"{rates[1]:>5} {r['newton_iterations']:6d} {r['oscillation']:6.2f} "
                         f"{r['setup_s']:8.2f} {r['solve_s']:8.2f}",
