@@ -85,8 +85,8 @@ def main():
     rows = []
     if root:
         print(
-            f"{'cell':>4} {'deg':>3} {'law':>9} {'lbb':>11} {'N':>4} {'dofs':>7} {'e_pressure':>10} "
-            f"{'rate':>5} {'e_tangent':>10} {'rate':>5} {'newton':>6} {'osc':>6} "
+            f"{'cell':>4} {'deg':>3} {'law':>9} {'lbb':>11} {'N':>4} {'dofs':>7} "
+            f"{'e_pressure':>10} {'rate':>5} {'e_tangent':>10} {'rate':>5} {'newton':>6} {'osc':>6} "
             f"{'setup s':>8} {'solve s':>8}"
         )
     for cell, degree in ((c, d) for c in args.cells for d in args.degrees):
