@@ -86,8 +86,8 @@ def main():
     if root:
         print(
             f"{'cell':>4} {'deg':>3} {'law':>9} {'lbb':>11} {'N':>4} {'dofs':>7} "
-            f"{'e_pressure':>10} {'rate':>5} {'e_tangent':>10} {'rate':>5} {'newton':>6} {'osc':>6} "
-            f"{'setup s':>8} {'solve s':>8}"
+            f"{'e_pressure':>10} {'rate':>5} {'e_tangent':>10} {'rate':>5} "
+            f"{'newton':>6} {'osc':>6} {'setup s':>8} {'solve s':>8}"
         )
     for cell, degree in ((c, d) for c in args.cells for d in args.degrees):
         for law in args.laws:
