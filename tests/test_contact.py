@@ -127,3 +127,19 @@ def test_solved_problems_are_freed():
     del problem
     gc.collect()
     assert all(r() is None for r in refs)
+
+
+@pytest.mark.parametrize("degree, geometry_degree", [(1, 1), (2, 2)])
+def test_case3_annulus_uniform_pressure(degree, geometry_degree):
+    """Paper case 3 with no rotation yet (alpha = 0): frictionless contact at r = 8 m,
+    exact uniform pressure -1825/1636 MPa (straight cells for P1, curved for P2)."""
+    from xfem_contact.paper_cases import annulus_pressure_error, annulus_problem
+
+    errors = []
+    for n in (10, 20):
+        problem = annulus_problem(n, 4 * n, degree, geometry_degree=geometry_degree)
+        report = problem.solve()
+        assert report.iterations <= 10
+        errors.append(annulus_pressure_error(problem))
+    print(f"\ncase 3 (alpha = 0), degree {degree}: pressure errors {errors}")
+    assert errors[1] < errors[0] < 5e-3

@@ -10,6 +10,7 @@ from mpi4py import MPI
 
 import xfem_contact
 from xfem_contact import moment_fitting
+from xfem_contact.meshes import curved_square
 
 CENTRE, RADIUS = np.array([0.51, 0.47]), 0.3
 
@@ -165,46 +166,12 @@ def test_bad_level_sets_raise():
         xfem_contact.CutMesh(mesh, lambda x: x[0] - 0.3, degree=3)
 
 
-def curved_square(n: int):
-    """Unit square meshed by n x n curved 9-node quadrilaterals (Q2 geometry)."""
-    import basix.ufl
-
-    m = 2 * n + 1
-    s = np.linspace(0.0, 1.0, m)
-    X, Y = np.meshgrid(s, s, indexing="xy")
-    x = np.c_[X.ravel(), Y.ravel()]
-    bump = 0.05 * np.sin(np.pi * x[:, 0]) * np.sin(np.pi * x[:, 1])
-    x = x + np.c_[bump * np.cos(3 * x[:, 1]), bump * np.sin(2 * x[:, 0])]
-    node = lambda i, j: i + m * j  # noqa: E731
-    cells = []
-    for j in range(0, m - 1, 2):
-        for i in range(0, m - 1, 2):
-            cells.append(
-                [
-                    node(i, j),
-                    node(i + 2, j),
-                    node(i, j + 2),
-                    node(i + 2, j + 2),
-                    node(i + 1, j),
-                    node(i, j + 1),
-                    node(i + 2, j + 1),
-                    node(i + 1, j + 2),
-                    node(i + 1, j + 1),
-                ]
-            )
-    element = basix.ufl.element("Lagrange", "quadrilateral", 2, shape=(2,))
-    comm = MPI.COMM_WORLD
-    if comm.rank != 0:
-        x, cells = np.zeros((0, 2)), np.zeros((0, 9), dtype=np.int64)
-    return dolfinx.mesh.create_mesh(comm, np.array(cells, dtype=np.int64), element, x)
-
-
 def test_curved_q2_cells_disc_area():
     """Curved 9-node parent cells: disc area and circle length converge at high order."""
     sizes = [8, 16, 32, 64]
     errors = []
     for n in sizes:
-        mesh = curved_square(n)
+        mesh = curved_square(MPI.COMM_WORLD, n)
         cut = xfem_contact.CutMesh(mesh, distance, degree=2)
         c = one(mesh)
         assert integrate(c * cut.dx(-1)) + integrate(c * cut.dx(1)) == pytest.approx(

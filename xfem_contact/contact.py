@@ -35,7 +35,7 @@ from mpi4py import MPI
 from xfem_contact import lbb as lbb_module
 from xfem_contact.cutmesh import CutMesh
 from xfem_contact.elasticity import ElasticityProblem
-from xfem_contact.evaluation import evaluate_at_rules
+from xfem_contact.evaluation import evaluate_at_rules, rule_cells
 from xfem_contact.materials import Material
 from xfem_contact.nonlinear_solver import NewtonReport, RestrictedNewton
 from xfem_contact.restriction import MultiplierProlongation, restriction_matrix
@@ -107,7 +107,7 @@ class ContactProblem(ElasticityProblem):
     def augmentation_field(self):
         """``r = augmentation * E / h`` (Pa/m), UFL."""
         E = 0.5 * (self.materials[-1].E + self.materials[1].E)
-        return self.augmentation * E / ufl.CellDiameter(self.mesh)
+        return self.augmentation * E / self.cell_size
 
     def multipliers(self, fields):
         """(lambda_n, lambda_t or None) of a field tuple."""
@@ -179,7 +179,12 @@ class ContactProblem(ElasticityProblem):
         normals = rules.normals
         tangents = np.c_[-normals[:, 1], normals[:, 0]]
         E = 0.5 * (self.materials[-1].E + self.materials[1].E)
-        r = self.augmentation * E / _diameters(cut, rules)
+        h = self.cell_size
+        r = (
+            self.augmentation
+            * E
+            / h.x.array[h.function_space.dofmap.list[rule_cells(cut, rules), 0]]
+        )
         gap = np.sum(jump * normals, axis=1)
         slip = np.sum(jump * tangents, axis=1)
         lam_n = lam[:, 0]
@@ -235,16 +240,6 @@ class ContactProblem(ElasticityProblem):
                 log=log,
             )
         return self._newton.solve()
-
-
-def _diameters(cut: CutMesh, rules) -> np.ndarray:
-    """Cell diameter (m) at every point of interface rules."""
-    from xfem_contact.evaluation import rule_cells
-
-    cells = rule_cells(cut, rules)
-    x = cut.mesh.geometry.x[cut.mesh.geometry.dofmaps[0][cells], :2]
-    diff = x[:, :, None, :] - x[:, None, :, :]
-    return np.sqrt((diff**2).sum(axis=-1)).max(axis=(1, 2))
 
 
 def vital_vertex_prolongation(cut: CutMesh, space) -> MultiplierProlongation:

@@ -10,6 +10,7 @@ Units: SI (Pa, m, N/m^2 for tractions).
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Callable
 
 import dolfinx.fem
@@ -185,6 +186,19 @@ class ElasticityProblem:
             self._rhs.append(ufl.inner(f, v) * self.cut.dx(s))
 
     # -- forms and solve -----------------------------------------------------------
+    @functools.cached_property
+    def cell_size(self) -> dolfinx.fem.Function:
+        """Cell diameters h (m) as a DG0 function (largest vertex distance): unlike
+        ``ufl.CellDiameter`` it also serves curved (Q2-geometry) cells."""
+        V0 = dolfinx.fem.functionspace(self.mesh, ("DG", 0))
+        h = dolfinx.fem.Function(V0, name="h")
+        tdim = self.mesh.topology.dim
+        num_cells = self.mesh.topology.index_map(tdim).size_local
+        num_cells += self.mesh.topology.index_map(tdim).num_ghosts
+        cells = np.arange(num_cells, dtype=np.int32)
+        h.x.array[V0.dofmap.list[cells, 0]] = self.mesh.h(tdim, cells)
+        return h
+
     def bulk_form(self, u, v) -> ufl.Form:
         """Elastic energy of both sides plus the ghost penalty, ``u``, ``v``: field tuples."""
         a = sum(
@@ -215,7 +229,7 @@ class ElasticityProblem:
         """Barbosa-Hughes term ``gamma h / (2 mu) int (lambda - t(u)).(mu - t(v))``
         (``t`` the average interface traction; ``lam``, ``mu`` Cartesian vectors):
         consistent, and LBB-stable for any multiplier space."""
-        h = ufl.CellDiameter(self.mesh)
+        h = self.cell_size
         shear = 0.5 * (self.materials[-1].mu + self.materials[1].mu)
         scale = self.multiplier_stabilization * h / (2.0 * shear)
         t_u, t_v = self.interface_traction(u), self.interface_traction(v)
@@ -223,7 +237,7 @@ class ElasticityProblem:
 
     def _ghost_penalty(self, trial, test) -> ufl.Form:
         dS = ufl.Measure("dS", domain=self.mesh, subdomain_data=ghost_penalty_facets(self.cut))
-        h = ufl.avg(ufl.CellDiameter(self.mesh))
+        h = ufl.avg(self.cell_size)
         terms = []
         for i, s in enumerate(SIDES):
             scale = self.ghost_penalty * 2.0 * self.materials[s].mu

@@ -145,3 +145,42 @@ def straight_interface_problem(
         lambda x: np.isclose(np.abs(x[0]), 1.5), lambda x: 1e5 - 5e4 * x[1], side=1
     )
     return problem
+
+
+#: Paper case 3: radii (m), modulus (Pa), outer pressure (Pa), exact contact pressure (Pa)
+ANNULUS_RADII = (3.0, 8.0, 20.0)
+ANNULUS_E, ANNULUS_PRESSURE = 100e6, 1e6
+ANNULUS_CONTACT_PRESSURE = -1825.0 / 1636.0 * 1e6
+
+
+def annulus_problem(
+    n_radial: int,
+    n_angular: int,
+    degree: int,
+    geometry_degree: int = 2,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    **options,
+) -> ContactProblem:
+    """Paper case 3 with alpha = 0 (no rotation yet): plate 3 m <= r <= 20 m, X-FEM
+    circular interface r = 8 m in frictionless contact, E = 100 MPa, nu = 0, pressure
+    1 MPa on r = 20, inner boundary fixed; u_y = 0 at (20, 0) removes the outer ring's
+    free rotation. Exact contact pressure -1825/1636 MPa (Lamé)."""
+    from xfem_contact.meshes import annulus
+
+    r_in, r_gamma, r_out = ANNULUS_RADII
+    mesh = annulus(comm, r_in, r_out, n_radial, n_angular, geometry_degree)
+    cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - r_gamma, degree=2)
+    problem = ContactProblem(cut, degree, Material(ANNULUS_E, 0.0), "frictionless", **options)
+    tol = 1e-6 * r_out
+    problem.add_displacement(lambda x: np.abs(np.hypot(x[0], x[1]) - r_in) < tol, 0.0)
+    problem.add_pressure(lambda x: np.abs(np.hypot(x[0], x[1]) - r_out) < tol, ANNULUS_PRESSURE)
+    problem.add_point_displacement([r_out, 0.0], 0.0, 1)
+    return problem
+
+
+def annulus_pressure_error(problem: ContactProblem) -> float:
+    """Relative L2 error of the contact pressure against the uniform exact value."""
+    lam_n, _ = problem.multipliers(ufl.split(problem.w))
+    p = ANNULUS_CONTACT_PRESSURE
+    dG = problem.cut.dGamma
+    return float(np.sqrt(integrate((lam_n - p) ** 2 * dG) / integrate(p**2 * dG)))
