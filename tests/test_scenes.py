@@ -88,6 +88,11 @@ def test_only_named_effects_are_built(law, multipliers, tangential, solver):
             "unknown names",
         ),
         (lambda d: d.update(parts={"p": {"where": "x +"}}), "Cannot read"),
+        (lambda d: d["mesh"].update(kind="sphere"), "mesh.kind"),
+        (
+            lambda d: d["loads"].append({"part": "inner", "type": "pressure", "value": 1}),
+            "no such boundary part",
+        ),
     ],
 )
 def test_validation_errors_name_the_problem(change, message):
@@ -118,6 +123,7 @@ def test_bundled_scenes_load():
         "hydrostatic_frictionless",
         "plain_plate",
         "elliptic_inclusion_shear",
+        "case3_annulus_no_rotation",
     } <= set(names)
     for path in names.values():
         load_scene(path)

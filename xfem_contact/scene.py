@@ -48,12 +48,23 @@ SHAPES = ("circle", "ellipse", "line", "half-plane", "expression")
 LOAD_TYPES = ("pressure", "traction", "displacement", "point_displacement", "body_force")
 KINEMATICS = ("small", "large")
 CELLS = ("quadrilateral", "triangle")
-BUILTIN_PARTS = ("left", "right", "bottom", "top", "boundary")
+MESH_KINDS = ("rectangle", "annulus")
+BUILTIN_PARTS = {
+    "rectangle": ("left", "right", "bottom", "top", "boundary"),
+    "annulus": ("inner", "outer", "boundary"),
+}
 
 #: Allowed keys of each table, with their meaning (the schema in one place)
 SCHEMA = {
     "scene": {"name": "scene name", "description": "free text"},
-    "mesh": {"corners": "[[x0, y0], [x1, y1]] (m)", "cells": "[nx, ny]", "cell": f"one of {CELLS}"},
+    "mesh": {
+        "kind": f"one of {MESH_KINDS}",
+        "corners": "[[x0, y0], [x1, y1]] (m, rectangle)",
+        "radii": "[r_inner, r_outer] (m, annulus centred at the origin)",
+        "cells": "[nx, ny] or [n_radial, n_angular]",
+        "cell": f"one of {CELLS}",
+        "geometry_degree": "1 (straight cells) or 2 (curved cells, annulus)",
+    },
     "discretisation": {
         "degree": "displacement degree 1 or 2",
         "levelset_degree": "1 or 2",
@@ -134,7 +145,10 @@ class Scene:
     """A validated scene (see the module docstring for the TOML form)."""
 
     name: str
+    kind: str
     corners: tuple
+    radii: tuple
+    geometry_degree: int
     cells: tuple
     cell: str
     degree: int
@@ -240,7 +254,8 @@ def load_scene(source: str | pathlib.Path | dict) -> Scene:
         parts[name] = table["where"]
 
     loads = []
-    known_parts = set(BUILTIN_PARTS) | set(parts)
+    mesh_kind = _choice(mesh.get("kind", "rectangle"), MESH_KINDS, "mesh.kind")
+    known_parts = set(BUILTIN_PARTS[mesh_kind]) | set(parts)
     for k, table in enumerate(data.get("loads", [])):
         where = f"loads[{k}]"
         _check_keys(table, SCHEMA["load"], where)
@@ -274,6 +289,9 @@ def load_scene(source: str | pathlib.Path | dict) -> Scene:
         raise ValueError(f"mesh.cells must be [nx, ny] with positive entries, got {cells}")
     return Scene(
         name=head.get("name", "scene"),
+        kind=mesh_kind,
+        radii=tuple(map(float, mesh.get("radii", [1.0, 2.0]))),
+        geometry_degree=_choice(mesh.get("geometry_degree", 1), (1, 2), "mesh.geometry_degree"),
         corners=tuple(tuple(map(float, c)) for c in mesh.get("corners", [[0, 0], [1, 1]])),
         cells=cells,
         cell=_choice(mesh.get("cell", "quadrilateral"), CELLS, "mesh.cell"),

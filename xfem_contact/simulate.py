@@ -16,6 +16,7 @@ from xfem_contact.contact import ContactProblem
 from xfem_contact.cutmesh import CutMesh
 from xfem_contact.elasticity import ElasticityProblem
 from xfem_contact.expressions import compile_expression
+from xfem_contact.meshes import annulus
 from xfem_contact.plain import PlainElasticityProblem
 from xfem_contact.scene import InterfaceSpec, Scene
 
@@ -45,7 +46,11 @@ def levelset(spec: InterfaceSpec) -> Callable[[np.ndarray], np.ndarray]:
 
 def _locator(scene: Scene, name: str) -> Callable:
     (x0, y0), (x1, y1) = scene.corners
+    r0, r1 = scene.radii
+    tol = 1e-6 * r1
     builtin = {
+        "inner": lambda x: np.abs(np.hypot(x[0], x[1]) - r0) < tol,
+        "outer": lambda x: np.abs(np.hypot(x[0], x[1]) - r1) < tol,
         "left": lambda x: np.isclose(x[0], x0),
         "right": lambda x: np.isclose(x[0], x1),
         "bottom": lambda x: np.isclose(x[1], y0),
@@ -85,12 +90,15 @@ def _value(value, vector: bool):
 
 def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
     """Create the mesh and the problem of a scene (collective). Returns (problem, effects)."""
-    mesh = dolfinx.mesh.create_rectangle(
-        comm,
-        [list(scene.corners[0]), list(scene.corners[1])],
-        list(scene.cells),
-        dolfinx.mesh.CellType[scene.cell],
-    )
+    if scene.kind == "annulus":
+        mesh = annulus(comm, *scene.radii, *scene.cells, scene.geometry_degree)
+    else:
+        mesh = dolfinx.mesh.create_rectangle(
+            comm,
+            [list(scene.corners[0]), list(scene.corners[1])],
+            list(scene.cells),
+            dolfinx.mesh.CellType[scene.cell],
+        )
     material = next(iter(scene.materials.values()))
     if not scene.interfaces:
         problem = PlainElasticityProblem(mesh, scene.degree, material)
