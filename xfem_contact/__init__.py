@@ -12,10 +12,8 @@ except ImportError:  # conda/apt DOLFINx: nothing to do
 
 __version__ = "0.1.0"
 
+from xfem_contact.cutmesh import CutMesh  # noqa: E402
 from xfem_contact.forms import form  # noqa: E402
 from xfem_contact.runtime import CellRules  # noqa: E402
 
-__all__ = ["CellRules", "form"]
-from xfem_contact.cutmesh import CutMesh  # noqa: E402
-
-__all__ += ["CutMesh"]
+__all__ = ["CellRules", "CutMesh", "form"]
