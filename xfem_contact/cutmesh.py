@@ -114,6 +114,14 @@ class CutMesh:
         #: sub-triangulation ("cut"), and per-cell rules ("quadrature")
         self.timings = {"cut": cut_time, "quadrature": time.perf_counter() - start - cut_time}
 
+    def side_indicator(self) -> dolfinx.fem.Function:
+        """DG0 function of each cell's side (-1, 0 for cut, +1), ghosts included. Collective."""
+        V0 = dolfinx.fem.functionspace(self.mesh, ("DG", 0))
+        side = dolfinx.fem.Function(V0, name="side")
+        side.x.array[V0.dofmap.list[: self.cell_sides.size, 0]] = self.cell_sides
+        side.x.scatter_forward()
+        return side
+
     def side_rules(self, side: int) -> quadrature.RuleSet:
         """Per-cut-cell rules of side -1 or +1 (reference points, weights)."""
         if side not in (-1, 1):

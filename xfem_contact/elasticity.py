@@ -290,9 +290,5 @@ def ghost_penalty_facets(cut: CutMesh) -> list[tuple[int, np.ndarray]]:
 
 def _all_cell_sides(cut: CutMesh) -> np.ndarray:
     """Side (-1, 0 = cut, +1) of owned and ghost cells (ghosts via a DG0 scatter)."""
-    V0 = dolfinx.fem.functionspace(cut.mesh, ("DG", 0))
-    f = dolfinx.fem.Function(V0)
-    owned = cut.cell_sides.size
-    f.x.array[V0.dofmap.list[:owned, 0]] = cut.cell_sides
-    f.x.scatter_forward()
-    return np.rint(f.x.array[V0.dofmap.list[:, 0]]).astype(np.int8)
+    side = cut.side_indicator()
+    return np.rint(side.x.array[side.function_space.dofmap.list[:, 0]]).astype(np.int8)

@@ -122,8 +122,7 @@ class EnrichedSpace:
         if self.has_multiplier:
             rules = cut.interface_rules  # interface
             length = np.zeros(cut.cut_cells.size)
-            rows = np.repeat(np.arange(length.size), np.diff(rules.offsets))
-            np.add.at(length, rows, rules.weights * _abs_det_at(cut, rules))
+            np.add.at(length, rules.point_rows, rules.weights * _abs_det_at(cut, rules))
             carrying = cut.cut_cells[length > 0.0]
             active |= self._mark(2, carrying) > 0
         return active
@@ -186,6 +185,5 @@ def _cell_areas(cut: CutMesh) -> np.ndarray:
 
 def _abs_det_at(cut: CutMesh, rules) -> np.ndarray:
     """|det J| at every point of ``rules`` (points of cut cells)."""
-    rows = np.repeat(np.arange(rules.offsets.size - 1), np.diff(rules.offsets))
-    J = cut.maps.jacobian(cut.cut_cells[rows], rules.points)
+    J = cut.maps.jacobian(cut.cut_cells[rules.point_rows], rules.points)
     return np.abs(np.linalg.det(J))

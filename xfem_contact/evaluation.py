@@ -42,7 +42,7 @@ def evaluate_reference(
 
 def rule_cells(cut: CutMesh, rules: RuleSet) -> npt.NDArray[np.int32]:
     """Local cell of every point of per-cut-cell ``rules``, shape ``(npoints,)``."""
-    return cut.cut_cells[np.repeat(np.arange(rules.offsets.size - 1), np.diff(rules.offsets))]
+    return cut.cut_cells[rules.point_rows]
 
 
 def evaluate_at_rules(

@@ -36,10 +36,7 @@ def write_sides(directory: str | pathlib.Path, cut: CutMesh) -> pathlib.Path:
     """Write the cell side indicator (DG0: -1, 0 for cut, +1) to ``sides.xdmf``. Collective."""
     directory = pathlib.Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    V0 = dolfinx.fem.functionspace(cut.mesh, ("DG", 0))
-    side = dolfinx.fem.Function(V0, name="side")
-    side.x.array[V0.dofmap.list[: cut.cell_sides.size, 0]] = cut.cell_sides
-    side.x.scatter_forward()
+    side = cut.side_indicator()
     path = directory / "sides.xdmf"
     with dolfinx.io.XDMFFile(cut.mesh.comm, path, "w") as f:
         f.write_mesh(cut.mesh)

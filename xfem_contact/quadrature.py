@@ -51,6 +51,11 @@ class RuleSet:
     normals: npt.NDArray[np.float64] | None = None
 
     @property
+    def point_rows(self) -> npt.NDArray[np.int64]:
+        """Rule (cut-cell row) of every point, shape ``(N,)``."""
+        return np.repeat(np.arange(self.offsets.size - 1), np.diff(self.offsets))
+
+    @property
     def num_rules(self) -> int:
         """Number of rules (cut cells)."""
         return int(self.offsets.size - 1)
