@@ -5,7 +5,10 @@ multipliers (Pa): the normal pressure ``lambda_n`` and, with friction, the
 tangential traction ``lambda_t``; ``lambda = lambda_n n + lambda_t t`` is the
 traction ``sigma n`` on side -1 (``n`` from side -1 to +1, ``t`` = ``n`` turned by
 +90 degrees), compression negative. With the jump ``[u] = u_+ - u_-``, gap
-``g_n = [u].n`` and slip ``g_t = [u].t`` (one load step from the reference state),
+``g_n = [u].n`` and slip ``g_t = [u].t`` (sticking: tangential jump from the
+reference state) or slip increment ``g_t = [u - u_old].t`` (Coulomb, path
+dependent: ``u_old`` the last accepted load step, see
+:meth:`ContactProblem.accept_step`; zero when the load is applied in one step),
 the Alart-Curnier augmented multipliers are
 
     P_n = min(0, lambda_n + r g_n)
@@ -96,6 +99,8 @@ class ContactProblem(ElasticityProblem):
         )
         self.law, self.friction, self.augmentation, self.lbb = law, friction, augmentation, lbb
         self.w = dolfinx.fem.Function(self.space.W, name="w")
+        #: The last accepted load step (its jump is the origin of the slip increment)
+        self.w_old = dolfinx.fem.Function(self.space.W, name="w_old")
         self._newton: RestrictedNewton | None = None
 
     # -- interface kinematics ----------------------------------------------------------
@@ -125,6 +130,9 @@ class ContactProblem(ElasticityProblem):
         P_n = ufl.min_value(0.0, lam_n + r * ufl.dot(jump, n))
         if lam_t is None:
             return P_n, None
+        if self.incremental:
+            old = ufl.split(self.w_old)
+            jump = jump - (old[1] - old[0])
         trial_t = lam_t + r * ufl.dot(jump, t)
         if self.law == "sticking":
             return P_n, trial_t
@@ -148,6 +156,14 @@ class ContactProblem(ElasticityProblem):
             F -= self.multiplier_stabilization_form(
                 self.traction_vector(u), self.traction_vector(v), u, v
             )
+            if self.incremental:
+                # The tangential law is incremental (slip of the step): its share of the
+                # stabilisation is measured from the last accepted step too, so that the
+                # steps telescope (sticking in n steps = in one). Jacobian unchanged.
+                old = ufl.split(self.w_old)
+                _, old_t = self.multipliers(old)
+                old_residual = old_t - ufl.dot(self.interface_traction(old), t)
+                F += self.stabilization_scale() * old_residual * mu_t * self.cut.dGamma
         if self._rhs:
             F -= sum(self._rhs[1:], self._rhs[0])
         return F
@@ -167,7 +183,9 @@ class ContactProblem(ElasticityProblem):
     def interface_state(self, w: dolfinx.fem.Function) -> dict[str, np.ndarray]:
         """Point values at this process's interface quadrature points.
 
-        Returns arrays of shape ``(npoints,)``: ``gap`` and ``slip`` (m), the
+        Returns arrays of shape ``(npoints,)``: ``gap``, ``slip`` and
+        ``slip_increment`` (the slip the tangential law sees: of the load step for
+        Coulomb, else the slip) (m), the
         multipliers ``lambda_n``, ``lambda_t`` and the augmented (applied)
         tractions ``P_n``, ``P_t`` (Pa; tangential ones zero when frictionless),
         and ``r`` (Pa/m).
@@ -187,10 +205,18 @@ class ContactProblem(ElasticityProblem):
         )
         gap = np.sum(jump * normals, axis=1)
         slip = np.sum(jump * tangents, axis=1)
+        if self.incremental:
+            old = self.w_old
+            jump_old = evaluate_at_rules(old.sub(1), cut, rules) - evaluate_at_rules(
+                old.sub(0), cut, rules
+            )
+            slip_increment = slip - np.sum(jump_old * tangents, axis=1)
+        else:
+            slip_increment = slip
         lam_n = lam[:, 0]
         lam_t = lam[:, 1] if lam.shape[1] > 1 else np.zeros_like(lam_n)
         P_n = np.minimum(0.0, lam_n + r * gap)
-        trial = lam_t + r * slip
+        trial = lam_t + r * slip_increment
         if self.law == "frictionless":
             P_t = np.zeros_like(P_n)
         elif self.law == "sticking":
@@ -200,6 +226,7 @@ class ContactProblem(ElasticityProblem):
         return {
             "gap": gap,
             "slip": slip,
+            "slip_increment": slip_increment,
             "lambda_n": lam_n,
             "lambda_t": lam_t,
             "P_n": P_n,
@@ -219,6 +246,17 @@ class ContactProblem(ElasticityProblem):
             counts |= {"stick": int(stick.sum()), "slip": int((contact & ~stick).sum())}
         comm = self.mesh.comm
         return {k: comm.allreduce(v, op=MPI.SUM) for k, v in counts.items()}
+
+    @property
+    def incremental(self) -> bool:
+        """Whether the tangential law acts on the slip of the load step (Coulomb)."""
+        return self.law == "coulomb"
+
+    def accept_step(self) -> None:
+        """Accept the current solution as the end of a load step: the Coulomb slip of
+        the next step is measured from it (friction is path dependent)."""
+        self.w.x.scatter_forward()
+        self.w_old.x.array[:] = self.w.x.array
 
     def solve(
         self, petsc_options: dict | None = None, log: Callable[[str], None] | None = None
@@ -240,6 +278,11 @@ class ContactProblem(ElasticityProblem):
                 log=log,
             )
         return self._newton.solve()
+
+    @property
+    def last_report(self) -> NewtonReport | None:
+        """The report of the last :meth:`solve` (None before the first)."""
+        return None if self._newton is None else self._newton.report
 
 
 def vital_vertex_prolongation(cut: CutMesh, space) -> MultiplierProlongation:

@@ -23,13 +23,12 @@ from xfem_contact.cutmesh import CutMesh
 from xfem_contact.enrichment import EnrichedSpace
 from xfem_contact.forms import form
 from xfem_contact.linear_solver import solve_restricted
+from xfem_contact.loading import Facets, LoadFactor, boundary_facets
 from xfem_contact.materials import Material
 
 INTERFACE_LAWS = ("free", "bonded")
 SIDES = (-1, 1)
 
-#: A boundary part: local facet indices, or a locator ``x -> bool`` of shape (3, n) -> (n,)
-Facets = np.ndarray | Callable[[np.ndarray], np.ndarray]
 #: A load: a number, a UFL expression, or a callable of the UFL coordinate ``x``
 Load = float | ufl.core.expr.Expr | Callable
 
@@ -98,6 +97,8 @@ class ElasticityProblem:
         self._bcs: list[dolfinx.fem.DirichletBC] = []
         self._rhs: list = []
         self._x = ufl.SpatialCoordinate(self.mesh)
+        #: Scales every load and prescribed displacement (see :mod:`xfem_contact.loading`)
+        self.load_factor = LoadFactor(self.mesh)
 
     #: Interface laws this problem solves
     LAWS = INTERFACE_LAWS
@@ -110,14 +111,7 @@ class ElasticityProblem:
     # -- boundary parts and loads ---------------------------------------------------
     def facets(self, part: Facets) -> np.ndarray:
         """Local exterior facet indices of a boundary part; error if it is empty."""
-        fdim = self.mesh.topology.dim - 1
-        if callable(part):
-            facets = dolfinx.mesh.locate_entities_boundary(self.mesh, fdim, part)
-        else:
-            facets = np.asarray(part, dtype=np.int32)
-        if self.mesh.comm.allreduce(facets.size, op=MPI.SUM) == 0:
-            raise ValueError("The boundary part holds no boundary facet (does it exist?)")
-        return facets
+        return boundary_facets(self.mesh, part)
 
     def _ufl(self, value: Load):
         if isinstance(value, ufl.core.expr.Expr) or not callable(value):
@@ -142,6 +136,7 @@ class ElasticityProblem:
                 g.interpolate(value)
             else:
                 g.x.array[:] = value
+            self.load_factor.track(g)
             dofs = dolfinx.fem.locate_dofs_topological((sub, V), fdim, facets)
             self._bcs.append(dolfinx.fem.dirichletbc(g, dofs, sub))
 
@@ -160,14 +155,17 @@ class ElasticityProblem:
             found += self.mesh.comm.allreduce(dofs[0].size, op=MPI.SUM)
             g = dolfinx.fem.Function(V)
             g.x.array[:] = value
+            self.load_factor.track(g)
             self._bcs.append(dolfinx.fem.dirichletbc(g, dofs, sub))
         if found == 0:
             raise ValueError(f"No mesh node at {point.tolist()} to fix")
 
     def add_traction(self, part: Facets, traction: Load, side: int | None = None) -> None:
-        """Surface traction (Pa) on a boundary part; ``side`` restricts it to one side."""
+        """Surface traction (Pa) on a boundary part; ``side`` restricts it to one side.
+
+        Scaled by the load factor, as every load."""
         facets = self.facets(part)
-        t = self._ufl(traction)
+        t = self.load_factor.scaled(self._ufl(traction))
         for s in SIDES if side is None else (side,):
             v = self.space.test()[0 if s == -1 else 1]
             self._rhs.append(ufl.inner(t, v) * self.cut.ds(s, facets))
@@ -180,7 +178,7 @@ class ElasticityProblem:
 
     def add_body_force(self, force: Load, side: int | None = None) -> None:
         """Body force density (N/m^3) on one side or both."""
-        f = self._ufl(force)
+        f = self.load_factor.scaled(self._ufl(force))
         for s in SIDES if side is None else (side,):
             v = self.space.test()[0 if s == -1 else 1]
             self._rhs.append(ufl.inner(f, v) * self.cut.dx(s))
@@ -229,11 +227,13 @@ class ElasticityProblem:
         """Barbosa-Hughes term ``gamma h / (2 mu) int (lambda - t(u)).(mu - t(v))``
         (``t`` the average interface traction; ``lam``, ``mu`` Cartesian vectors):
         consistent, and LBB-stable for any multiplier space."""
-        h = self.cell_size
-        shear = 0.5 * (self.materials[-1].mu + self.materials[1].mu)
-        scale = self.multiplier_stabilization * h / (2.0 * shear)
         t_u, t_v = self.interface_traction(u), self.interface_traction(v)
-        return scale * ufl.inner(lam - t_u, mu - t_v) * self.cut.dGamma
+        return self.stabilization_scale() * ufl.inner(lam - t_u, mu - t_v) * self.cut.dGamma
+
+    def stabilization_scale(self) -> ufl.core.expr.Expr:
+        """``gamma h / (2 mu)`` (m/Pa) of the multiplier stabilisation (UFL)."""
+        shear = 0.5 * (self.materials[-1].mu + self.materials[1].mu)
+        return self.multiplier_stabilization * self.cell_size / (2.0 * shear)
 
     def _ghost_penalty(self, trial, test) -> ufl.Form:
         dS = ufl.Measure("dS", domain=self.mesh, subdomain_data=ghost_penalty_facets(self.cut))

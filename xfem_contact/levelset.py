@@ -136,3 +136,56 @@ class CellMaps:
             return np.asarray(self._exact(x3), dtype=np.float64)
 
         return phi
+
+
+def union(
+    mesh: dolfinx.mesh.Mesh, levelsets: dict[str, LevelSetCallable], degree: int
+) -> LevelSetCallable:
+    """One level set for several interfaces: ``min_i phi_i``, negative inside any. Collective.
+
+    The interfaces must be apart: no mesh node inside two of them (nested or
+    intersecting interfaces) and no cell cut by two (the minimum would bend the
+    interface inside that cell). Each is checked on its interpolant of ``degree``.
+
+    Args:
+        mesh: The mesh.
+        levelsets: Level-set callables by interface name.
+        degree: Interpolation degree (1 or 2) used for the checks.
+
+    Raises:
+        ValueError: naming the interface that never crosses the mesh, or the two
+            interfaces whose insides overlap or that cut the same cells.
+    """
+    names = list(levelsets)
+    inside, cut = {}, {}
+    for name in names:
+        try:
+            phi = interpolate(mesh, levelsets[name], degree).function
+        except ValueError as error:
+            raise ValueError(f"Interface {name!r}: {error}") from None
+        values = phi.x.array
+        owned = phi.function_space.dofmap.index_map.size_local
+        inside[name] = values[:owned] < 0.0
+        num_cells = mesh.topology.index_map(mesh.topology.dim).size_local
+        nodal = values[phi.function_space.dofmap.list[:num_cells]]
+        cut[name] = (nodal.min(axis=1) < 0.0) & (nodal.max(axis=1) >= 0.0)
+    comm = mesh.comm
+    for i, a in enumerate(names):
+        for b in names[i + 1 :]:
+            if comm.allreduce(int(np.count_nonzero(inside[a] & inside[b])), op=MPI.SUM):
+                raise ValueError(
+                    f"Interfaces {a!r} and {b!r} overlap (mesh nodes lie inside both): "
+                    "nested or intersecting interfaces are not supported"
+                )
+            shared = comm.allreduce(int(np.count_nonzero(cut[a] & cut[b])), op=MPI.SUM)
+            if shared:
+                raise ValueError(
+                    f"Interfaces {a!r} and {b!r} cut the same {shared} cell(s): keep at "
+                    "least one cell between them (refine the mesh or move them apart)"
+                )
+    functions = [levelsets[name] for name in names]
+
+    def phi(x: np.ndarray) -> np.ndarray:
+        return np.minimum.reduce([np.asarray(f(x), dtype=np.float64) for f in functions])
+
+    return phi

@@ -13,6 +13,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from xfem_contact.loading import Facets, LoadFactor, boundary_facets
 from xfem_contact.materials import Material
 
 
@@ -22,21 +23,27 @@ class PlainElasticityProblem:
     def __init__(self, mesh: dolfinx.mesh.Mesh, degree: int, material: Material):
         self.mesh, self.material = mesh, material
         self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (mesh.geometry.dim,)))
-        self._bcs, self._rhs, self._facet_sets = [], [], []
+        self._bcs, self._rhs, self._facet_sets, self._body = [], [], [], []
         self._x = ufl.SpatialCoordinate(mesh)
+        #: Scales every load and prescribed displacement (see :mod:`xfem_contact.loading`)
+        self.load_factor = LoadFactor(mesh)
 
-    def facets(self, locator) -> np.ndarray:
-        fdim = self.mesh.topology.dim - 1
-        facets = dolfinx.mesh.locate_entities_boundary(self.mesh, fdim, locator)
-        if self.mesh.comm.allreduce(facets.size, op=MPI.SUM) == 0:
-            raise ValueError("The boundary part holds no boundary facet (does it exist?)")
-        return facets
+    def _ufl(self, value):
+        """A load as UFL: numbers and expressions as they are, callables of ``x`` applied."""
+        if isinstance(value, ufl.core.expr.Expr) or not callable(value):
+            return ufl.as_ufl(value)
+        return value(self._x)
+
+    def facets(self, part: Facets) -> np.ndarray:
+        """Local exterior facet indices of a boundary part; error if it is empty."""
+        return boundary_facets(self.mesh, part)
 
     def add_displacement(self, locator, value, component: int | None = None) -> None:
         fdim, facets = self.mesh.topology.dim - 1, self.facets(locator)
         if component is None:
             g = dolfinx.fem.Function(self.V)
             _fill(g, value)
+            self.load_factor.track(g)
             dofs = dolfinx.fem.locate_dofs_topological(self.V, fdim, facets)
             self._bcs.append(dolfinx.fem.dirichletbc(g, dofs))
             return
@@ -44,6 +51,7 @@ class PlainElasticityProblem:
         V, _ = sub.collapse()
         g = dolfinx.fem.Function(V)
         _fill(g, value)
+        self.load_factor.track(g)
         dofs = dolfinx.fem.locate_dofs_topological((sub, V), fdim, facets)
         self._bcs.append(dolfinx.fem.dirichletbc(g, dofs, sub))
 
@@ -57,29 +65,35 @@ class PlainElasticityProblem:
             raise ValueError(f"No mesh node at {list(point)} to fix")
         g = dolfinx.fem.Function(V)
         g.x.array[:] = value
+        self.load_factor.track(g)
         self._bcs.append(dolfinx.fem.dirichletbc(g, dofs, sub))
 
     def add_traction(self, locator, traction) -> None:
         facets = self.facets(locator)
         self._facet_sets.append(facets)
-        self._rhs.append((len(self._facet_sets), traction))
+        self._rhs.append((len(self._facet_sets), self.load_factor.scaled(self._ufl(traction))))
 
     def add_pressure(self, locator, pressure) -> None:
-        self.add_traction(locator, -pressure * ufl.FacetNormal(self.mesh))
+        self.add_traction(locator, -self._ufl(pressure) * ufl.FacetNormal(self.mesh))
 
-    def solve(self) -> dolfinx.fem.Function:
-        """One linear solve (PETSc LU). Collective."""
+    def add_body_force(self, force) -> None:
+        """Body force density (N/m^3), scaled by the load factor."""
+        self._body.append(self.load_factor.scaled(self._ufl(force)))
+
+    def solve(self, petsc_options: dict | None = None) -> dolfinx.fem.Function:
+        """One linear solve (PETSc LU unless ``petsc_options`` say otherwise). Collective."""
         u, v = ufl.TrialFunction(self.V), ufl.TestFunction(self.V)
         a = ufl.inner(self.material.stress(u), ufl.sym(ufl.grad(v))) * ufl.dx
         entities = [(k + 1, self._pairs(f)) for k, f in enumerate(self._facet_sets)]
         ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=entities)
         L = sum((ufl.inner(t, v) * ds(k) for k, t in self._rhs), ufl.ZeroBaseForm((v,)))
+        L += sum((ufl.inner(f, v) * ufl.dx for f in self._body), ufl.ZeroBaseForm((v,)))
         problem = dolfinx.fem.petsc.LinearProblem(
             a,
             L,
             bcs=self._bcs,
             petsc_options_prefix="xfem_plain_",
-            petsc_options={"ksp_type": "preonly", "pc_type": "lu"},
+            petsc_options={"ksp_type": "preonly", "pc_type": "lu", **(petsc_options or {})},
         )
         return problem.solve()
 
