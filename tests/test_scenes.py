@@ -2,12 +2,19 @@
 
 import json
 
+import xfem_contact
+
+# isort: split
+import dolfinx.fem
+import numpy as np
 import pytest
 from mpi4py import MPI
 
 from xfem_contact import cli
+from xfem_contact.cutmesh import CutMesh
+from xfem_contact.nonlinear_solver import NewtonFailure
 from xfem_contact.scene import bundled_scenes, load_scene
-from xfem_contact.simulate import build, run
+from xfem_contact.simulate import build, levelset, run
 
 
 def base(**interface):
@@ -124,6 +131,7 @@ def test_bundled_scenes_load():
         "plain_plate",
         "elliptic_inclusion_shear",
         "case3_annulus_no_rotation",
+        "plate_with_hole_inclusion",
     } <= set(names)
     for path in names.values():
         load_scene(path)
@@ -149,3 +157,207 @@ def test_run_contact_scene_reports_newton():
     assert summary["effects"]["solver"].startswith("SNES")
     assert summary["iterations"] <= 10
     assert summary["contact_status"]["contact"] > 0
+
+
+# -- load steps and solver options --------------------------------------------------------
+
+
+def pressed_inclusion(law: str, **solver) -> dict:
+    """A plate fixed all round, its inclusion pushed down by a body force."""
+    data = base(law=law, friction=0.5)
+    data["loads"] = [
+        {"part": "boundary", "type": "displacement", "value": [0.0, 0.0]},
+        {"type": "body_force", "value": [0.0, -1e3], "side": -1},
+    ]
+    if solver:
+        data["solver"] = solver
+    return data
+
+
+def test_load_factor_scales_every_load_of_a_linear_problem():
+    data = base(law="bonded")
+    data["loads"].append({"part": "right", "type": "displacement", "value": 1e-4, "component": 0})
+    data["loads"].append({"type": "body_force", "value": [0.0, -1e3]})
+    problem, _ = build(load_scene(data))
+    full = problem.solve().w.x.array.copy()
+    problem.load_factor.set(0.25)
+    quarter = problem.solve().w.x.array
+    assert np.abs(full).max() > 0
+    assert np.allclose(quarter, 0.25 * full, rtol=0, atol=1e-12 * np.abs(full).max())
+
+
+@pytest.mark.parametrize("law", ["frictionless", "sticking"])
+def test_load_steps_end_at_the_one_step_solution(law):
+    """Frictionless and sticking contact are path independent: 3 steps = 1 step."""
+    one = run(load_scene(pressed_inclusion(law)), log=None)
+    three = run(load_scene(pressed_inclusion(law, load_steps=3)), log=None)
+    assert three["load_steps"] == 3 and len(three["iterations_per_step"]) == 3
+    a, b = (np.array(s["interface_samples"]["lambda_n"]) for s in (one, three))
+    assert np.abs(a).max() > 0
+    assert np.allclose(a, b, rtol=0, atol=1e-8 * np.abs(a).max())
+
+
+def test_coulomb_steps_respect_the_cone_and_print_a_line_per_step():
+    lines = []
+    summary = run(load_scene(pressed_inclusion("coulomb", load_steps=2)), log=lines.append)
+    s = {k: np.array(v) for k, v in summary["interface_samples"].items()}
+    assert np.all(np.abs(s["P_t"]) <= 0.5 * np.abs(s["P_n"]) * (1 + 1e-12) + 1e-14)
+    assert sum("load step" in line for line in lines) == 2
+    assert sum("Newton" in line for line in lines) >= 2
+
+
+def test_newton_failure_is_reported_with_its_history():
+    data = pressed_inclusion("coulomb", max_iterations=1)
+    with pytest.raises(NewtonFailure, match="iterate  0"):
+        run(load_scene(data), log=None)
+
+
+@pytest.mark.parametrize(
+    "solver, message",
+    [
+        ({"load_steps": 0}, "solver.load_steps"),
+        ({"load_steps": 1.5}, "solver.load_steps"),
+        ({"rtol": -1.0}, "solver.rtol"),
+        ({"steps": 3}, "Unknown key"),
+        ({"petsc": {"pc_type": [1]}}, "solver.petsc.pc_type"),
+    ],
+)
+def test_solver_table_errors(solver, message):
+    data = base()
+    data["solver"] = solver
+    with pytest.raises(ValueError, match=message):
+        load_scene(data)
+
+
+# -- several interfaces -------------------------------------------------------------------
+
+
+def two_inclusions(centres=((0.28, 0.5), (0.72, 0.5)), radius=0.12, **change) -> dict:
+    """Two frictionless inclusions in a plate under hydrostatic pressure 1 Pa."""
+    data = base()
+    data["mesh"]["cells"] = [16, 16]
+    data["interfaces"] = [
+        {"name": f"inc{k}", "shape": "circle", "centre": list(c), "radius": radius}
+        | {"law": "frictionless"}
+        for k, c in enumerate(centres)
+    ]
+    data["interfaces"][1].update(change)
+    data["loads"] = [
+        {"part": p, "type": "pressure", "value": 1.0} for p in ("left", "right", "bottom", "top")
+    ] + [
+        {"type": "point_displacement", "point": [0.5, 0.0], "component": 0, "value": 0.0},
+        {"type": "point_displacement", "point": [0.5, 1.0], "component": 0, "value": 0.0},
+        {"type": "point_displacement", "point": [0.0, 0.5], "component": 1, "value": 0.0},
+    ]
+    return data
+
+
+def test_two_inclusions_under_hydrostatic_pressure():
+    """Same material everywhere: the exact stress is -1 Pa I, so P_n = -1 on both circles."""
+    scene = load_scene(two_inclusions())
+    problem, effects = build(scene)
+    assert effects["interfaces"] == ["inc0", "inc1"]
+
+    def length(cut):
+        one = dolfinx.fem.assemble_scalar(xfem_contact.form(1.0 * cut.dGamma))
+        return cut.mesh.comm.allreduce(one, op=MPI.SUM)
+
+    # the union's interface is each circle's own cut, exactly
+    alone = [CutMesh(problem.mesh, levelset(spec), degree=2) for spec in scene.interfaces]
+    total = length(problem.cut)
+    assert abs(total - sum(length(c) for c in alone)) < 1e-13
+    assert abs(total - 2 * 2 * np.pi * 0.12) < 1e-3 * total
+    summary = run(scene, log=None)
+    s = {k: np.array(v) for k, v in summary["interface_samples"].items()}
+    assert (s["x"] < 0.5).any() and (s["x"] > 0.5).any()  # both interfaces in contact
+    assert np.all(np.abs(s["P_n"] + 1.0) < 2e-2)
+
+
+@pytest.mark.parametrize(
+    "change, error, message",
+    [
+        ({"centre": [0.3, 0.5]}, ValueError, "overlap"),  # intersecting
+        ({"centre": [0.28, 0.5], "radius": 0.05}, ValueError, "overlap"),  # nested
+        ({"centre": [0.5, 0.5]}, ValueError, "cut the same"),  # 1 mesh cell apart
+        ({"law": "bonded"}, NotImplementedError, "interfaces\\[1\\].law"),
+        ({"name": "inc0"}, ValueError, "unique"),
+    ],
+)
+def test_several_interfaces_errors(change, error, message):
+    with pytest.raises(error, match=message):
+        build(load_scene(two_inclusions(**change)))
+
+
+# -- gmsh meshes ----------------------------------------------------------------------------
+
+
+def gmsh_scene(**mesh) -> dict:
+    """The bundled plate with a hole, meshed coarsely, a frictionless inclusion above it."""
+    data = base(law="frictionless")
+    data["mesh"] = {
+        "kind": "gmsh",
+        "file": "plate_with_hole.geo",
+        "cell": "quadrilateral",
+        "geometry_degree": 2,
+        "size": 0.08,
+    } | mesh
+    data["interfaces"][0] |= {"centre": [0.5, 0.8], "radius": 0.1}
+    data["loads"] = [
+        {"part": "bottom", "type": "displacement", "value": [0.0, 0.0]},
+        {"part": "top", "type": "pressure", "value": 1e5},
+        {"part": "hole", "type": "pressure", "value": 0.0},
+    ]
+    return data
+
+
+SCENES = bundled_scenes()["plate_with_hole_inclusion"].parent
+
+
+@pytest.mark.mpi
+def test_gmsh_scene_runs_with_named_parts():
+    """A .geo with physical curves: loads on named parts; same on 1 and 2 ranks."""
+    summary = run(load_scene(gmsh_scene(), folder=SCENES), log=None)
+    assert summary["effects"]["interface"] == "frictionless"
+    s = {k: np.array(v) for k, v in summary["interface_samples"].items()}
+    assert summary["contact_status"]["contact"] > 0
+    # the top pressure goes through the inclusion: compression on its top and bottom
+    assert s["P_n"][np.abs(s["x"] - 0.5) < 0.03].min() < -1e4
+    assert summary["dofs"]["standard"] > 0
+
+
+@pytest.mark.parametrize(
+    "mesh, load, message",
+    [
+        ({}, {"part": "roof", "type": "pressure", "value": 1}, "known: .*hole"),
+        ({"file": "nowhere.geo"}, None, "no such file"),
+        ({"file": "plate_with_hole_inclusion.toml"}, None, "expected a .geo or .msh"),
+        ({"kind": "rectangle"}, None, "mesh.file is for mesh.kind = 'gmsh'"),
+    ],
+)
+def test_gmsh_scene_errors(mesh, load, message):
+    data = gmsh_scene(**mesh)
+    if load:
+        data["loads"].append(load)
+    with pytest.raises(ValueError, match=message):
+        load_scene(data, folder=SCENES)
+
+
+def test_msh_file_takes_its_own_cells(tmp_path):
+    import gmsh
+
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(str(SCENES / "plate_with_hole.geo"))
+        gmsh.model.mesh.generate(2)
+        gmsh.write(str(tmp_path / "plate.msh"))
+    finally:
+        gmsh.finalize()
+    data = gmsh_scene(file=str(tmp_path / "plate.msh"))
+    with pytest.raises(ValueError, match="read from the .msh file"):
+        load_scene(data)
+    for key in ("cell", "geometry_degree", "size"):
+        data["mesh"].pop(key)
+    scene = load_scene(data)
+    problem, _ = build(scene)
+    assert problem.mesh.topology.cell_name() == "triangle"

@@ -48,22 +48,35 @@ SHAPES = ("circle", "ellipse", "line", "half-plane", "expression")
 LOAD_TYPES = ("pressure", "traction", "displacement", "point_displacement", "body_force")
 KINEMATICS = ("small", "large")
 CELLS = ("quadrilateral", "triangle")
-MESH_KINDS = ("rectangle", "annulus")
+MESH_KINDS = ("rectangle", "annulus", "gmsh")
 BUILTIN_PARTS = {
     "rectangle": ("left", "right", "bottom", "top", "boundary"),
     "annulus": ("inner", "outer", "boundary"),
+    "gmsh": ("boundary",),  # plus the file's named 1-D physical groups
 }
+#: Keys in which the interfaces of one scene must agree (they are cut as one level set)
+SHARED_INTERFACE_KEYS = (
+    "law",
+    "friction",
+    "augmentation",
+    "lbb",
+    "kinematics",
+    "inside",
+    "outside",
+)
 
 #: Allowed keys of each table, with their meaning (the schema in one place)
 SCHEMA = {
     "scene": {"name": "scene name", "description": "free text"},
     "mesh": {
         "kind": f"one of {MESH_KINDS}",
+        "file": "a gmsh .geo or .msh file, relative to the scene file (gmsh)",
+        "size": "target cell size (m) when meshing a .geo file (gmsh)",
         "corners": "[[x0, y0], [x1, y1]] (m, rectangle)",
         "radii": "[r_inner, r_outer] (m, annulus centred at the origin)",
         "cells": "[nx, ny] or [n_radial, n_angular]",
         "cell": f"one of {CELLS}",
-        "geometry_degree": "1 (straight cells) or 2 (curved cells, annulus)",
+        "geometry_degree": "1 (straight cells) or 2 (curved cells: annulus, gmsh .geo)",
     },
     "discretisation": {
         "degree": "displacement degree 1 or 2",
@@ -93,6 +106,13 @@ SCHEMA = {
         "nu": "Poisson ratio in (-1, 0.5)",
         "plane": "strain | stress",
     },
+    "solver": {
+        "load_steps": "number of equal load steps (>= 1, default 1)",
+        "max_iterations": "Newton iterations per step (default 30)",
+        "rtol": "relative Newton tolerance (default 1e-10)",
+        "atol": "absolute Newton tolerance (default 1e-12)",
+        "petsc": "table of extra PETSc options (without prefix)",
+    },
     "part": {"where": "boolean expression of x, y selecting boundary facets"},
     "load": {
         "part": "a boundary part name",
@@ -112,6 +132,7 @@ TOP_LEVEL = (
     "interfaces",
     "parts",
     "loads",
+    "solver",
     "outputs",
 )
 
@@ -146,6 +167,8 @@ class Scene:
 
     name: str
     kind: str
+    file: pathlib.Path | None
+    size: float | None
     corners: tuple
     radii: tuple
     geometry_degree: int
@@ -159,6 +182,9 @@ class Scene:
     parts: dict[str, str]
     loads: tuple[LoadSpec, ...]
     outputs: dict
+    load_steps: int = 1
+    #: PETSc options of the solver (SNES/KSP, without prefix)
+    petsc_options: dict = dataclasses.field(default_factory=dict)
 
 
 def _check_keys(table: dict, allowed, where: str) -> None:
@@ -173,13 +199,21 @@ def _choice(value, choices, where: str):
     return value
 
 
-def load_scene(source: str | pathlib.Path | dict) -> Scene:
-    """Read and validate a scene from a TOML file path or an already parsed dict."""
+def load_scene(
+    source: str | pathlib.Path | dict, folder: str | pathlib.Path | None = None
+) -> Scene:
+    """Read and validate a scene from a TOML file path or an already parsed dict.
+
+    ``folder``: where relative file names (``mesh.file``) are looked up; default
+    the scene file's folder, or the working directory for a dict.
+    """
     if isinstance(source, dict):
         data = source
+        folder = pathlib.Path(folder or ".")
     else:
         with open(source, "rb") as f:
             data = tomllib.load(f)
+        folder = pathlib.Path(folder or pathlib.Path(source).parent)
     _check_keys(data, TOP_LEVEL, "top level")
     head = data.get("scene", {})
     _check_keys(head, SCHEMA["scene"], "scene")
@@ -244,8 +278,7 @@ def load_scene(source: str | pathlib.Path | dict) -> Scene:
                 kinematics=kinematics,
             )
         )
-    if len(interfaces) > 1:
-        raise NotImplementedError("Several interfaces in one scene are not available yet")
+    _check_shared(interfaces)
 
     parts = {}
     for name, table in data.get("parts", {}).items():
@@ -255,7 +288,12 @@ def load_scene(source: str | pathlib.Path | dict) -> Scene:
 
     loads = []
     mesh_kind = _choice(mesh.get("kind", "rectangle"), MESH_KINDS, "mesh.kind")
+    mesh_file, size = _gmsh_source(mesh, mesh_kind, folder)
     known_parts = set(BUILTIN_PARTS[mesh_kind]) | set(parts)
+    if mesh_file is not None:
+        from xfem_contact.gmsh_io import physical_parts
+
+        known_parts |= set(physical_parts(mesh_file))
     for k, table in enumerate(data.get("loads", [])):
         where = f"loads[{k}]"
         _check_keys(table, SCHEMA["load"], where)
@@ -282,6 +320,13 @@ def load_scene(source: str | pathlib.Path | dict) -> Scene:
             )
         )
 
+    solver = data.get("solver", {})
+    _check_keys(solver, SCHEMA["solver"], "solver")
+    load_steps = solver.get("load_steps", 1)
+    if isinstance(load_steps, bool) or not isinstance(load_steps, int) or load_steps < 1:
+        raise ValueError(f"solver.load_steps must be an integer >= 1, got {load_steps!r}")
+    petsc = _petsc_options(solver)
+
     outputs = data.get("outputs", {})
     _check_keys(outputs, SCHEMA["outputs"], "outputs")
     cells = tuple(mesh.get("cells", [20, 20]))
@@ -290,6 +335,8 @@ def load_scene(source: str | pathlib.Path | dict) -> Scene:
     return Scene(
         name=head.get("name", "scene"),
         kind=mesh_kind,
+        file=mesh_file,
+        size=size,
         radii=tuple(map(float, mesh.get("radii", [1.0, 2.0]))),
         geometry_degree=_choice(mesh.get("geometry_degree", 1), (1, 2), "mesh.geometry_degree"),
         corners=tuple(tuple(map(float, c)) for c in mesh.get("corners", [[0, 0], [1, 1]])),
@@ -303,7 +350,75 @@ def load_scene(source: str | pathlib.Path | dict) -> Scene:
         parts=parts,
         loads=tuple(loads),
         outputs={"vtx": True, "png": True, **outputs},
+        load_steps=load_steps,
+        petsc_options=petsc,
     )
+
+
+def _check_shared(interfaces: list[InterfaceSpec]) -> None:
+    """Interfaces of one scene are cut as one level set (the union of their insides):
+    they must agree in law, parameters and materials."""
+    for k, spec in enumerate(interfaces[1:], start=1):
+        for key in SHARED_INTERFACE_KEYS:
+            mine, first = getattr(spec, key), getattr(interfaces[0], key)
+            if mine != first:
+                raise NotImplementedError(
+                    f"interfaces[{k}].{key} = {mine!r} differs from interfaces[0].{key} = "
+                    f"{first!r}: the interfaces of one scene are cut as one level set (the "
+                    f"union of their insides) and must share {list(SHARED_INTERFACE_KEYS)}; "
+                    "interfaces with different laws or materials are not available yet"
+                )
+    names = [spec.name for spec in interfaces]
+    if len(set(names)) != len(names):
+        raise ValueError(f"Interface names must be unique, got {names}")
+
+
+def _gmsh_source(mesh: dict, kind: str, folder: pathlib.Path):
+    """(file, size) of a gmsh mesh, checked; (None, None) for built-in meshes."""
+    if kind != "gmsh":
+        for key in ("file", "size"):
+            if key in mesh:
+                raise ValueError(f"mesh.{key} is for mesh.kind = 'gmsh', not {kind!r}")
+        return None, None
+    if "file" not in mesh:
+        raise ValueError("mesh.kind = 'gmsh' needs mesh.file (a .geo or .msh file)")
+    path = (folder / mesh["file"]).resolve()
+    if path.suffix not in (".geo", ".msh"):
+        raise ValueError(f"mesh.file = {mesh['file']!r}: expected a .geo or .msh file")
+    if not path.exists():
+        raise ValueError(f"mesh.file = {mesh['file']!r}: no such file ({path})")
+    if path.suffix == ".msh":
+        given = sorted({"size", "cell", "geometry_degree"} & set(mesh))
+        if given:
+            raise ValueError(
+                f"mesh.{given[0]} is read from the .msh file itself; give it only with a .geo"
+            )
+    size = mesh.get("size")
+    if size is not None and not float(size) > 0.0:
+        raise ValueError(f"mesh.size must be > 0 (m), got {size!r}")
+    return path, None if size is None else float(size)
+
+
+def _petsc_options(solver: dict) -> dict:
+    """PETSc options of the [solver] table (Newton tolerances and the raw options)."""
+    options = {}
+    for key, option in (
+        ("max_iterations", "snes_max_it"),
+        ("rtol", "snes_rtol"),
+        ("atol", "snes_atol"),
+    ):
+        if key in solver:
+            value = solver[key]
+            if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
+                raise ValueError(f"solver.{key} must be a positive number, got {value!r}")
+            options[option] = value
+    raw = solver.get("petsc", {})
+    if not isinstance(raw, dict):
+        raise ValueError("solver.petsc must be a table of PETSc options")
+    for key, value in raw.items():
+        if not isinstance(value, str | int | float | bool):
+            raise ValueError(f"solver.petsc.{key} must be a string, number or boolean")
+    return options | raw
 
 
 def bundled_scenes() -> dict[str, pathlib.Path]:

@@ -5,7 +5,9 @@ from __future__ import annotations
 import pathlib
 import time
 from collections.abc import Callable
+from typing import NamedTuple
 
+import dolfinx.io
 import dolfinx.mesh
 import numpy as np
 import ufl
@@ -15,8 +17,12 @@ from xfem_contact import forms
 from xfem_contact.contact import ContactProblem
 from xfem_contact.cutmesh import CutMesh
 from xfem_contact.elasticity import ElasticityProblem
+from xfem_contact.evaluation import interface_points
 from xfem_contact.expressions import compile_expression
+from xfem_contact.levelset import union
+from xfem_contact.loading import load_steps
 from xfem_contact.meshes import annulus
+from xfem_contact.output import write_json
 from xfem_contact.plain import PlainElasticityProblem
 from xfem_contact.scene import InterfaceSpec, Scene
 
@@ -44,7 +50,14 @@ def levelset(spec: InterfaceSpec) -> Callable[[np.ndarray], np.ndarray]:
     return lambda x: np.broadcast_to(np.asarray(f(x), dtype=float), x[0].shape).copy()
 
 
-def _locator(scene: Scene, name: str) -> Callable:
+def _part(scene: Scene, name: str, meshed: MeshedDomain) -> Callable | np.ndarray:
+    """A boundary part: a locator of ``x`` for built-in and expression parts, local
+    facet indices for the named physical groups of a gmsh file."""
+    if name in scene.parts:
+        f = compile_expression(scene.parts[name], f"parts.{name}.where")
+        return lambda x: np.broadcast_to(np.asarray(f(x), dtype=bool), x[0].shape).copy()
+    if name in meshed.parts:
+        return meshed.facet_tags.find(meshed.parts[name])
     (x0, y0), (x1, y1) = scene.corners
     r0, r1 = scene.radii
     tol = 1e-6 * r1
@@ -57,9 +70,6 @@ def _locator(scene: Scene, name: str) -> Callable:
         "top": lambda x: np.isclose(x[1], y1),
         "boundary": lambda x: np.ones(x.shape[1], dtype=bool),
     }
-    if name in scene.parts:
-        f = compile_expression(scene.parts[name], f"parts.{name}.where")
-        return lambda x: np.broadcast_to(np.asarray(f(x), dtype=bool), x[0].shape).copy()
     return builtin[name]
 
 
@@ -88,34 +98,64 @@ def _value(value, vector: bool):
     return float(value)
 
 
+class MeshedDomain(NamedTuple):
+    """The mesh of a scene with its named boundary parts (gmsh physical groups)."""
+
+    mesh: dolfinx.mesh.Mesh
+    facet_tags: dolfinx.mesh.MeshTags | None = None
+    parts: dict[str, int] = {}
+
+
+def create_mesh(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> MeshedDomain:
+    """The mesh a scene names: rectangle, annulus (curved cells) or a gmsh file. Collective."""
+    if scene.kind == "gmsh":
+        from xfem_contact.gmsh_io import read_gmsh
+
+        meshed = read_gmsh(scene.file, comm, scene.geometry_degree, scene.cell, scene.size)
+        return MeshedDomain(meshed.mesh, meshed.facet_tags, meshed.parts)
+    if scene.kind == "annulus":
+        return MeshedDomain(annulus(comm, *scene.radii, *scene.cells, scene.geometry_degree))
+    mesh = dolfinx.mesh.create_rectangle(
+        comm,
+        [list(scene.corners[0]), list(scene.corners[1])],
+        list(scene.cells),
+        dolfinx.mesh.CellType[scene.cell],
+    )
+    return MeshedDomain(mesh)
+
+
+def interface_levelset(scene: Scene, mesh: dolfinx.mesh.Mesh) -> Callable:
+    """The level set of the scene's interfaces: one, or the union of several (checked
+    apart, see :func:`xfem_contact.levelset.union`). Collective."""
+    if len(scene.interfaces) == 1:
+        return levelset(scene.interfaces[0])
+    return union(
+        mesh, {spec.name: levelset(spec) for spec in scene.interfaces}, scene.levelset_degree
+    )
+
+
 def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
     """Create the mesh and the problem of a scene (collective). Returns (problem, effects)."""
-    if scene.kind == "annulus":
-        mesh = annulus(comm, *scene.radii, *scene.cells, scene.geometry_degree)
-    else:
-        mesh = dolfinx.mesh.create_rectangle(
-            comm,
-            [list(scene.corners[0]), list(scene.corners[1])],
-            list(scene.cells),
-            dolfinx.mesh.CellType[scene.cell],
-        )
+    meshed = create_mesh(scene, comm)
+    mesh = meshed.mesh
     material = next(iter(scene.materials.values()))
     if not scene.interfaces:
         problem = PlainElasticityProblem(mesh, scene.degree, material)
         effects = {
             "interface": None,
+            "interfaces": [],
             "cut": False,
             "enrichment": False,
             "multipliers": 0,
             "tangential_multiplier": False,
-            "solver": "KSP (one linear solve)",
+            "solver": "KSP (one linear solve per load step)",
             "pairing": False,
         }
     else:
-        spec = scene.interfaces[0]
+        spec = scene.interfaces[0]  # the interfaces share law and materials
         cut = CutMesh(
             mesh,
-            levelset(spec),
+            interface_levelset(scene, mesh),
             degree=scene.levelset_degree,
             quadrature_degree=scene.quadrature_degree,
         )
@@ -133,10 +173,11 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             solver = "SNES (generalized Newton)"
         else:
             problem = ElasticityProblem(cut, scene.degree, materials, spec.law)
-            solver = "KSP (one linear solve)"
+            solver = "KSP (one linear solve per load step)"
         comps = problem.space.multiplier_components
         effects = {
             "interface": spec.law,
+            "interfaces": [s.name for s in scene.interfaces],
             "cut": True,
             "enrichment": True,
             "multipliers": comps,
@@ -145,16 +186,16 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             "pairing": False,
         }
     for load in scene.loads:
-        _apply(problem, scene, load)
+        _apply(problem, scene, load, meshed)
     return problem, effects
 
 
-def _apply(problem, scene: Scene, load) -> None:
+def _apply(problem, scene: Scene, load, meshed: MeshedDomain) -> None:
     side = {} if isinstance(problem, PlainElasticityProblem) else {"side": load.side}
     if load.type == "point_displacement":
         problem.add_point_displacement(load.point, float(load.value), int(load.component))
         return
-    where = _locator(scene, load.part) if load.part else None
+    where = _part(scene, load.part, meshed) if load.part else None
     if load.type == "displacement":
         problem.add_displacement(where, _value(load.value, False), load.component)
     elif load.type == "pressure":
@@ -163,6 +204,71 @@ def _apply(problem, scene: Scene, load) -> None:
         problem.add_traction(where, _value(load.value, True), **side)
     elif load.type == "body_force":
         problem.add_body_force(_value(load.value, True), **side)
+    else:  # the scene schema admits no other type
+        raise AssertionError(f"unhandled load type {load.type!r}")
+
+
+class Result:
+    """The output fields of a problem as collapsed Functions, refreshed after each solve.
+
+    Plain problems have one field ``u``; cut problems ``u_minus``, ``u_plus`` and,
+    with an interface law that needs one, ``multiplier``.
+    """
+
+    def __init__(self, problem):
+        self.problem = problem
+        if isinstance(problem, PlainElasticityProblem):
+            self.names = ["u"]
+            self.fields = [dolfinx.fem.Function(problem.V, name="u")]
+            self._maps = [None]
+        else:
+            W = problem.space.W
+            self.names = ["u_minus", "u_plus"]
+            if problem.space.has_multiplier:
+                self.names.append("multiplier")
+            self.fields, self._maps = [], []
+            for i, name in enumerate(self.names):
+                V, dofs = W.sub(i).collapse()
+                self.fields.append(dolfinx.fem.Function(V, name=name))
+                self._maps.append(np.asarray(dofs))
+
+    def update(self, solution: dolfinx.fem.Function) -> None:
+        """Copy a solution (plain ``u`` or mixed ``w``) into the fields."""
+        for f, dofs in zip(self.fields, self._maps, strict=True):
+            f.x.array[:] = solution.x.array if dofs is None else solution.x.array[dofs]
+            f.x.scatter_forward()
+
+
+def solve_step(
+    problem, petsc_options: dict | None = None, log: Callable[[str], None] | None = None
+) -> tuple[dolfinx.fem.Function, int, dict]:
+    """Solve a problem at its current load factor: (solution, iterations, status).
+
+    Contact problems run Newton from the previous step (a ``log`` line per
+    iterate) and accept the step; linear ones solve once. ``petsc_options``
+    override the solver's defaults (cut problems). Raises
+    :class:`~xfem_contact.nonlinear_solver.NewtonFailure` with the iteration
+    history when Newton fails.
+    """
+    if isinstance(problem, PlainElasticityProblem):
+        return problem.solve(petsc_options), 1, {}
+    if isinstance(problem, ContactProblem):
+        report = problem.solve(petsc_options=petsc_options, log=log)
+        problem.accept_step()
+        return problem.w, report.iterations, report.status[-1]
+    return problem.solve(petsc_options=petsc_options).w, 1, {}
+
+
+def interface_samples(problem: ContactProblem) -> dict[str, list[float]]:
+    """Interface quadrature point values of all processes (for plots and the summary):
+    ``x``, ``y`` (m), ``gap``, ``slip`` (m), ``lambda_n``, ``lambda_t``, ``P_n``,
+    ``P_t`` (Pa). Collective."""
+    state = problem.interface_state(problem.w)
+    points = interface_points(problem.cut)
+    local = {"x": points[:, 0], "y": points[:, 1]}
+    local |= {k: state[k] for k in ("gap", "slip", "lambda_n", "lambda_t", "P_n", "P_t")}
+    comm = problem.mesh.comm
+    return {k: np.concatenate(comm.allgather(v)).tolist() for k, v in local.items()}
 
 
 def run(
@@ -171,56 +277,100 @@ def run(
     log: Callable[[str], None] | None = print,
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> dict:
-    """Build, solve and summarise a scene; writes VTX and ``summary.json`` into ``out``."""
+    """Build, solve and summarise a scene. Collective.
+
+    The loads are applied in ``scene.load_steps`` equal steps (a line per step and
+    per Newton iterate goes to ``log``; ``None`` for silence). With ``out``, the
+    fields of every step go to VTX files (``displacement.bp``, ``multiplier.bp``,
+    time = load factor), the final state to ``result.vtu`` and the summary to
+    ``summary.json``.
+
+    Returns:
+        The summary: effects built, fields, dof counts, iterations per step, the
+        contact status, timings (s).
+    """
     say = log if (log and comm.rank == 0) else (lambda *a: None)
     compiled_before = len(forms._cache)
     start = time.perf_counter()
     problem, effects = build(scene, comm)
+    build_time = time.perf_counter() - start
     say(f"scene {scene.name}: effects {effects}")
-    summary = {"scene": scene.name, "effects": effects, "ranks": comm.size}
+    result = Result(problem)
+    series = _open_series(out, result) if (out is not None and scene.outputs["vtx"]) else []
+    steps, iterations, residuals = load_steps(scene.load_steps), [], []
+    status: dict = {}
+    solve_start = time.perf_counter()
+    try:
+        for k, t in enumerate(steps, start=1):
+            problem.load_factor.set(t)
+            solution, its, status = solve_step(
+                problem, scene.petsc_options or None, say if log else None
+            )
+            iterations.append(its)
+            if isinstance(problem, ContactProblem):
+                residuals.append(problem.last_report.residuals)
+            result.update(solution)
+            for writer in series:
+                writer.write(float(t))
+            say(
+                f"load step {k}/{len(steps)} (factor {t:.4g}): {its} iteration(s)"
+                + "".join(f", {key} {value}" for key, value in status.items())
+            )
+    finally:
+        for writer in series:
+            writer.close()
+    solve_time = time.perf_counter() - solve_start
+    summary = {
+        "scene": scene.name,
+        "effects": effects,
+        "ranks": comm.size,
+        "fields": result.names,
+        "load_steps": len(steps),
+        "iterations": int(sum(iterations)),
+        "iterations_per_step": iterations,
+    }
     if isinstance(problem, PlainElasticityProblem):
-        u = problem.solve()
-        summary |= {
-            "fields": ["u"],
-            "dofs": {"u": problem.V.dofmap.index_map.size_global * 2},
-            "iterations": 1,
-        }
-        fields = [u]
+        summary["dofs"] = {"u": problem.V.dofmap.index_map.size_global * problem.V.dofmap.bs}
     else:
-        if isinstance(problem, ContactProblem):
-            report = problem.solve(log=say)
-            w, iterations = problem.w, report.iterations
-            summary["contact_status"] = report.status[-1]
-        else:
-            w, iterations = problem.solve().w, 1
         dofs = problem.space.dof_counts()
-        names = ["u_minus", "u_plus"] + (["multiplier"] if problem.space.has_multiplier else [])
-        summary |= {
-            "fields": names,
-            "dofs": dofs._asdict() | {"total": dofs.total},
-            "iterations": iterations,
-        }
-        fields = [w.sub(i).collapse() for i in range(len(names))]
-        for f, name in zip(fields, names, strict=True):
-            f.name = name
+        summary["dofs"] = dofs._asdict() | {"total": dofs.total}
+    if isinstance(problem, ContactProblem):
+        summary["contact_status"] = status
+        summary["newton_residuals"] = residuals
+        summary["interface_samples"] = interface_samples(problem)
     summary["forms_compiled"] = len(forms._cache) - compiled_before
-    summary["timings"] = {"total": time.perf_counter() - start}
+    cut_timings = getattr(getattr(problem, "cut", None), "timings", {})
+    timings = dict(cut_timings) | {
+        "mesh_and_spaces": build_time - sum(cut_timings.values()),
+        "solve": solve_time,
+    }
     if out is not None:
-        from xfem_contact.output import write_fields, write_json
-
+        output_start = time.perf_counter()
         out = pathlib.Path(out)
-        if scene.outputs.get("vtx", True):
-            write_fields(out, "displacement", fields[:2])
-            if len(fields) > 2:
-                write_fields(out, "multiplier", fields[2:])
-        _write_grid(out, problem, fields)
-        if comm.rank == 0:
-            write_json(out / "summary.json", summary)
+        _write_grid(out, problem, result.fields)
+        timings["output"] = time.perf_counter() - output_start
+    summary["timings"] = timings | {"total": time.perf_counter() - start}
+    if out is not None and comm.rank == 0:
+        write_json(out / "summary.json", summary)
     say(
         f"done in {summary['timings']['total']:.2f} s: dofs {summary['dofs']}, "
-        f"iterations {summary['iterations']}"
+        f"iterations {summary['iterations_per_step']}"
     )
     return summary
+
+
+def _open_series(out: str | pathlib.Path, result: Result) -> list:
+    """VTX writers of the displacement(s) and the multiplier (one time step per load step)."""
+    out = pathlib.Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    comm = result.fields[0].function_space.mesh.comm
+    groups = [("displacement", result.fields[:2])]
+    if len(result.fields) > 2:
+        groups.append(("multiplier", result.fields[2:]))
+    return [
+        dolfinx.io.VTXWriter(comm, out / f"{name}.bp", fields, engine="BP4")
+        for name, fields in groups
+    ]
 
 
 def _write_grid(out: pathlib.Path, problem, fields) -> None:
