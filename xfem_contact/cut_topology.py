@@ -1,8 +1,9 @@
 """Reference-cell data, sign topology and side polygons for cutting cells.
 
-Helper of :mod:`xfem_contact.cut` (pure numpy and Basix, no DOLFINx). Cells are
-Basix reference cells; the level set of each cell is given by its nodal values
-``phi`` of shape ``(ncells, ndofs)`` in Basix Lagrange (``gll_warped``) order.
+Base of :mod:`xfem_contact.cut` and its helper modules, importing none of
+them (pure numpy and Basix, no DOLFINx). Cells are Basix reference cells; the
+level set of each cell is given by its nodal values ``phi`` of shape
+``(ncells, ndofs)`` in Basix Lagrange (``gll_warped``) order.
 
 The cell boundary is walked as a counter-clockwise *loop* of vertices; loop
 edge ``j`` runs from loop vertex ``j`` to loop vertex ``j + 1`` (cyclically). On
@@ -25,9 +26,9 @@ values. Two exceptions keep exact zeros from creating spurious topology:
 (:data:`TWICE`, :data:`MANY`, :data:`INTERIOR`, :data:`CORNER`). Cells with
 only :data:`CORNER` lie wholly on side -1 with the interface along their zero
 edges (:func:`zero_edges`); the others are cut after splitting them into
-sub-cells (:func:`split_parameters`, :func:`split_cells`), on which the level
-set is again a degree-1 or 2 Lagrange interpolant (:func:`lagrange_basis`
-evaluates it at their nodes).
+sub-cells (:mod:`xfem_contact.cut_split`), on which the level set is again a
+degree-1 or 2 Lagrange interpolant (:func:`lagrange_basis` evaluates it at
+their nodes). :func:`side_polygon` lists the two sides of a simply cut cell.
 """
 
 from __future__ import annotations
@@ -39,9 +40,9 @@ import basix
 import numpy as np
 import numpy.typing as npt
 
-_TANGENCY = 64.0 * np.finfo(np.float64).eps
+TANGENCY = 64.0 * np.finfo(np.float64).eps
+"""Dips within ``TANGENCY * max|phi|`` of zero (per cell) are tangency, not crossings."""
 _LATTICE = 8  # interior sample lattice: (_LATTICE + 1) points per direction
-_SPLIT_MARGIN = 1.0 / 16.0  # adaptive split parameters stay in [margin, 1 - margin]
 
 # Cuts that one SEG3 cannot represent (bit flags in the ``kind`` of :func:`topology`).
 TWICE = 1
@@ -217,7 +218,7 @@ def edge_coefficients(
     return 2.0 * a + 2.0 * b - 4.0 * m, 4.0 * m - 3.0 * a - b
 
 
-def _loop_edges(data: CellData, phi: np.ndarray) -> tuple[np.ndarray, ...]:
+def loop_edges(data: CellData, phi: np.ndarray) -> tuple[np.ndarray, ...]:
     """Start values, end values, ``A`` and ``B`` of every loop edge, each ``(ncells, nv)``."""
     start = phi[:, data.loop]
     end = np.roll(start, -1, axis=1)
@@ -247,7 +248,7 @@ def topology(data: CellData, phi: np.ndarray) -> tuple[npt.NDArray[np.bool_], np
         :data:`INTERIOR` is checked for degree 2 only (a bilinear or linear
         interpolant has no closed zero line).
     """
-    start, end, A, B = _loop_edges(data, phi)
+    start, end, A, B = loop_edges(data, phi)
     neg = start < 0
     # Zero vertices that the interface leaves along an edge towards side +1.
     out_neg = (B < 0) | ((B == 0) & (A < 0))  # g < 0 just after t = 0
@@ -255,8 +256,8 @@ def topology(data: CellData, phi: np.ndarray) -> tuple[npt.NDArray[np.bool_], np
     in_neg = (slope_end > 0) | ((slope_end == 0) & (A < 0))  # g < 0 just before t = 1
     trig = (start == 0) & (((end >= 0) & out_neg) | (np.roll((start >= 0) & in_neg, 1, axis=1)))
     neg = neg | trig
-    tol = _TANGENCY * np.abs(phi).max(axis=1)
-    double, _ = _double_crossings(start, A, B, neg, tol)
+    tol = TANGENCY * np.abs(phi).max(axis=1)
+    double, _ = double_crossings(start, A, B, neg, tol)
     changes = (neg != np.roll(neg, -1, axis=1)).sum(axis=1)
     mixed = changes > 0
     corner = mixed & (_zero_edges(start, A, B).sum(axis=1) >= 2) & ~(start > 0).any(axis=1)
@@ -278,11 +279,11 @@ def _zero_edges(start: np.ndarray, A: np.ndarray, B: np.ndarray) -> np.ndarray:
 
 def zero_edges(data: CellData, phi: np.ndarray) -> npt.NDArray[np.bool_]:
     """Loop edges ``(ncells, nv)`` on which the interpolant of ``phi`` vanishes identically."""
-    start, _, A, B = _loop_edges(data, phi)
+    start, _, A, B = loop_edges(data, phi)
     return _zero_edges(start, A, B)
 
 
-def _double_crossings(
+def double_crossings(
     start: np.ndarray, A: np.ndarray, B: np.ndarray, neg: np.ndarray, tol: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """Loop edges whose polynomial dips beyond ``tol`` ``(ncells,)`` to the side
@@ -297,7 +298,7 @@ def _double_crossings(
     return dip & (neg == np.roll(neg, -1, axis=1)), tstar
 
 
-def _interior_values(data: CellData, phi: np.ndarray, rows: np.ndarray) -> np.ndarray:
+def interior_values(data: CellData, phi: np.ndarray, rows: np.ndarray) -> np.ndarray:
     """Interpolant at the interior lattice for cells ``rows``, ``(rows.size, npoints)``."""
     return phi[rows] @ data.lattice_basis.T
 
@@ -312,7 +313,7 @@ def _interior_sign_changes(
     chunk = 65536
     for k in range(0, rows.size, chunk):  # bounded memory, vectorised within a chunk
         r = rows[k : k + chunk]
-        values = _interior_values(data, phi, r)
+        values = interior_values(data, phi, r)
         minus = neg[r].any(axis=1)
         wrong = np.where(minus, values.max(axis=1) > tol[r], values.min(axis=1) < -tol[r])
         found.append(r[wrong])
@@ -323,132 +324,6 @@ def describe_kinds(kind: np.ndarray) -> str:
     """What the flags in ``kind`` say, e.g. ``"crosses an edge twice"`` (for errors)."""
     present = int(np.bitwise_or.reduce(kind, initial=0))
     return " / ".join(text for flag, text in KIND_NAMES.items() if present & flag)
-
-
-def split_parameters(
-    data: CellData,
-    phi: np.ndarray,
-    neg: np.ndarray,
-    kind: np.ndarray,
-    through: np.ndarray | None = None,
-    across: np.ndarray | None = None,
-) -> npt.NDArray[np.float64]:
-    """Where to split each loop edge of cells that need subdividing, ``(ncells, nv)``.
-
-    By default the mid-point (1/2). An edge crossed twice (:data:`TWICE`) is
-    split at the extremum of its polynomial, between the two crossings, so that
-    a cap of any width is separated in one step. Otherwise a cell with a point
-    ``through`` is split by a line through it: an uncut cell with an interior
-    sign change (:data:`INTERIOR`) through the lattice point of largest
-    opposite value, inside the closed piece (both lines for quadrilaterals,
-    the one parallel to edge (1, 2) for triangles); with a direction ``across``
-    given, by the one available line most transversal to it. Adaptive parameters are clamped
-    to ``[1/16, 15/16]``. Quadrilaterals split along one ``X`` and one ``Y``
-    line, so opposite loop edges get matching parameters (``t_2 = 1 - t_0``,
-    ``t_3 = 1 - t_1``).
-
-    Args:
-        data: Reference-cell data.
-        phi: Nodal values, shape ``(ncells, ndofs)``.
-        neg: Topological vertex sides from :func:`topology`, ``(ncells, nv)``.
-        kind: Flags from :func:`topology`, ``(ncells,)``.
-        through: Optional points to split through, ``(ncells, 2)``, NaN rows: none.
-        across: Optional directions to cross there, ``(ncells, 2)``, NaN rows: any.
-    """
-    n, nv = neg.shape
-    P = np.full((n, 2), np.nan) if through is None else through.copy()
-    d = np.full((n, 2), np.nan) if across is None else across
-    interior = np.flatnonzero(((kind & INTERIOR) != 0) & ((kind & TWICE) == 0))
-    if interior.size:
-        values = _interior_values(data, phi, interior)
-        sign = np.where(neg[interior].any(axis=1), 1.0, -1.0)  # towards the other side
-        P[interior] = data.lattice[np.argmax(sign[:, None] * values, axis=1)]
-    P = np.clip(P, _SPLIT_MARGIN, 1.0 - _SPLIT_MARGIN)
-    t = np.full((n, nv), 0.5)
-    has, free = ~np.isnan(P[:, 0]), np.isnan(d[:, 0])
-    if data.cell_type == "triangle":
-        # Lines through P parallel to edge (1, 2), (0, 2), (0, 1): the cuts of corners 0, 1, 2
-        directions = np.array([[1.0, -1.0], [0.0, 1.0], [1.0, 0.0]])
-        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-        dd = np.nan_to_num(d)
-        cross = np.abs(dd[:, [0]] * directions[:, 1] - dd[:, [1]] * directions[:, 0])
-        line = np.where(free, 0, np.argmax(cross, axis=1))
-        x, y = P[:, 0], P[:, 1]
-        s = np.clip(x + y, _SPLIT_MARGIN, 1.0 - _SPLIT_MARGIN)
-        options = [{0: s, 2: 1.0 - s}, {0: x, 1: 1.0 - x}, {2: 1.0 - y, 1: y}]
-        for k, option in enumerate(options):
-            rows = has & (line == k)
-            for edge, value in option.items():
-                t[rows, edge] = value[rows]
-    else:
-        along_x = np.abs(d[:, 0]) >= np.abs(d[:, 1])  # cross such directions by an X = c line
-        t[:, 0] = np.where(has & (free | along_x), P[:, 0], t[:, 0])
-        t[:, 1] = np.where(has & (free | ~along_x), P[:, 1], t[:, 1])
-    start, _, A, B = _loop_edges(data, phi)
-    tol = _TANGENCY * np.abs(phi).max(axis=1)
-    double, tstar = _double_crossings(start, A, B, neg, tol)
-    tstar = np.clip(np.where(double, tstar, 0.5), _SPLIT_MARGIN, 1.0 - _SPLIT_MARGIN)
-    if data.cell_type == "triangle":
-        t = np.where(double, tstar, t)
-    else:  # per axis: the first of the two parallel edges that is crossed twice
-        for axis in (0, 1):
-            first, other = tstar[:, axis], 1.0 - tstar[:, axis + 2]
-            adaptive = np.where(double[:, axis], first, other)
-            t[:, axis] = np.where(double[:, axis] | double[:, axis + 2], adaptive, t[:, axis])
-        t[:, 2:] = 1.0 - t[:, :2]
-    return t
-
-
-def split_cells(data: CellData, vertices: np.ndarray, t: np.ndarray) -> npt.NDArray[np.float64]:
-    """Split cells into four at the loop-edge parameters ``t`` (``(m, nv)``, from
-    :func:`split_parameters`).
-
-    Triangles split into three corner triangles and a middle one; quadrilaterals
-    (axis-parallel rectangles in the coordinates of ``vertices``) into four
-    rectangles. Children keep the orientation of the parent, and vertices shared
-    by siblings are the same floating-point numbers.
-
-    Args:
-        data: Reference-cell data.
-        vertices: Vertices of the cells in Basix order, shape ``(m, nv, 2)``.
-        t: Split parameters, shape ``(m, nv)``.
-
-    Returns:
-        Vertices of the children, shape ``(m, 4, nv, 2)``.
-    """
-
-    def point(a: np.ndarray, b: np.ndarray, s: np.ndarray) -> np.ndarray:
-        s = s[:, None]
-        return (1.0 - s) * a + s * b  # symmetric in (a, b) for s = 1/2
-
-    V = [vertices[:, i] for i in range(vertices.shape[1])]
-    if data.cell_type == "triangle":
-        p01, p12, p20 = (
-            point(V[0], V[1], t[:, 0]),
-            point(V[1], V[2], t[:, 1]),
-            point(V[2], V[0], t[:, 2]),
-        )
-        children = [(V[0], p01, p20), (p01, V[1], p12), (p20, p12, V[2]), (p12, p20, p01)]
-    else:
-        x0, x1, y0, y1 = V[0][:, 0], V[1][:, 0], V[0][:, 1], V[2][:, 1]
-        xs = point(x0[:, None], x1[:, None], t[:, 0])[:, 0]
-        ys = point(y0[:, None], y1[:, None], t[:, 1])[:, 0]
-        children = []
-        for ya, yb in ((y0, ys), (ys, y1)):
-            for xa, xb in ((x0, xs), (xs, x1)):
-                corners = [(xa, ya), (xb, ya), (xa, yb), (xb, yb)]
-                children.append(tuple(np.stack(c, axis=1) for c in corners))
-    return np.stack([np.stack(c, axis=1) for c in children], axis=1)
-
-
-def straight_triangles(data: CellData, vertices: np.ndarray) -> npt.NDArray[np.float64]:
-    """Straight P2 triangles tiling cells, counter-clockwise, Basix node order:
-    shape ``(m, 1, 6, 2)`` for triangles, ``(m, 2, 6, 2)`` for quadrilaterals
-    (diagonal from vertex 0 to vertex 3), from vertices ``(m, nv, 2)`` (Basix order)."""
-    tris = [(0, 1, 2)] if data.cell_type == "triangle" else [(0, 1, 3), (0, 3, 2)]
-    v = vertices[:, np.array(tris)]  # (m, ntri, 3, 2)
-    mids = 0.5 * (v[:, :, [1, 0, 0]] + v[:, :, [2, 2, 1]])
-    return np.concatenate([v, mids], axis=2)
 
 
 def side_polygon(code: int, nv: int, side: int) -> list[int]:
