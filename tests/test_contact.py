@@ -129,10 +129,10 @@ def test_solved_problems_are_freed():
     assert all(r() is None for r in refs)
 
 
-@pytest.mark.parametrize("degree, geometry_degree", [(1, 1), (2, 2)])
+@pytest.mark.parametrize("degree, geometry_degree", [(1, 1), (1, 2), (2, 2)])
 def test_case3_annulus_uniform_pressure(degree, geometry_degree):
     """Paper case 3 with no rotation yet (alpha = 0): frictionless contact at r = 8 m,
-    exact uniform pressure -1825/1636 MPa (straight cells for P1, curved for P2)."""
+    exact uniform pressure -1825/1636 MPa (P1 on straight and curved cells, P2 on curved)."""
     from xfem_contact.paper_cases import annulus_pressure_error, annulus_problem
 
     errors = []
