@@ -8,7 +8,6 @@ xfem-contact show DIR
 from __future__ import annotations
 
 import argparse
-import json
 import pathlib
 import sys
 
@@ -43,31 +42,14 @@ def _scenes(args) -> int:
 
 
 def _show(args) -> int:
-    import pyvista
+    """Render a run folder: result.png, cut.png and pressure.png (those with data)."""
+    from xfem_contact.pictures import render_folder
 
-    folder = pathlib.Path(args.dir)
-    grids = sorted(folder.glob("result*.vtu"))
-    if not grids:
-        print(
-            f"error: no result*.vtu in {folder} (run a scene with --out {folder} first)",
-            file=sys.stderr,
-        )
+    try:
+        render_folder(args.dir, log=print)
+    except FileNotFoundError as error:
+        print(f"error: {error}", file=sys.stderr)
         return 2
-    summary = json.loads((folder / "summary.json").read_text())
-    pyvista.OFF_SCREEN = True
-    plotter = pyvista.Plotter(off_screen=True, window_size=(900, 700))
-    for path in grids:
-        grid = pyvista.read(path)
-        u = grid.point_data["u"]
-        scale = 0.1 * max(grid.length, 1e-30) / max(abs(u).max(), 1e-300)
-        warped = grid.warp_by_vector("u", factor=scale)
-        warped.point_data["|u| (m)"] = (u**2).sum(axis=1) ** 0.5
-        plotter.add_mesh(warped, scalars="|u| (m)", show_edges=False)
-    plotter.view_xy()
-    plotter.add_text(f"{summary['scene']}: deformed (x{scale:.3g})", font_size=10)
-    png = folder / "result.png"
-    plotter.screenshot(png)
-    print(f"wrote {png}")
     return 0
 
 

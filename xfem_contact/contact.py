@@ -60,6 +60,9 @@ class ContactProblem(ElasticityProblem):
         augmentation: Dimensionless factor of ``r = augmentation * E / h`` (> 0).
         lbb: ``"stabilized"`` (default), ``"restriction"`` (vital vertices) or ``"none"``.
         multiplier_stabilization: Weight of the stabilisation (``lbb="stabilized"``).
+        multiplier_extension: Weight of the normal-gradient term fixing the
+            multiplier off the interface (see :class:`ElasticityProblem`; not with
+            ``lbb="none"``).
         ghost_penalty: See :class:`ElasticityProblem`.
     """
 
@@ -79,6 +82,7 @@ class ContactProblem(ElasticityProblem):
         augmentation: float = 1.0,
         lbb: str = "stabilized",
         multiplier_stabilization: float = 0.1,
+        multiplier_extension: float = 1e-8,
         ghost_penalty: float = 0.01,
     ):
         if law == "coulomb" and friction is None:
@@ -96,6 +100,7 @@ class ContactProblem(ElasticityProblem):
             law,
             ghost_penalty=ghost_penalty,
             multiplier_stabilization=multiplier_stabilization if lbb == "stabilized" else 0.0,
+            multiplier_extension=multiplier_extension if lbb != "none" else 0.0,
         )
         self.law, self.friction, self.augmentation, self.lbb = law, friction, augmentation, lbb
         self.w = dolfinx.fem.Function(self.space.W, name="w")
@@ -152,6 +157,8 @@ class ContactProblem(ElasticityProblem):
         if P_t is not None:
             interface += P_t * ufl.dot(jump_v, t) - (lam_t - P_t) * mu_t / r
         F = self.bulk_form(u, v) + interface * self.cut.dGamma
+        if self.multiplier_extension > 0:
+            F -= self.multiplier_extension_form(u[2], v[2])
         if self.multiplier_stabilization > 0:
             F -= self.multiplier_stabilization_form(
                 self.traction_vector(u), self.traction_vector(v), u, v

@@ -12,7 +12,6 @@ DEFAULT_PETSC_OPTIONS = {
     "ksp_type": "preonly",
     "pc_type": "lu",
     "pc_factor_mat_solver_type": "mumps",
-    "mat_mumps_cntl_1": 0.1,  # pivoting threshold for saddle points (see nonlinear_solver)
 }
 
 

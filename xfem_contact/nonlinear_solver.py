@@ -31,10 +31,6 @@ DEFAULT_SNES_OPTIONS = {
     "ksp_type": "preonly",
     "pc_type": "lu",
     "pc_factor_mat_solver_type": "mumps",
-    # The multiplier block is tiny (h / E) next to the stiffness: MUMPS's default
-    # pivoting threshold 0.01 left 2.5e-2 relative linear residuals (P1 on curved
-    # annulus cells, 20 x 80) and Newton stalled; 0.1 gives 5e-12.
-    "mat_mumps_cntl_1": 0.1,
 }
 
 

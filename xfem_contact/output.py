@@ -5,6 +5,8 @@
 - :func:`write_lips`: a VTK unstructured grid (``.vtu``) made of the uncut cells
   and the curved sub-triangles of the cut cells, each carrying the displacement
   of its own side: the lips of the interface appear separate and discontinuous.
+- :func:`write_cut_geometry`: the cut itself (sub-triangles and interface pieces)
+  as ``.vtu`` files, for ``xfem-contact show`` and ParaView.
 - :func:`write_json`: a JSON summary (numpy values converted).
 """
 
@@ -18,7 +20,6 @@ import dolfinx.io
 import numpy as np
 
 from xfem_contact.cutmesh import CutMesh
-from xfem_contact.evaluation import evaluate_reference
 
 
 def write_fields(directory: str | pathlib.Path, name: str, functions: list) -> list[pathlib.Path]:
@@ -44,53 +45,45 @@ def write_sides(directory: str | pathlib.Path, cut: CutMesh) -> pathlib.Path:
     return path
 
 
+def _rank_path(path: pathlib.Path, comm) -> pathlib.Path:
+    """``path`` with suffix ``_r{rank}`` before the extension when run in parallel."""
+    if comm.size > 1:
+        path = path.with_name(f"{path.stem}_r{comm.rank}{path.suffix}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
 def write_lips(path: str | pathlib.Path, cut: CutMesh, u_minus, u_plus) -> pathlib.Path:
     """Write a ``.vtu`` grid of uncut cells and sub-triangles with each side's displacement.
 
-    Local to each process: rank ``r`` writes ``path`` with suffix ``_r{r}`` when
-    run in parallel. ``u_minus``, ``u_plus``: displacement Functions (collapsed).
+    The grid is :func:`xfem_contact.pictures.deformed_lips_grid` (quadratic cells,
+    point data ``u`` in m, cell data ``side``, ``cut``, ``cell``). Local to each
+    process: rank ``r`` writes ``path`` with suffix ``_r{r}`` when run in parallel.
+    ``u_minus``, ``u_plus``: displacement Functions of sides -1 and +1.
     """
-    import basix
-    import pyvista
+    from xfem_contact.vtk_grids import deformed_lips_grid
 
-    mesh = cut.mesh
-    tdim = mesh.topology.dim
-    path = pathlib.Path(path)
-    if mesh.comm.size > 1:
-        path = path.with_name(f"{path.stem}_r{mesh.comm.rank}{path.suffix}")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    ref = {"triangle": np.array([[0, 1, 2]]), "quadrilateral": np.array([[0, 1, 3], [0, 3, 2]])}
-    ref_vertices = basix.geometry(mesh.basix_cell())
-    split = ref[mesh.topology.cell_name()]
-    points, values, sides, triangles = [], [], [], []
-    for side, u in ((-1, u_minus), (1, u_plus)):
-        cells = np.flatnonzero(cut.cell_sides == side).astype(np.int32)
-        X = np.tile(ref_vertices[split.ravel()], (cells.size, 1))
-        c = np.repeat(cells, split.size)
-        tri_geom, tri_cell = (
-            (cut.geometry.tri_minus, cut.geometry.tri_minus_cell)
-            if side == -1
-            else (cut.geometry.tri_plus, cut.geometry.tri_plus_cell)
-        )
-        X = np.concatenate([X, tri_geom[:, :3].reshape(-1, tdim)])
-        c = np.concatenate([c, np.repeat(cut.cut_cells[tri_cell], 3)])
-        points.append(cut.maps.push_forward(c, X))
-        values.append(evaluate_reference(u, c, X))
-        sides.append(np.full(X.shape[0] // 3, side))
-    start = 0
-    for p in points:
-        triangles.append(start + np.arange(p.shape[0]).reshape(-1, 3))
-        start += p.shape[0]
-    xyz = np.concatenate(points)
-    xyz = np.c_[xyz, np.zeros((xyz.shape[0], 3 - xyz.shape[1]))]
-    tri = np.concatenate(triangles)
-    cells = np.c_[np.full(tri.shape[0], 3), tri].ravel()
-    grid = pyvista.UnstructuredGrid(cells, np.full(tri.shape[0], pyvista.CellType.TRIANGLE), xyz)
-    u = np.concatenate(values)
-    grid.point_data["u"] = np.c_[u, np.zeros((u.shape[0], 3 - u.shape[1]))]
-    grid.cell_data["side"] = np.concatenate(sides)
-    grid.save(path)
+    path = _rank_path(pathlib.Path(path), cut.mesh.comm)
+    deformed_lips_grid(cut, u_minus, u_plus).save(path)
     return path
+
+
+def write_cut_geometry(directory: str | pathlib.Path, cut: CutMesh) -> list[pathlib.Path]:
+    """Write ``subcells.vtu`` (uncut cells and curved sub-triangles, cell data ``side``,
+    ``cut``, ``cell``) and ``interface.vtu`` (curved interface pieces) into ``directory``.
+
+    Local to each process (not collective): in parallel rank ``r`` writes
+    ``subcells_r{r}.vtu`` and ``interface_r{r}.vtu``. See :mod:`xfem_contact.pictures`.
+    """
+    from xfem_contact.vtk_grids import interface_grid, subcell_grid
+
+    directory, comm = pathlib.Path(directory), cut.mesh.comm
+    paths = []
+    for name, grid in (("subcells", subcell_grid(cut)), ("interface", interface_grid(cut))):
+        path = _rank_path(directory / f"{name}.vtu", comm)
+        grid.save(path)
+        paths.append(path)
+    return paths
 
 
 def _jsonable(value):

@@ -39,3 +39,52 @@ def line_plot(
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def interface_abscissa(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, str]:
+    """A coordinate along the interface for points ``(x, y)`` (m), shape ``(n,)`` each.
+
+    Returns the polar angle (degrees, in (-180, 180]) about the points' centroid,
+    or, for points on a straight line (a line interface), the position (m)
+    along that line from the centroid; and the axis label saying which.
+    """
+    x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+    centred = np.c_[x - x.mean(), y - y.mean()]
+    if x.size < 3:
+        return centred[:, 0], "x - mean x (m)"
+    _, sv, vt = np.linalg.svd(centred, full_matrices=False)
+    if sv[1] <= 1e-6 * sv[0]:
+        return centred @ vt[0], "position along the interface (m)"
+    theta = np.degrees(np.arctan2(centred[:, 1], centred[:, 0]))
+    return theta, "polar angle about the interface centroid (degrees)"
+
+
+def plot_pressure(
+    abscissa: np.ndarray,
+    values: np.ndarray,
+    path: str | pathlib.Path,
+    exact: float | typing.Callable[[np.ndarray], np.ndarray] | None = None,
+    xlabel: str = "polar angle about the interface centroid (degrees)",
+    title: str = "Contact pressure on the interface",
+) -> pathlib.Path:
+    """PNG of the contact pressure (multiplier ``lambda_n``, Pa; negative in
+    compression) at interface points against a coordinate along the interface.
+
+    Args:
+        abscissa: Coordinate of each point, shape ``(n,)`` (e.g. from
+            :func:`interface_abscissa`); points are sorted by it.
+        values: ``lambda_n`` at the points (Pa), shape ``(n,)``.
+        path: The PNG file.
+        exact: The exact pressure (Pa): a constant or a function of the abscissa,
+            drawn dashed; ``None`` for none.
+        xlabel: Label of the abscissa.
+        title: Title of the plot.
+    """
+    s, p = np.asarray(abscissa, dtype=np.float64), np.asarray(values, dtype=np.float64)
+    order = np.argsort(s)
+    series = [Series(s[order], p[order], ".", "X-FEM multiplier $\\lambda_n$")]
+    if exact is not None:
+        t = np.linspace(s.min(), s.max(), 400) if s.size else np.zeros(0)
+        e = np.full_like(t, exact) if np.isscalar(exact) else np.asarray(exact(t), dtype=float)
+        series.append(Series(t, e, "k--", "exact"))
+    return line_plot(path, series, xlabel, "contact pressure $\\lambda_n$ (Pa)", title)

@@ -350,8 +350,14 @@ def run(
         _write_grid(out, problem, result.fields)
         timings["output"] = time.perf_counter() - output_start
     summary["timings"] = timings | {"total": time.perf_counter() - start}
+    if out is not None:
+        comm.barrier()  # every rank's files are on disk before rank 0 renders them
     if out is not None and comm.rank == 0:
         write_json(out / "summary.json", summary)
+        if scene.outputs["png"]:
+            from xfem_contact.pictures import render_folder
+
+            render_folder(out, log=say)
     say(
         f"done in {summary['timings']['total']:.2f} s: dofs {summary['dofs']}, "
         f"iterations {summary['iterations_per_step']}"
@@ -374,8 +380,9 @@ def _open_series(out: str | pathlib.Path, result: Result) -> list:
 
 
 def _write_grid(out: pathlib.Path, problem, fields) -> None:
-    """``result.vtu`` (per process): the lips of a cut scene, or the plain mesh."""
-    from xfem_contact.output import write_lips
+    """``result.vtu`` (per process): the lips of a cut scene, or the plain mesh; and
+    for a cut scene ``subcells.vtu``/``interface.vtu`` (the cut geometry)."""
+    from xfem_contact.output import write_cut_geometry, write_lips
 
     if isinstance(problem, PlainElasticityProblem):
         import dolfinx.plot
@@ -391,3 +398,4 @@ def _write_grid(out: pathlib.Path, problem, fields) -> None:
         grid.save(out / name)
     else:
         write_lips(out / "result.vtu", problem.cut, fields[0], fields[1])
+        write_cut_geometry(out, problem.cut)
