@@ -8,8 +8,10 @@ pressure is n.sigma.n = -3/2 + cos(2 theta)/2 and the tangential traction
 element) by default; generalized Newton (PETSc SNES) on the augmented Lagrangian.
 
 Writes in --out: VTX files of the displacement of each side and of the
-multipliers, a .vtu of the lips, a PNG of the contact pressure against the angle
-with the exact curve, and a JSON summary (``--json``, default OUT/summary.json).
+multipliers, ``result.vtu`` (the lips), ``subcells.vtu``/``interface.vtu`` (the
+cut), a PNG of the contact pressure against the angle with the exact curve, and a
+JSON summary (``--json``, default OUT/summary.json); ``xfem-contact show OUT``
+renders the folder.
 
 Run: ``python demos/inclusion_contact.py [--n 40] [--degree 2] [--law sticking]``,
 also under ``mpiexec -n 2``.
@@ -23,8 +25,7 @@ import time
 import numpy as np
 from mpi4py import MPI
 
-from xfem_contact.evaluation import interface_points
-from xfem_contact.output import write_fields, write_json, write_lips
+from xfem_contact.output import write_cut_geometry, write_fields, write_json, write_lips
 from xfem_contact.paper_cases import INCLUSION_CENTRE, inclusion_errors, inclusion_problem
 from xfem_contact.plots import Series, line_plot
 
@@ -70,22 +71,20 @@ def main():
         f"{errors.pressure:.4e}; tangential traction rel. L2 error {errors.tangential:.4e}"
     )
 
-    state = problem.interface_state(problem.w)
-    xy = interface_points(cut)
-    samples = np.c_[xy, state["lambda_n"]]
+    samples = problem.interface_samples()  # collective
     fields = [problem.w.sub(i).collapse() for i in range(3)]
     for f, name in zip(fields, ("u_minus", "u_plus", "multiplier"), strict=True):
         f.name = name
     write_fields(out, "displacement", fields[:2])
     write_fields(out, "multiplier", fields[2:])
-    write_lips(out / "lips.vtu", cut, fields[0], fields[1])
+    write_lips(out / "result.vtu", cut, fields[0], fields[1])
+    write_cut_geometry(out, cut)
     dofs = problem.space.dof_counts()  # collective
-    gathered = comm.gather(samples, root=0)
     if comm.rank == 0:
-        samples = np.concatenate(gathered)
-        theta = np.arctan2(samples[:, 1] - INCLUSION_CENTRE[1], samples[:, 0] - INCLUSION_CENTRE[0])
+        x, y, lam = (np.array(samples[k]) for k in ("x", "y", "lambda_n"))
+        theta = np.arctan2(y - INCLUSION_CENTRE[1], x - INCLUSION_CENTRE[0])
         order = np.argsort(theta)
-        plot(out / "contact_pressure.png", theta[order], samples[order, 2], args)
+        plot(out / "contact_pressure.png", theta[order], lam[order], args)
         summary = {
             "case": "paper case 2: circular inclusion, contact",
             "n": args.n,
@@ -101,7 +100,7 @@ def main():
             "contact_status": report.status[-1],
             "dofs": dofs._asdict() | {"total": dofs.total},
             "timings": timings,
-            "interface_samples": samples[order],
+            "interface_samples": samples,
         }
         path = write_json(args.json or out / "summary.json", summary)
         say(f"  wrote {path}, {out / 'contact_pressure.png'} and VTX/.vtu files in {out}")

@@ -8,8 +8,9 @@ quadratic, so quadratic X-FEM reproduces it to round-off; the lower block does
 not move and the gap stays >= 3.875e-6 m.
 
 Writes (in --out): the interface displacement plot (u_y of both lips against x,
-exact dashed: the paper's Fig. 4) as PNG, VTX fields, a .vtu of the lips, and a
-JSON summary (``--json``, default OUT/summary.json).
+exact dashed: the paper's Fig. 4) as PNG, VTX fields, ``result.vtu`` (the lips),
+``subcells.vtu``/``interface.vtu`` (the cut), and a JSON summary (``--json``,
+default OUT/summary.json); ``xfem-contact show OUT`` renders the folder.
 
 Run: ``python demos/straight_interface.py --degree 2 --cell quadrilateral``
 (also under ``mpiexec -n 2``).
@@ -28,7 +29,7 @@ import ufl
 from mpi4py import MPI
 
 from xfem_contact.evaluation import evaluate_at_rules, interface_points
-from xfem_contact.output import write_fields, write_json, write_lips
+from xfem_contact.output import write_cut_geometry, write_fields, write_json, write_lips
 from xfem_contact.paper_cases import straight_interface_exact, straight_interface_problem
 from xfem_contact.plots import Series, line_plot
 
@@ -92,7 +93,8 @@ def main():
     u_minus, u_plus = solution.field(0), solution.field(1)
     u_minus.name, u_plus.name = "u_minus", "u_plus"
     write_fields(out, "displacement", [u_minus, u_plus])
-    write_lips(out / "lips.vtu", cut, u_minus, u_plus)
+    write_lips(out / "result.vtu", cut, u_minus, u_plus)
+    write_cut_geometry(out, cut)
     rows_upper = np.c_[xi, upper]
     rows_lower = np.c_[xi, lower]
     gathered = comm.gather((rows_upper, rows_lower), root=0)
@@ -118,7 +120,7 @@ def main():
             "lower_lip_samples": rows_lower[order],
         }
         path = write_json(args.json or out / "summary.json", summary)
-        say(f"wrote {path}, {out / 'interface_displacement.png'}, VTX and lips.vtu in {out}")
+        say(f"wrote {path}, {out / 'interface_displacement.png'}, VTX and .vtu files in {out}")
 
 
 def plot(path, upper, lower, args):

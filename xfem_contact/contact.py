@@ -38,7 +38,7 @@ from mpi4py import MPI
 from xfem_contact import lbb as lbb_module
 from xfem_contact.cutmesh import CutMesh
 from xfem_contact.elasticity import ElasticityProblem
-from xfem_contact.evaluation import evaluate_at_rules, rule_cells
+from xfem_contact.evaluation import evaluate_at_rules, interface_points, rule_cells
 from xfem_contact.materials import Material
 from xfem_contact.nonlinear_solver import NewtonReport, RestrictedNewton
 from xfem_contact.restriction import MultiplierProlongation, restriction_matrix
@@ -241,6 +241,17 @@ class ContactProblem(ElasticityProblem):
             "r": r,
             "trial_t": trial,
         }
+
+    def interface_samples(self) -> dict[str, list[float]]:
+        """The interface state of the solution at the quadrature points of all processes
+        (for plots and summaries): ``x``, ``y``, ``gap``, ``slip`` (m), ``lambda_n``,
+        ``lambda_t``, ``P_n``, ``P_t`` (Pa), each a list over the points. Collective."""
+        state = self.interface_state(self.w)
+        points = interface_points(self.cut)
+        local = {"x": points[:, 0], "y": points[:, 1]}
+        local |= {k: state[k] for k in ("gap", "slip", "lambda_n", "lambda_t", "P_n", "P_t")}
+        comm = self.mesh.comm
+        return {k: np.concatenate(comm.allgather(v)).tolist() for k, v in local.items()}
 
     def interface_status(self, w: dolfinx.fem.Function) -> dict:
         """Global counts of interface quadrature points in contact / stick / slip."""

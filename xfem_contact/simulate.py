@@ -17,7 +17,6 @@ from xfem_contact import forms
 from xfem_contact.contact import ContactProblem
 from xfem_contact.cutmesh import CutMesh
 from xfem_contact.elasticity import ElasticityProblem
-from xfem_contact.evaluation import interface_points
 from xfem_contact.expressions import compile_expression
 from xfem_contact.levelset import union
 from xfem_contact.loading import load_steps
@@ -259,18 +258,6 @@ def solve_step(
     return problem.solve(petsc_options=petsc_options).w, 1, {}
 
 
-def interface_samples(problem: ContactProblem) -> dict[str, list[float]]:
-    """Interface quadrature point values of all processes (for plots and the summary):
-    ``x``, ``y`` (m), ``gap``, ``slip`` (m), ``lambda_n``, ``lambda_t``, ``P_n``,
-    ``P_t`` (Pa). Collective."""
-    state = problem.interface_state(problem.w)
-    points = interface_points(problem.cut)
-    local = {"x": points[:, 0], "y": points[:, 1]}
-    local |= {k: state[k] for k in ("gap", "slip", "lambda_n", "lambda_t", "P_n", "P_t")}
-    comm = problem.mesh.comm
-    return {k: np.concatenate(comm.allgather(v)).tolist() for k, v in local.items()}
-
-
 def run(
     scene: Scene,
     out: str | pathlib.Path | None = None,
@@ -337,7 +324,7 @@ def run(
     if isinstance(problem, ContactProblem):
         summary["contact_status"] = status
         summary["newton_residuals"] = residuals
-        summary["interface_samples"] = interface_samples(problem)
+        summary["interface_samples"] = problem.interface_samples()
     summary["forms_compiled"] = len(forms._cache) - compiled_before
     cut_timings = getattr(getattr(problem, "cut", None), "timings", {})
     timings = dict(cut_timings) | {
