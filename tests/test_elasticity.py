@@ -150,3 +150,23 @@ def test_bad_input_raises():
     problem = ElasticityProblem(cut, 1, Material(1.0, 0.3), "free")
     with pytest.raises(ValueError, match="no boundary facet"):
         problem.add_pressure(lambda x: np.isclose(x[0], 7.0), 1.0)
+
+
+@pytest.mark.mpi
+def test_mesh_without_ghost_cells_is_refused_in_parallel():
+    """The ghost penalty needs the cells across shared facets: a mesh distributed
+    without ghosts would silently drop the facets between processes."""
+    partitioner = dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode.none, 2)
+    mesh = dolfinx.mesh.create_rectangle(
+        MPI.COMM_WORLD,
+        [[0.0, 0.0], [1.0, 1.0]],
+        [8, 8],
+        dolfinx.mesh.CellType.quadrilateral,
+        partitioner=partitioner,
+    )
+    cut = xfem_contact.CutMesh(mesh, lambda x: np.hypot(x[0] - 0.5, x[1] - 0.5) - 0.3, degree=2)
+    if MPI.COMM_WORLD.size == 1:  # nothing to ghost
+        assert ElasticityProblem(cut, 1, Material(1.0, 0.3)).ghost_penalty > 0
+    else:
+        with pytest.raises(ValueError, match="without ghost cells"):
+            ElasticityProblem(cut, 1, Material(1.0, 0.3))

@@ -316,7 +316,13 @@ SCENES = bundled_scenes()["plate_with_hole_inclusion"].parent
 @pytest.mark.mpi
 def test_gmsh_scene_runs_with_named_parts():
     """A .geo with physical curves: loads on named parts; same on 1 and 2 ranks."""
-    summary = run(load_scene(gmsh_scene(), folder=SCENES), log=None)
+    scene = load_scene(gmsh_scene(), folder=SCENES)
+    summary = run(scene, log=None)
+    alone = run(scene, log=None, comm=MPI.COMM_SELF)
+    a, b = (np.array(s["interface_samples"]["lambda_n"]) for s in (summary, alone))
+    order_a = np.lexsort([summary["interface_samples"][k] for k in ("x", "y")])
+    order_b = np.lexsort([alone["interface_samples"][k] for k in ("x", "y")])
+    assert np.allclose(a[order_a], b[order_b], rtol=0, atol=1e-9 * np.abs(a).max())
     assert summary["effects"]["interface"] == "frictionless"
     s = {k: np.array(v) for k, v in summary["interface_samples"].items()}
     assert summary["contact_status"]["contact"] > 0

@@ -194,13 +194,14 @@ class CutMesh:
             if found == 0:
                 raise ValueError(f"No facet carries the tag value {value}")
         facets = np.unique(np.asarray(facets, dtype=np.int32))
+        num_owned = mesh.topology.index_map(fdim).size_local
+        facets = facets[facets < num_owned]  # ghost facets are integrated by their owner
         mesh.topology.create_connectivity(fdim, fdim + 1)
         exterior = dolfinx.mesh.exterior_facet_indices(mesh.topology)
         bad = np.setdiff1d(facets, exterior)
         if bad.size:
             raise ValueError(f"Facets {bad[:5].tolist()} are not exterior facets of the mesh")
-        num_owned = mesh.topology.index_map(fdim).size_local
-        return facets[facets < num_owned]
+        return facets
 
     def _boundary(self, slot: int) -> list[IntegrationPart]:
         """Standard and runtime parts of boundary set ``slot`` on the current cut."""

@@ -101,6 +101,7 @@ class ElasticityProblem:
             min_support_fraction=min_support_fraction,
         )
         self.mesh = cut.mesh
+        _check_ghosts(self.mesh)
         self._bcs: list[dolfinx.fem.DirichletBC] = []
         self._rhs: list = []
         self._x = ufl.SpatialCoordinate(self.mesh)
@@ -331,3 +332,18 @@ def _all_cell_sides(cut: CutMesh) -> np.ndarray:
     """Side (-1, 0 = cut, +1) of owned and ghost cells (ghosts via a DG0 scatter)."""
     side = cut.side_indicator()
     return np.rint(side.x.array[side.function_space.dofmap.list[:, 0]]).astype(np.int8)
+
+
+def _check_ghosts(mesh: dolfinx.mesh.Mesh) -> None:
+    """In parallel, the ghost penalty and the interface data need the cells across
+    shared facets: refuse a mesh distributed without ghost cells. Collective."""
+    comm = mesh.comm
+    if comm.size == 1:
+        return
+    ghosts = mesh.topology.index_map(mesh.topology.dim).num_ghosts
+    if comm.allreduce(ghosts, op=MPI.SUM) == 0:
+        raise ValueError(
+            "The mesh is distributed without ghost cells; create it with "
+            "partitioner=dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode."
+            "shared_facet) (see xfem_contact.meshes.ghosted_partitioner)"
+        )

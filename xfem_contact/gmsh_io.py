@@ -100,10 +100,13 @@ def read_gmsh(
         raise ValueError(f"size must be a positive length, got {size!r}")
     import dolfinx.io.gmsh
 
+    from xfem_contact.meshes import ghosted_partitioner
+
+    partitioner = ghosted_partitioner()
     root = 0
     if comm.rank != root:
         _raise_shared(comm.bcast(None, root=root))
-        data = dolfinx.io.gmsh.model_to_mesh(None, comm, root, gdim=2)
+        data = dolfinx.io.gmsh.model_to_mesh(None, comm, root, gdim=2, partitioner=partitioner)
         parts = comm.bcast(None, root=root)
     else:
         with contextlib.ExitStack() as stack:
@@ -119,7 +122,9 @@ def read_gmsh(
             except Exception as e:  # every rank raises it
                 error = e
             _raise_shared(comm.bcast(error, root=root))
-            data = dolfinx.io.gmsh.model_to_mesh(gmsh.model, comm, root, gdim=2)
+            data = dolfinx.io.gmsh.model_to_mesh(
+                gmsh.model, comm, root, gdim=2, partitioner=partitioner
+            )
         parts = comm.bcast(parts, root=root)
     mesh = data.mesh
     assert mesh.geometry.dim == 2

@@ -8,6 +8,16 @@ import numpy as np
 from mpi4py import MPI
 
 
+def ghosted_partitioner():
+    """A cell partitioner that ghosts the cells across shared facets.
+
+    The ghost penalty and the cut-cell data need the cells on both sides of every
+    interior facet; ``dolfinx.mesh.create_mesh`` and ``dolfinx.io.gmsh`` default to
+    no ghosts (``create_rectangle`` ghosts shared facets already).
+    """
+    return dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode.shared_facet, 2)
+
+
 def _quad_cells(ni: int, nj: int, node, degree: int) -> np.ndarray:
     """Cells of an ni x nj structured grid of quads in DOLFINx node order.
 
@@ -71,7 +81,7 @@ def annulus(
     element = basix.ufl.element("Lagrange", "quadrilateral", d, shape=(2,))
     if comm.rank != 0:
         x, cells = np.zeros((0, 2)), np.zeros((0, cells.shape[1]), dtype=np.int64)
-    return dolfinx.mesh.create_mesh(comm, cells, element, x)
+    return dolfinx.mesh.create_mesh(comm, cells, element, x, partitioner=ghosted_partitioner())
 
 
 def curved_square(comm: MPI.Comm, n: int, amplitude: float = 0.05) -> dolfinx.mesh.Mesh:
@@ -87,4 +97,4 @@ def curved_square(comm: MPI.Comm, n: int, amplitude: float = 0.05) -> dolfinx.me
     element = basix.ufl.element("Lagrange", "quadrilateral", 2, shape=(2,))
     if comm.rank != 0:
         x, cells = np.zeros((0, 2)), np.zeros((0, 9), dtype=np.int64)
-    return dolfinx.mesh.create_mesh(comm, cells, element, x)
+    return dolfinx.mesh.create_mesh(comm, cells, element, x, partitioner=ghosted_partitioner())
