@@ -21,26 +21,15 @@ import xfem_contact  # noqa: F401  (before dolfinx with the PyPI wheel)
 import numpy as np
 from mpi4py import MPI
 
-from xfem_contact.evaluation import interface_points
 from xfem_contact.nonlinear_solver import NewtonFailure
-from xfem_contact.paper_cases import INCLUSION_CENTRE, inclusion_errors, inclusion_problem
+from xfem_contact.paper_cases import inclusion_errors, inclusion_problem, pressure_total_variation
 
 EXACT_TOTAL_VARIATION = 4.0  # of -3/2 + cos(2 theta)/2 over the circle
 
 
 def oscillation(problem) -> float:
     """Total variation of lambda_n along the interface / that of the exact pressure."""
-    comm = problem.mesh.comm
-    xy = interface_points(problem.cut)
-    lam = problem.interface_state(problem.w)["lambda_n"]
-    data = comm.gather(np.c_[xy, lam], root=0)
-    if comm.rank != 0:
-        return comm.bcast(None, root=0)
-    data = np.concatenate(data)
-    theta = np.arctan2(data[:, 1] - INCLUSION_CENTRE[1], data[:, 0] - INCLUSION_CENTRE[0])
-    values = data[np.argsort(theta), 2]
-    tv = np.abs(np.diff(np.r_[values, values[:1]])).sum() / EXACT_TOTAL_VARIATION
-    return comm.bcast(tv, root=0)
+    return pressure_total_variation(problem) / EXACT_TOTAL_VARIATION
 
 
 def run(n, degree, law, lbb, cell):
