@@ -408,6 +408,7 @@ def render_folder(
                 folder / "pressure.png",
                 xlabel=label,
                 title=f"{name}: contact pressure",
+                applied=samples.get("P_n"),
             )
         )
     else:

@@ -66,6 +66,7 @@ def plot_pressure(
     exact: float | typing.Callable[[np.ndarray], np.ndarray] | None = None,
     xlabel: str = "polar angle about the interface centroid (degrees)",
     title: str = "Contact pressure on the interface",
+    applied: np.ndarray | None = None,
 ) -> pathlib.Path:
     """PNG of the contact pressure (multiplier ``lambda_n``, Pa; negative in
     compression) at interface points against a coordinate along the interface.
@@ -79,10 +80,15 @@ def plot_pressure(
             drawn dashed; ``None`` for none.
         xlabel: Label of the abscissa.
         title: Title of the plot.
+        applied: The applied (augmented) pressure ``P_n = min(0, lambda_n + r g_n)``
+            at the points (Pa), shape ``(n,)``: zero where the interface is open.
     """
     s, p = np.asarray(abscissa, dtype=np.float64), np.asarray(values, dtype=np.float64)
     order = np.argsort(s)
     series = [Series(s[order], p[order], ".", "X-FEM multiplier $\\lambda_n$")]
+    if applied is not None:
+        a = np.asarray(applied, dtype=np.float64)[order]
+        series.append(Series(s[order], a, "x", "applied $P_n = \\min(0, \\lambda_n + r g_n)$"))
     if exact is not None:
         t = np.linspace(s.min(), s.max(), 400) if s.size else np.zeros(0)
         e = np.full_like(t, exact) if np.isscalar(exact) else np.asarray(exact(t), dtype=float)
