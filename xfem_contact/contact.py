@@ -82,7 +82,7 @@ class ContactProblem(ElasticityProblem):
         augmentation: float = 1.0,
         lbb: str = "stabilized",
         multiplier_stabilization: float = 0.1,
-        multiplier_extension: float = 1e-8,
+        multiplier_extension: float = 1e-12,
         ghost_penalty: float = 0.01,
     ):
         if law == "coulomb" and friction is None:
