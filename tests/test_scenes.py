@@ -207,9 +207,11 @@ def test_coulomb_steps_respect_the_cone_and_print_a_line_per_step():
 
 
 def test_newton_failure_is_reported_with_its_history():
-    data = pressed_inclusion("coulomb", max_iterations=1)
-    with pytest.raises(NewtonFailure, match="iterate  0"):
+    data = pressed_inclusion("coulomb", max_iterations=1, load_steps=2)
+    with pytest.raises(NewtonFailure, match="load step 1/2") as failure:
         run(load_scene(data), log=None)
+    assert "iterate  0" in str(failure.value) and "iterate  1" in str(failure.value)
+    assert len(failure.value.report.residuals) == 2
 
 
 @pytest.mark.parametrize(

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pathlib
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
 from typing import NamedTuple
 
 import dolfinx.io
@@ -21,6 +22,7 @@ from xfem_contact.expressions import compile_expression
 from xfem_contact.levelset import union
 from xfem_contact.loading import load_steps
 from xfem_contact.meshes import annulus
+from xfem_contact.nonlinear_solver import NewtonFailure
 from xfem_contact.output import write_json
 from xfem_contact.plain import PlainElasticityProblem
 from xfem_contact.scene import InterfaceSpec, Scene
@@ -102,7 +104,7 @@ class MeshedDomain(NamedTuple):
 
     mesh: dolfinx.mesh.Mesh
     facet_tags: dolfinx.mesh.MeshTags | None = None
-    parts: dict[str, int] = {}
+    parts: Mapping[str, int] = MappingProxyType({})
 
 
 def create_mesh(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> MeshedDomain:
@@ -290,9 +292,16 @@ def run(
     try:
         for k, t in enumerate(steps, start=1):
             problem.load_factor.set(t)
-            solution, its, status = solve_step(
-                problem, scene.petsc_options or None, say if log else None
-            )
+            try:
+                solution, its, status = solve_step(
+                    problem, scene.petsc_options or None, say if log else None
+                )
+            except NewtonFailure as failure:
+                raise NewtonFailure(
+                    f"Scene {scene.name!r}, load step {k}/{len(steps)} (load factor {t:.4g}): "
+                    f"Newton failed (SNES reason {failure.report.reason})",
+                    failure.report,
+                ) from None
             iterations.append(its)
             if isinstance(problem, ContactProblem):
                 residuals.append(problem.last_report.residuals)
