@@ -275,12 +275,12 @@ class ElasticityProblem:
         n = self.cut.normal
         shear = 0.5 * (self.materials[-1].mu + self.materials[1].mu)
         scale = self.multiplier_extension * self.cell_size**2 / (2.0 * shear)
-        on_cut_cells = 1.0 - abs(self.cell_sides)  # 1 on cut cells, 0 elsewhere
+        on_cut_cells = 1.0 - abs(self.side_indicator)  # 1 on cut cells, 0 elsewhere
         grad_lam, grad_mu = ufl.dot(ufl.grad(lam), n), ufl.dot(ufl.grad(mu), n)
         return on_cut_cells * scale * ufl.inner(grad_lam, grad_mu) * ufl.dx(domain=self.mesh)
 
     @functools.cached_property
-    def cell_sides(self) -> dolfinx.fem.Function:
+    def side_indicator(self) -> dolfinx.fem.Function:
         """The cells' sides as a DG0 function: -1, +1, or 0 on cut cells."""
         return self.cut.side_indicator()
 
