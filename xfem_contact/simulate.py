@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import pathlib
 import time
-from collections.abc import Callable, Mapping
-from types import MappingProxyType
+from collections.abc import Callable
 from typing import NamedTuple
 
 import dolfinx.io
@@ -19,6 +18,7 @@ from xfem_contact.contact import ContactProblem
 from xfem_contact.cutmesh import CutMesh
 from xfem_contact.elasticity import ElasticityProblem
 from xfem_contact.expressions import compile_expression
+from xfem_contact.gmsh_io import GmshMesh, facets, read_gmsh
 from xfem_contact.levelset import union
 from xfem_contact.loading import load_steps
 from xfem_contact.meshes import annulus
@@ -57,8 +57,8 @@ def _part(scene: Scene, name: str, meshed: MeshedDomain) -> Callable | np.ndarra
     if name in scene.parts:
         f = compile_expression(scene.parts[name], f"parts.{name}.where")
         return lambda x: np.broadcast_to(np.asarray(f(x), dtype=bool), x[0].shape).copy()
-    if name in meshed.parts:
-        return meshed.facet_tags.find(meshed.parts[name])
+    if meshed.gmsh is not None and name in meshed.gmsh.parts:
+        return facets(meshed.gmsh, name)
     (x0, y0), (x1, y1) = scene.corners
     r0, r1 = scene.radii
     tol = 1e-6 * r1
@@ -100,20 +100,17 @@ def _value(value, vector: bool):
 
 
 class MeshedDomain(NamedTuple):
-    """The mesh of a scene with its named boundary parts (gmsh physical groups)."""
+    """The mesh of a scene and, for a gmsh file, what was read with it (named parts)."""
 
     mesh: dolfinx.mesh.Mesh
-    facet_tags: dolfinx.mesh.MeshTags | None = None
-    parts: Mapping[str, int] = MappingProxyType({})
+    gmsh: GmshMesh | None = None
 
 
 def create_mesh(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> MeshedDomain:
     """The mesh a scene names: rectangle, annulus (curved cells) or a gmsh file. Collective."""
     if scene.kind == "gmsh":
-        from xfem_contact.gmsh_io import read_gmsh
-
         meshed = read_gmsh(scene.file, comm, scene.geometry_degree, scene.cell, scene.size)
-        return MeshedDomain(meshed.mesh, meshed.facet_tags, meshed.parts)
+        return MeshedDomain(meshed.mesh, meshed)
     if scene.kind == "annulus":
         return MeshedDomain(annulus(comm, *scene.radii, *scene.cells, scene.geometry_degree))
     mesh = dolfinx.mesh.create_rectangle(
