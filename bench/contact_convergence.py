@@ -21,8 +21,8 @@ import xfem_contact  # noqa: F401  (before dolfinx with the PyPI wheel)
 import numpy as np
 from mpi4py import MPI
 
-from xfem_contact.nonlinear_solver import NewtonFailure
-from xfem_contact.paper_cases import inclusion_errors, inclusion_problem, pressure_total_variation
+from xfem_contact.cases.paper import inclusion_errors, inclusion_problem, pressure_total_variation
+from xfem_contact.solvers.newton import NewtonFailure
 
 EXACT_TOTAL_VARIATION = 4.0  # of -3/2 + cos(2 theta)/2 over the circle
 

@@ -25,9 +25,9 @@ import time
 import numpy as np
 from mpi4py import MPI
 
-from xfem_contact.output import write_cut_geometry, write_fields, write_json, write_lips
-from xfem_contact.paper_cases import INCLUSION_CENTRE, inclusion_errors, inclusion_problem
-from xfem_contact.plots import Series, line_plot
+from xfem_contact.cases.paper import INCLUSION_CENTRE, inclusion_errors, inclusion_problem
+from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
+from xfem_contact.io.plots import Series, line_plot
 
 
 def main():

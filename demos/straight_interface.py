@@ -28,10 +28,10 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from xfem_contact.evaluation import evaluate_at_rules, interface_points
-from xfem_contact.output import write_cut_geometry, write_fields, write_json, write_lips
-from xfem_contact.paper_cases import straight_interface_exact, straight_interface_problem
-from xfem_contact.plots import Series, line_plot
+from xfem_contact.cases.paper import straight_interface_exact, straight_interface_problem
+from xfem_contact.fem.evaluation import evaluate_at_rules, interface_points
+from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
+from xfem_contact.io.plots import Series, line_plot
 
 
 def main():

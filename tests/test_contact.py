@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from xfem_contact.contact import ContactProblem
-from xfem_contact.materials import Material
-from xfem_contact.nonlinear_solver import NewtonFailure
-from xfem_contact.paper_cases import inclusion_errors, inclusion_problem
+from xfem_contact.cases.paper import inclusion_errors, inclusion_problem
+from xfem_contact.mechanics.contact import ContactProblem
+from xfem_contact.mechanics.materials import Material
+from xfem_contact.solvers.newton import NewtonFailure
 
 SIZES = [10, 20, 40]
 
@@ -99,7 +99,7 @@ def test_annulus_parallel_equals_serial(degree):
     """Curved-cell annulus meshes are built by ``dolfinx.mesh.create_mesh``, whose
     default partitioner makes no ghost cells: the ghost penalty then missed the
     facets between processes and 2 ranks differed from 1 in the 3rd digit."""
-    from xfem_contact.paper_cases import annulus_pressure_error, annulus_problem
+    from xfem_contact.cases.paper import annulus_pressure_error, annulus_problem
 
     errors = []
     for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
@@ -149,7 +149,7 @@ def test_solved_problems_are_freed():
 def test_case3_annulus_uniform_pressure(degree, geometry_degree):
     """Paper case 3 with no rotation yet (alpha = 0): frictionless contact at r = 8 m,
     exact uniform pressure -1825/1636 MPa (P1 on straight and curved cells, P2 on curved)."""
-    from xfem_contact.paper_cases import annulus_pressure_error, annulus_problem
+    from xfem_contact.cases.paper import annulus_pressure_error, annulus_problem
 
     errors = []
     for n in (10, 20):
@@ -168,7 +168,7 @@ def test_annulus_multiplier_modes_invisible_on_the_interface_are_fixed(n, degree
     the whole interface. Without the normal-gradient term the Jacobian is singular to
     round-off and Newton stalled (n = 12, P2) or needed 4 steps; with it, the active
     set being right from the start, the problem is linear: one Newton step."""
-    from xfem_contact.paper_cases import annulus_pressure_error, annulus_problem
+    from xfem_contact.cases.paper import annulus_pressure_error, annulus_problem
 
     problem = annulus_problem(n, 4 * n, degree)
     report = problem.solve()

@@ -14,13 +14,13 @@ import xfem_contact  # noqa: F401  (before dolfinx)
 import numpy as np
 import pytest
 
-from xfem_contact.materials import Material
-from xfem_contact.paper_cases import (
+from xfem_contact.cases.paper import (
     INCLUSION_E,
     inclusion_errors,
     inclusion_problem,
     pressure_total_variation,
 )
+from xfem_contact.mechanics.materials import Material
 
 EXACT_TOTAL_VARIATION = 4.0  # of n.sigma.n = -3/2 + cos(2 theta)/2 (Pa) around the circle
 N = 20  # cells per side, h = 0.05 m

@@ -1,5 +1,5 @@
-"""Cut-cell geometry and quadrature (pure numpy): ``xfem_contact.cut`` and
-``xfem_contact.quadrature`` against exact references.
+"""Cut-cell geometry and quadrature (pure numpy): ``xfem_contact.geometry.cut`` and
+``xfem_contact.quadrature.rules`` against exact references.
 
 References are computed independently here: straight cuts by clipping the
 reference cell with the half-plane (shoelace areas, high-order rules on a
@@ -16,8 +16,10 @@ import basix
 import numpy as np
 import pytest
 
-from xfem_contact import boundary, cut, quadrature
-from xfem_contact.cut_topology import lagrange_basis
+from xfem_contact.geometry import cut
+from xfem_contact.geometry.cut_topology import lagrange_basis
+from xfem_contact.quadrature import boundary
+from xfem_contact.quadrature import rules as quadrature
 
 CELLS = ["triangle", "quadrilateral"]
 DEGREES = [1, 2]

@@ -9,8 +9,8 @@ from dolfinx.fem import assemble_scalar
 from mpi4py import MPI
 
 import xfem_contact
-from xfem_contact import moment_fitting
-from xfem_contact.meshes import curved_square
+from xfem_contact.io.meshes import curved_square
+from xfem_contact.quadrature import moment_fitting
 
 CENTRE, RADIUS = np.array([0.51, 0.47]), 0.3
 
@@ -142,7 +142,7 @@ def test_boundary_pieces_exact(cell, degree):
 
 def test_update_reuses_compiled_forms():
     """A moved interface: new rules, same compiled kernels."""
-    from xfem_contact import forms
+    from xfem_contact.fem import forms
 
     mesh = unit_square(8, "quadrilateral")
     cut = xfem_contact.CutMesh(mesh, lambda x: np.hypot(x[0] - 0.5, x[1] - 0.5) - 0.2)

@@ -9,15 +9,15 @@ import ufl
 from mpi4py import MPI
 
 import xfem_contact
-from xfem_contact.elasticity import ElasticityProblem
-from xfem_contact.linear_solver import assemble_restricted
-from xfem_contact.materials import Material
-from xfem_contact.paper_cases import (
+from xfem_contact.cases.paper import (
     inclusion_errors,
     inclusion_problem,
     straight_interface_exact,
     straight_interface_problem,
 )
+from xfem_contact.mechanics.elasticity import ElasticityProblem
+from xfem_contact.mechanics.materials import Material
+from xfem_contact.solvers.linear import assemble_restricted
 
 
 def integrate(expr):
@@ -51,7 +51,7 @@ def case1(nx, ny, cell, degree):
 
 def _interface_values(cut, w, field):
     """Field values at the interface quadrature points, shape (npoints, 2)."""
-    from xfem_contact.evaluation import evaluate_at_rules
+    from xfem_contact.fem.evaluation import evaluate_at_rules
 
     return evaluate_at_rules(w.sub(field), cut, cut.interface_rules)
 

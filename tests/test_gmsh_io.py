@@ -13,7 +13,7 @@ import pytest
 import ufl
 from mpi4py import MPI
 
-from xfem_contact.gmsh_io import facets, physical_parts, read_gmsh
+from xfem_contact.io.gmsh import facets, physical_parts, read_gmsh
 
 GEO = Path(xfem_contact.__file__).parent / "scenes" / "plate_with_hole.geo"
 R = 0.15  # hole radius of the bundled geometry (m)

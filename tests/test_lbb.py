@@ -1,12 +1,12 @@
 """Vital vertices and the prolongation of the reduced multiplier space
-(``xfem_contact.lbb``, pure numpy)."""
+(``xfem_contact.mechanics.lbb``, pure numpy)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from xfem_contact import lbb
+from xfem_contact.mechanics import lbb
 
 
 def grid_cut_edges(n: int, phi) -> tuple[np.ndarray, np.ndarray]:

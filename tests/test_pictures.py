@@ -14,11 +14,12 @@ import pytest
 from conftest import unit_square
 from mpi4py import MPI
 
-from xfem_contact import cli, pictures, vtk_grids
-from xfem_contact.cutmesh import CutMesh
-from xfem_contact.forms import form
-from xfem_contact.output import write_cut_geometry, write_lips
-from xfem_contact.plots import interface_abscissa, plot_pressure
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.forms import form
+from xfem_contact.io import pictures, vtk_grids
+from xfem_contact.io.output import write_cut_geometry, write_lips
+from xfem_contact.io.plots import interface_abscissa, plot_pressure
+from xfem_contact.scenes import cli
 
 CENTRE, RADIUS = (0.51, 0.47), 0.3
 
@@ -157,8 +158,8 @@ def test_pngs_are_written_and_not_blank(tmp_path):
 def test_show_renders_a_run_folder(tmp_path, capsys):
     from test_scenes import base
 
-    from xfem_contact.scene import load_scene
-    from xfem_contact.simulate import run
+    from xfem_contact.scenes.run import run
+    from xfem_contact.scenes.scene import load_scene
 
     data = base(law="frictionless")
     data["loads"] = [

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from xfem_contact import cli
-from xfem_contact.cutmesh import CutMesh
-from xfem_contact.nonlinear_solver import NewtonFailure
-from xfem_contact.scene import bundled_scenes, load_scene
-from xfem_contact.simulate import build, levelset, run
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.scenes import cli
+from xfem_contact.scenes.run import build, levelset, run
+from xfem_contact.scenes.scene import bundled_scenes, load_scene
+from xfem_contact.solvers.newton import NewtonFailure
 
 
 def base(**interface):

@@ -12,8 +12,8 @@ except ImportError:  # conda/apt DOLFINx: nothing to do
 
 __version__ = "0.1.0"
 
-from xfem_contact.cutmesh import CutMesh  # noqa: E402
-from xfem_contact.forms import form  # noqa: E402
-from xfem_contact.runtime import CellRules  # noqa: E402
+from xfem_contact.fem.cutmesh import CutMesh  # noqa: E402
+from xfem_contact.fem.forms import form  # noqa: E402
+from xfem_contact.quadrature.cell_rules import CellRules  # noqa: E402
 
 __all__ = ["CellRules", "CutMesh", "form"]

@@ -1,0 +1,261 @@
+"""CutMesh: a mesh cut by a level-set interface, with UFL measures for each side
+and for the interface.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import numpy.typing as npt
+import ufl
+from mpi4py import MPI
+
+from xfem_contact.geometry import cut
+from xfem_contact.geometry.levelset import CellMaps, LevelSet, LevelSetCallable, interpolate
+from xfem_contact.quadrature import boundary
+from xfem_contact.quadrature import rules as quadrature
+from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart
+
+_SIDE_MINUS, _SIDE_PLUS, _INTERFACE = 1, 2, 3
+_BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
+_counter = itertools.count()
+
+
+class CutMesh:
+    """A mesh cut by the zero line of a level set.
+
+    Side -1 is ``phi < 0``, side +1 is ``phi >= 0``; the interface normal points
+    from side -1 to side +1. Cut cells are sub-triangulated into curved 6-node
+    triangles on each side and a 3-node curved segment on the interface
+    (straight for ``degree=1``), and integrated with per-cell runtime rules;
+    uncut cells use FFCx's standard rule.
+
+    Args:
+        mesh: A triangle or quadrilateral mesh (affine, distorted or curved).
+        levelset: A callable ``phi(x)`` (``x`` of shape ``(3, n)``) or a
+            scalar DOLFINx Function. With a callable the interface nodes lie
+            on its exact zero set; with a Function, on its interpolant's.
+        degree: Lagrange degree (1 or 2) the level set is interpolated in.
+        quadrature_degree: Polynomial degree of the rules on each curved
+            sub-triangle and on each interface segment.
+
+    Example:
+        >>> cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 0.5)
+        >>> area = dolfinx.fem.assemble_scalar(xfem_contact.form(1 * cut.dx(-1)))
+    """
+
+    def __init__(
+        self,
+        mesh: dolfinx.mesh.Mesh,
+        levelset: LevelSetCallable | dolfinx.fem.Function,
+        degree: int = 2,
+        quadrature_degree: int = 6,
+    ):
+        cell = mesh.topology.cell_name()
+        if cell not in ("triangle", "quadrilateral"):
+            raise NotImplementedError(
+                f"CutMesh supports triangle and quadrilateral meshes, not {cell}"
+            )
+        if quadrature_degree < 1:
+            raise ValueError(f"quadrature_degree must be >= 1, got {quadrature_degree}")
+        self.mesh = mesh
+        self.degree = degree
+        self.quadrature_degree = quadrature_degree
+        self.id = next(_counter)
+        self._boundary_sets: list[tuple[int, np.ndarray]] = []
+        self._boundary_parts: dict[int, list[IntegrationPart]] = {}
+        self.update(levelset)
+
+    def update(self, levelset: LevelSetCallable | dolfinx.fem.Function) -> None:
+        """Cut the mesh with a new level set (collective). Compiled forms are
+        reused: call :func:`xfem_contact.form` again to integrate on the new cut."""
+        mesh = self.mesh
+        tdim = mesh.topology.dim
+        cell_name = mesh.topology.cell_name()
+        start = time.perf_counter()
+        self.levelset: LevelSet = interpolate(mesh, levelset, self.degree)
+        maps = CellMaps(mesh, self.levelset)
+        num_owned = mesh.topology.index_map(tdim).size_local
+        owned = np.arange(num_owned, dtype=np.int32)
+        side = cut.classify(cell_name, self.degree, maps.nodal_values(owned))
+        self.cell_sides: npt.NDArray[np.int8] = side
+        cut_cells = owned[side == 0]
+        ncut = cut_cells.size
+        geometry = cut.subtriangulate(
+            cell_name, self.degree, maps.nodal_values(cut_cells), exact=maps.exact(cut_cells)
+        )
+        self.geometry = geometry
+        self.cut_cells = cut_cells
+        cut_time = time.perf_counter() - start
+        q = self.quadrature_degree
+        rules = {
+            _SIDE_MINUS: quadrature.side_rules(geometry, -1, q, ncut),
+            _SIDE_PLUS: quadrature.side_rules(geometry, +1, q, ncut),
+            _INTERFACE: quadrature.interface_rule(
+                geometry,
+                q,
+                ncut,
+                lambda rows, X: maps.jacobian(cut_cells[rows], X),
+                lambda rows, X: maps.grad_ref(cut_cells[rows], X),
+            ),
+        }
+        self.rules = rules
+        self._cell_rules = {
+            sid: CellRules(mesh, cut_cells, r.points, r.weights, r.offsets)
+            for sid, r in rules.items()
+        }
+        self._standard = {_SIDE_MINUS: owned[side == -1], _SIDE_PLUS: owned[side == 1]}
+        self.maps = maps
+        self._boundary_parts = {}
+        self.num_cut_cells_global = mesh.comm.allreduce(ncut, op=MPI.SUM)
+        #: Wall time (s) of the last update: level set + classification +
+        #: sub-triangulation ("cut"), and per-cell rules ("quadrature")
+        self.timings = {"cut": cut_time, "quadrature": time.perf_counter() - start - cut_time}
+
+    def side_indicator(self) -> dolfinx.fem.Function:
+        """DG0 function of each cell's side (-1, 0 for cut, +1), ghosts included. Collective."""
+        V0 = dolfinx.fem.functionspace(self.mesh, ("DG", 0))
+        side = dolfinx.fem.Function(V0, name="side")
+        side.x.array[V0.dofmap.list[: self.cell_sides.size, 0]] = self.cell_sides
+        side.x.scatter_forward()
+        return side
+
+    def side_rules(self, side: int) -> quadrature.RuleSet:
+        """Per-cut-cell rules of side -1 or +1 (reference points, weights)."""
+        if side not in (-1, 1):
+            raise ValueError(f"side must be -1 or +1, got {side!r}")
+        return self.rules[_SIDE_MINUS if side == -1 else _SIDE_PLUS]
+
+    @property
+    def interface_rules(self) -> quadrature.RuleSet:
+        """Per-cut-cell interface rules (weights ``ds / |det J|``, physical normals)."""
+        return self.rules[_INTERFACE]
+
+    # -- measures -----------------------------------------------------------
+    def dx(self, side: int, metadata: dict | None = None) -> ufl.Measure:
+        """Measure of side ``-1`` (phi < 0) or ``+1`` (phi >= 0): ``expr * cut.dx(-1)``.
+
+        ``metadata`` (e.g. ``{"quadrature_degree": 4}``) applies to uncut cells.
+        """
+        if side not in (-1, 1):
+            raise ValueError(f"side must be -1 or +1, got {side!r}")
+        sid = _SIDE_MINUS if side == -1 else _SIDE_PLUS
+        return ufl.Measure(
+            "dx", domain=self.mesh, subdomain_data=self, subdomain_id=sid, metadata=metadata or {}
+        )
+
+    @property
+    def dGamma(self) -> ufl.Measure:
+        """Measure of the interface (arc length in physical units): ``expr * cut.dGamma``."""
+        return ufl.Measure("dx", domain=self.mesh, subdomain_data=self, subdomain_id=_INTERFACE)
+
+    @property
+    def normal(self) -> ufl.core.expr.Expr:
+        """Unit normal of the interface, from side -1 to side +1 (UFL expression)."""
+        g = ufl.grad(self.levelset.function)
+        return g / ufl.sqrt(ufl.inner(g, g))
+
+    def ds(self, side: int, facets, value: int | None = None) -> ufl.Measure:
+        """Measure of the part of exterior facets lying on one side of the interface.
+
+        Args:
+            side: -1 or +1.
+            facets: Local indices of exterior facets (array), or a facet
+                ``MeshTags`` together with ``value``.
+            value: The tag value when ``facets`` is a ``MeshTags``.
+
+        Uncut cells' facets use FFCx's standard facet rule; pieces of facets of
+        cut cells are runtime rules with ``ufl.FacetNormal`` available.
+        """
+        if side not in (-1, 1):
+            raise ValueError(f"side must be -1 or +1, got {side!r}")
+        facets = self._facet_array(facets, value)
+        known = [s == side and np.array_equal(f, facets) for s, f in self._boundary_sets]
+        if any(known):
+            slot = known.index(True)
+        else:
+            self._boundary_sets.append((side, facets))
+            slot = len(self._boundary_sets) - 1
+        return ufl.Measure(
+            "ds", domain=self.mesh, subdomain_data=self, subdomain_id=_BOUNDARY0 + slot
+        )
+
+    def _facet_array(self, facets, value) -> np.ndarray:
+        mesh, fdim = self.mesh, self.mesh.topology.dim - 1
+        if isinstance(facets, dolfinx.mesh.MeshTags):
+            if facets.dim != fdim:
+                raise ValueError(f"Facet tags must have dimension {fdim}, got {facets.dim}")
+            if value is None:
+                raise ValueError("Give the tag value with a MeshTags: cut.ds(side, tags, value)")
+            facets = facets.find(value)
+            found = mesh.comm.allreduce(facets.size, op=MPI.SUM)
+            if found == 0:
+                raise ValueError(f"No facet carries the tag value {value}")
+        facets = np.unique(np.asarray(facets, dtype=np.int32))
+        num_owned = mesh.topology.index_map(fdim).size_local
+        facets = facets[facets < num_owned]  # ghost facets are integrated by their owner
+        mesh.topology.create_connectivity(fdim, fdim + 1)
+        exterior = dolfinx.mesh.exterior_facet_indices(mesh.topology)
+        bad = np.setdiff1d(facets, exterior)
+        if bad.size:
+            raise ValueError(f"Facets {bad[:5].tolist()} are not exterior facets of the mesh")
+        return facets
+
+    def _boundary(self, slot: int) -> list[IntegrationPart]:
+        """Standard and runtime parts of boundary set ``slot`` on the current cut."""
+        if slot in self._boundary_parts:
+            return self._boundary_parts[slot]
+        side, facets = self._boundary_sets[slot]
+        mesh, tdim = self.mesh, self.mesh.topology.dim
+        cell_name = mesh.topology.cell_name()
+        mesh.topology.create_connectivity(tdim - 1, tdim)
+        mesh.topology.create_connectivity(tdim, tdim - 1)
+        pairs = dolfinx.fem.compute_integration_domains(
+            dolfinx.fem.IntegralType.exterior_facet, mesh.topology, facets
+        ).reshape(-1, 2)
+        keep = self.cell_sides[pairs[:, 0]] == side
+        parts = [IntegrationPart("exterior_facet", entities=pairs[keep].ravel())]
+        # Pieces on cut cells: only those on facets of the set
+        rows, local, ends = boundary.facet_pieces(self.geometry, side, cell_name)
+        c2f = mesh.topology.connectivity(tdim, tdim - 1)
+        cell_facets = c2f.array.reshape(-1, c2f.offsets[1] - c2f.offsets[0])
+        in_set = np.isin(cell_facets[self.cut_cells[rows], local], facets)
+        rows, local, ends = rows[in_set], local[in_set], ends[in_set]
+        _, ref_normals = boundary.reference_facets(cell_name)
+        J = ufl.Jacobian(mesh)
+        for f, n_ref in enumerate(ref_normals):
+            mine = local == f
+            cells_rows = np.unique(rows[mine])
+            rule = boundary.facet_rules(
+                np.searchsorted(cells_rows, rows[mine]),
+                ends[mine],
+                cells_rows.size,
+                self.quadrature_degree,
+                lambda r, X, cr=cells_rows: self.maps.jacobian(self.cut_cells[cr[r]], X),
+            )
+            normal = ufl.dot(ufl.inv(J).T, ufl.as_vector(n_ref.tolist()))
+            normal = normal / ufl.sqrt(ufl.inner(normal, normal))
+            rules = CellRules(
+                mesh, self.cut_cells[cells_rows], rule.points, rule.weights, rule.offsets
+            )
+            parts.append(
+                IntegrationPart("cell", rules=rules, replace={ufl.FacetNormal(mesh): normal})
+            )
+        self._boundary_parts[slot] = parts
+        return parts
+
+    def integration_parts(self, subdomain_id: int) -> list[IntegrationPart]:
+        """Standard and runtime parts of a measure id (for :func:`xfem_contact.form`)."""
+        if subdomain_id >= _BOUNDARY0:
+            return self._boundary(subdomain_id - _BOUNDARY0)
+        if subdomain_id not in self._cell_rules:
+            raise ValueError(f"Unknown CutMesh measure id {subdomain_id}")
+        parts = []
+        if subdomain_id in self._standard:
+            parts.append(IntegrationPart("cell", entities=self._standard[subdomain_id]))
+        parts.append(IntegrationPart("cell", rules=self._cell_rules[subdomain_id]))
+        return parts

@@ -1,0 +1,189 @@
+"""Heaviside-enriched displacement spaces as mixed function spaces.
+
+``u = sum_i N_i u_i + sum_{i in cut supports} N_i (H - H(x_i)) a_i`` is the same
+field as one displacement per side, ``u = u_-`` on side -1 and ``u = u_+`` on
+side +1, each living on the cells its side touches. We use the latter: a mixed
+space ``(u_-, u_+[, lambda])`` whose dofs outside the support of their side (or,
+for the multiplier, outside the cut cells) are *inactive* and removed from every
+solve by a PETSc index set: the system has exactly standard + enriched dofs.
+"""
+
+from __future__ import annotations
+
+import typing
+
+import basix.ufl
+import dolfinx.fem
+import dolfinx.la
+import numpy as np
+import numpy.typing as npt
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from xfem_contact.fem.cutmesh import CutMesh
+
+
+class DofCounts(typing.NamedTuple):
+    """Global numbers of active dofs (scalar components)."""
+
+    standard: int  # dofs of the standard (unenriched) displacement space
+    enriched: int  # extra dofs of nodes whose support is cut
+    multiplier: int  # interface multiplier dofs (0 without multiplier)
+
+    @property
+    def total(self) -> int:
+        return self.standard + self.enriched + self.multiplier
+
+
+class EnrichedSpace:
+    """Displacement per side (Lagrange ``degree``, vector) and an optional
+    interface multiplier (P1 on the vertices of cut cells, scalar or vector).
+
+    Args:
+        cut: The cut mesh.
+        degree: Displacement degree, 1 or 2 (P1/P2 on triangles, Q1/Q2 on quads).
+        multiplier: Number of multiplier components: 0 (none), 1 (a scalar,
+            e.g. the normal contact pressure) or ``gdim`` (a vector: the
+            interface traction, Cartesian or normal/tangential).
+        min_support_fraction: A side's dofs whose support holds less than this
+            fraction of the support's area on that side are dropped (set
+            inactive) to keep the operator well conditioned; 0 keeps all.
+    """
+
+    def __init__(
+        self,
+        cut: CutMesh,
+        degree: int,
+        multiplier: int = 0,
+        min_support_fraction: float = 0.0,
+    ):
+        if degree not in (1, 2):
+            raise ValueError(f"Displacement degree must be 1 or 2, got {degree}")
+        if not 0.0 <= min_support_fraction < 1.0:
+            raise ValueError(f"min_support_fraction must be in [0, 1), got {min_support_fraction}")
+        mesh = cut.mesh
+        self.cut, self.degree = cut, degree
+        gdim = mesh.geometry.dim
+        cell = mesh.basix_cell()
+        displacement = basix.ufl.element("Lagrange", cell, degree, shape=(gdim,))
+        elements = [displacement, displacement]
+        if multiplier not in (0, 1, gdim):
+            raise ValueError(f"multiplier must have 0, 1 or {gdim} components, got {multiplier}")
+        if multiplier:
+            shape = () if multiplier == 1 else (gdim,)
+            elements.append(basix.ufl.element("Lagrange", cell, 1, shape=shape))
+        self.multiplier_components = multiplier
+        self.has_multiplier = multiplier > 0
+        self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
+        self.min_support_fraction = min_support_fraction
+        self._active = self._active_dofs()
+
+    # -- fields -------------------------------------------------------------
+    def trial(self) -> tuple:
+        """``(u_minus, u_plus[, lambda])`` trial functions."""
+        return ufl.split(ufl.TrialFunction(self.W))
+
+    def test(self) -> tuple:
+        """``(v_minus, v_plus[, mu])`` test functions."""
+        return ufl.split(ufl.TestFunction(self.W))
+
+    def subspace(self, field: int) -> dolfinx.fem.FunctionSpace:
+        """Sub-space of field 0 (side -1), 1 (side +1) or 2 (multiplier)."""
+        return self.W.sub(field)
+
+    # -- active dofs ----------------------------------------------------------
+    def _mark(self, field: int, cells: np.ndarray, weights: np.ndarray | None = None):
+        """Sum, over ``cells``, a per-cell weight into the dofs of ``field`` (parallel-safe)."""
+        imap, bs = self.W.dofmap.index_map, self.W.dofmap.index_map_bs
+        vec = dolfinx.la.vector(imap, bs)
+        dofs = self.W.sub(field).dofmap.list[cells]
+        w = np.ones(cells.size) if weights is None else weights
+        np.add.at(vec.array, dofs.ravel(), np.repeat(w, dofs.shape[1]))
+        vec.scatter_reverse(dolfinx.la.InsertMode.add)
+        vec.scatter_forward()
+        return vec.array
+
+    def _active_dofs(self) -> npt.NDArray[np.bool_]:
+        cut = self.cut
+        sides = cut.cell_sides
+        owned = np.arange(sides.size, dtype=np.int32)
+        active = np.zeros(
+            self.W.dofmap.index_map.size_local + self.W.dofmap.index_map.num_ghosts, dtype=bool
+        )
+        active = np.repeat(active, self.W.dofmap.index_map_bs)
+        for field, side in ((0, -1), (1, 1)):
+            touched = owned[(sides == side) | (sides == 0)]
+            support = self._mark(field, touched) > 0
+            if self.min_support_fraction > 0.0:
+                fraction = self._side_fraction(field, side)
+                support &= fraction >= self.min_support_fraction
+            active |= support
+        if self.has_multiplier:
+            rules = cut.interface_rules  # interface
+            length = np.zeros(cut.cut_cells.size)
+            np.add.at(length, rules.point_rows, rules.weights * _abs_det_at(cut, rules))
+            carrying = cut.cut_cells[length > 0.0]
+            active |= self._mark(2, carrying) > 0
+        return active
+
+    def _side_fraction(self, field: int, side: int) -> np.ndarray:
+        """Per dof: (area of its support on ``side``) / (area of its support)."""
+        cut = self.cut
+        areas = _cell_areas(cut)
+        side_area = np.where(cut.cell_sides == side, areas, 0.0)
+        rules = cut.side_rules(side)
+        cut_area = (
+            np.add.reduceat(rules.weights * _abs_det_at(cut, rules), rules.offsets[:-1])
+            if rules.weights.size
+            else np.zeros(0)
+        )
+        cut_area = np.where(np.diff(rules.offsets) > 0, cut_area, 0.0)
+        side_area[cut.cut_cells] = cut_area
+        on_side = self._mark(field, np.arange(areas.size, dtype=np.int32), side_area)
+        total = self._mark(field, np.arange(areas.size, dtype=np.int32), areas)
+        return np.divide(on_side, total, out=np.zeros_like(total), where=total > 0)
+
+    @property
+    def active(self) -> npt.NDArray[np.bool_]:
+        """Active flags of the local (owned + ghost) dofs of ``W``."""
+        return self._active
+
+    def index_set(self) -> PETSc.IS:
+        """Global indices of the active owned dofs (collective use)."""
+        imap, bs = self.W.dofmap.index_map, self.W.dofmap.index_map_bs
+        nowned = imap.size_local * bs
+        local = np.flatnonzero(self._active[:nowned]).astype(PETSc.IntType)
+        return PETSc.IS().createGeneral(local + imap.local_range[0] * bs, comm=imap.comm)
+
+    def dof_counts(self) -> DofCounts:
+        """Global active dof counts: standard, enriched and multiplier."""
+        imap, bs = self.W.dofmap.index_map, self.W.dofmap.index_map_bs
+        nowned = imap.size_local * bs
+        comm = self.cut.mesh.comm
+        counts = []
+        for field in range(3 if self.has_multiplier else 2):
+            dofs = np.unique(self.W.sub(field).dofmap.list.ravel())
+            dofs = dofs[dofs < nowned]
+            counts.append(comm.allreduce(int(self._active[dofs].sum()), op=MPI.SUM))
+        V = dolfinx.fem.functionspace(
+            self.cut.mesh, ("Lagrange", self.degree, (self.cut.mesh.geometry.dim,))
+        )
+        standard = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+        multiplier = counts[2] if self.has_multiplier else 0
+        return DofCounts(standard, counts[0] + counts[1] - standard, multiplier)
+
+
+def _cell_areas(cut: CutMesh) -> np.ndarray:
+    """Areas of the owned cells, shape ``(num_owned,)`` (assembled once)."""
+    mesh = cut.mesh
+    V0 = dolfinx.fem.functionspace(mesh, ("DG", 0))
+    v = ufl.TestFunction(V0)
+    vec = dolfinx.fem.assemble_vector(dolfinx.fem.form(v * ufl.dx))
+    return vec.array[V0.dofmap.list[: cut.cell_sides.size, 0]]
+
+
+def _abs_det_at(cut: CutMesh, rules) -> np.ndarray:
+    """|det J| at every point of ``rules`` (points of cut cells)."""
+    J = cut.maps.jacobian(cut.cut_cells[rules.point_rows], rules.points)
+    return np.abs(np.linalg.det(J))

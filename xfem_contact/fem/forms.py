@@ -1,0 +1,246 @@
+"""Turn UFL forms with cut-cell measures into DOLFINx forms.
+
+Measures whose ``subdomain_data`` provides ``integration_parts(subdomain_id)``
+(:class:`~xfem_contact.quadrature.cell_rules.CellRules`, :class:`~xfem_contact.fem.cutmesh.CutMesh`)
+are rewritten into a standard cell integral over the cells their part covers
+with the standard rule, and a runtime integral (integrand times the marker) over
+the cells with per-cell rules. Forms are compiled once per signature with the
+:mod:`xfem_contact.codegen` back end and re-created cheaply for new rules.
+"""
+
+from __future__ import annotations
+
+import collections.abc
+import typing
+
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import ufl
+from dolfinx.fem import IntegralType
+from dolfinx.fem.forms import CompiledForm, compile_form, create_form, get_integration_domains
+from ffcx.analysis import analyze_ufl_objects
+from ffcx.ir.representation import compute_ir
+from ffcx.options import get_options
+
+from xfem_contact.codegen import LANGUAGE
+from xfem_contact.codegen.tables import RuntimeIntegral, runtime_integral
+from xfem_contact.quadrature.cell_rules import CellRules
+
+_STANDARD_ID0 = 1000
+_RUNTIME_ID0 = 2000
+_TYPES = {
+    "cell": IntegralType.cell,
+    "exterior_facet": IntegralType.exterior_facet,
+    "interior_facet": IntegralType.interior_facet,
+    "vertex": IntegralType.vertex,
+}
+
+
+class _Compiled(typing.NamedTuple):
+    """What is kept per form signature: the JIT-compiled module and the runtime
+    table layouts. No UFL form is kept, so no mesh or function stays alive."""
+
+    ufcx_form: typing.Any
+    module: typing.Any
+    code: typing.Any
+    dtype: typing.Any
+    kernels: dict[int, RuntimeIntegral]
+
+
+_cache: dict[tuple, _Compiled] = {}
+
+
+def _is_cut_source(data) -> bool:
+    return hasattr(data, "integration_parts")
+
+
+def _source_key(data, integral) -> tuple[str, int, int]:
+    """Deterministic order of the cut-cell measures of a form (so of its signature)."""
+    return (type(data).__name__, data.id, integral.subdomain_id())
+
+
+def _integral(itg: ufl.Integral, integrand, integral_type: str, sid: int) -> ufl.Integral:
+    """``itg`` with a new integrand, type and id, and no subdomain data."""
+    return ufl.Integral(integrand, integral_type, itg.ufl_domain(), sid, itg.metadata(), None)
+
+
+class _Rewrite(typing.NamedTuple):
+    form: ufl.Form
+    domains: dict[str, list[tuple[int, np.ndarray]]]
+    rules: dict[int, CellRules]
+
+
+def _rewrite(ufl_form: ufl.Form) -> _Rewrite:
+    """Split every cut integral into its standard and runtime parts."""
+    ours = [i for i in ufl_form.integrals() if _is_cut_source(i.subdomain_data())]
+    if ours:
+        for itg in ufl_form.integrals():
+            data = itg.subdomain_data()
+            if (
+                not _is_cut_source(data)
+                and data is not None
+                and itg.integral_type() in ("cell", *{i.integral_type() for i in ours})
+            ):
+                raise ValueError(
+                    f"A form cannot mix cut measures with {itg.integral_type()} measures "
+                    f"carrying other subdomain data ({type(data).__name__}); use the plain "
+                    "measure (no subdomain data) or the cut measures"
+                )
+    keys = sorted({_source_key(i.subdomain_data(), i) for i in ours})
+    parts = {}
+    for key in keys:
+        itg = next(i for i in ours if _source_key(i.subdomain_data(), i) == key)
+        parts[key] = list(itg.subdomain_data().integration_parts(itg.subdomain_id()))
+    ids, next_standard, next_runtime = {}, _STANDARD_ID0, _RUNTIME_ID0
+    for key in keys:
+        for j, part in enumerate(parts[key]):
+            if part.rules is None:
+                ids[key, j], next_standard = next_standard, next_standard + 1
+            else:
+                ids[key, j], next_runtime = next_runtime, next_runtime + 1
+
+    integrals, domains, rules = [], {}, {}
+    for itg in ufl_form.integrals():
+        data = itg.subdomain_data()
+        if not _is_cut_source(data):
+            integrals.append(itg)
+            continue
+        key = _source_key(data, itg)
+        for j, part in enumerate(parts[key]):
+            sid = ids[key, j]
+            if part.rules is None:
+                domains.setdefault(part.integral_type, {})[sid] = part.entities
+                integrals.append(_integral(itg, itg.integrand(), part.integral_type, sid))
+            else:
+                integrand = itg.integrand()
+                if part.replace:
+                    integrand = ufl.replace(integrand, part.replace)
+                domains.setdefault("cell", {})[sid] = part.rules.cells
+                rules[sid] = part.rules
+                integrals.append(_integral(itg, integrand * part.rules.marker, "cell", sid))
+    return _Rewrite(
+        ufl.Form(integrals),
+        {t: sorted(d.items()) for t, d in domains.items()},
+        rules,
+    )
+
+
+def _runtime_kernels(ufl_form: ufl.Form, options: dict, cell) -> dict[int, RuntimeIntegral]:
+    """Runtime-table layout of each runtime cell integral, by subdomain id."""
+    analysis = analyze_ufl_objects([ufl_form], options["scalar_type"])
+    ir = compute_ir(analysis, {}, "", options, False)
+    by_name = {integral.expression.name: integral for integral in ir.integrals}
+    (form_ir,) = ir.forms
+    kernels = {}
+    for name, sid in zip(
+        form_ir.integral_names["cell"], form_ir.subdomain_ids["cell"], strict=False
+    ):
+        kernel = runtime_integral(by_name[name].expression, cell)
+        if kernel is not None:  # drop the marker: the cache must not keep meshes alive
+            kernels[sid] = kernel._replace(marker=None)
+    return kernels
+
+
+def _compile(
+    comm, ufl_form: ufl.Form, options: dict, jit_options: dict | None
+) -> tuple[_Compiled, CompiledForm]:
+    key = (
+        ufl_form.signature(),
+        tuple(sorted((k, str(v)) for k, v in options.items())),
+        str(jit_options),
+        comm.size,
+    )
+    if key not in _cache:
+        compiled = compile_form(
+            comm, ufl_form, form_compiler_options=options, jit_options=jit_options
+        )
+        cell = ufl_form.ufl_domain().ufl_coordinate_element().cell_type
+        kernels = _runtime_kernels(ufl_form, get_options(options), cell)
+        _cache[key] = _Compiled(
+            compiled.ufcx_form, compiled.module, compiled.code, compiled.dtype, kernels
+        )
+    cached = _cache[key]
+    # Equal signatures: the compiled kernels serve this form (same coefficient order).
+    return cached, CompiledForm(
+        ufl_form, cached.ufcx_form, cached.module, cached.code, cached.dtype
+    )
+
+
+def _other_domains(ufl_form: ufl.Form, ids: dict[str, list[int]]) -> dict:
+    """Integration entities of the non-rewritten integral types (as dolfinx.fem.form does)."""
+    domain = ufl_form.ufl_domain()
+    data = ufl_form.subdomain_data().get(domain, {})
+    out = {}
+    for name, itype in _TYPES.items():
+        sd = [d for d in data.get(name, []) if d is not None]
+        out[itype] = get_integration_domains(itype, sd[0] if sd else None, ids.get(name, []))
+    return out
+
+
+def form(
+    ufl_form: ufl.Form | collections.abc.Iterable,
+    form_compiler_options: dict | None = None,
+    jit_options: dict | None = None,
+):
+    """Create a DOLFINx form from a UFL form that may use cut-cell measures.
+
+    Collective. The form is compiled once per UFL signature (FFCx with the
+    :mod:`xfem_contact.codegen` back end) and bound to the *current* rules of
+    its measures: after :meth:`CutMesh.update`, call :func:`form` again (cheap)
+    to integrate on the new cut. The returned form keeps its rules alive.
+
+    Args:
+        ufl_form: A UFL form, or a (nested) list of them.
+        form_compiler_options: FFCx options (``scalar_type`` defaults to
+            ``dolfinx.default_scalar_type``; ``language`` is set here).
+        jit_options: DOLFINx JIT options.
+
+    Returns:
+        A :class:`dolfinx.fem.Form` (or a nested list of them) for
+        ``dolfinx.fem.assemble_*`` and ``dolfinx.fem.petsc``.
+    """
+    if isinstance(ufl_form, ufl.ZeroBaseForm):
+        return dolfinx.fem.form(ufl_form)
+    if not isinstance(ufl_form, ufl.Form):
+        if isinstance(ufl_form, collections.abc.Iterable):
+            return [form(f, form_compiler_options, jit_options) for f in ufl_form]
+        return ufl_form
+    options = {"scalar_type": dolfinx.default_scalar_type, **(form_compiler_options or {})}
+    options["language"] = LANGUAGE
+    rewrite = _rewrite(ufl_form)
+    domain = ufl_form.ufl_domain()
+    mesh = dolfinx.mesh.Mesh(domain.ufl_cargo(), domain)
+    compiled, compiled_form = _compile(mesh.comm, rewrite.form, options, jit_options)
+
+    dropped = set()
+    for sid, rules in rewrite.rules.items():
+        kernel = compiled.kernels.get(sid)
+        if kernel is None:  # FFCx removed the integral (a zero integrand)
+            dropped.add(sid)
+            continue
+        rules.register(kernel, domain.ufl_cell())
+
+    ufcx = compiled.ufcx_form
+    offsets = [ufcx.form_integral_offsets[i] for i in range(len(IntegralType) + 1)]
+    ids: dict[str, list[int]] = {}
+    for itype in IntegralType:
+        if itype.value + 1 < len(offsets):
+            ids[itype.name] = [
+                ufcx.form_integral_ids[j]
+                for j in range(offsets[itype.value], offsets[itype.value + 1])
+            ]
+    subdomains = _other_domains(rewrite.form, ids)
+    for name, entries in rewrite.domains.items():
+        itype = _TYPES[name]
+        entries = [(sid, e) for sid, e in entries if sid not in dropped]
+        subdomains[itype] = sorted(subdomains.get(itype, []) + entries, key=lambda e: e[0])
+
+    coeffs = ufl.algorithms.extract_coefficients(rewrite.form)
+    consts = ufl.algorithms.analysis.extract_constants(rewrite.form)
+    spaces = [arg.ufl_function_space() for arg in rewrite.form.arguments()]
+    result = create_form(
+        compiled_form, spaces, mesh, subdomains, {c: c for c in coeffs}, {c: c for c in consts}
+    )
+    result._xfem_rules = list(rewrite.rules.values())
+    return result

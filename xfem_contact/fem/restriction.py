@@ -1,0 +1,84 @@
+"""The restriction operator ``R`` from a reduced space to the full mixed space.
+
+Full dofs ``x = R y``: ``R`` selects the active dofs of an
+:class:`~xfem_contact.fem.enrichment.EnrichedSpace` (identity columns) and, where a
+multiplier prolongation is given (LBB restriction, :mod:`xfem_contact.mechanics.lbb`),
+expresses multiplier dofs as combinations of fewer reduced unknowns. Systems are
+solved as ``R^T J R y = -R^T F``. Collective.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from xfem_contact.fem.enrichment import EnrichedSpace
+
+
+class MultiplierProlongation:
+    """Multiplier dofs as combinations of reduced unknowns (local rows, global columns).
+
+    Attributes:
+        dofs: Local (owned) multiplier dofs of ``W`` the prolongation replaces, ``(m,)``.
+        rows: Index into ``dofs`` of each entry, ``(nnz,)``.
+        cols: Global reduced-unknown index (0-based among the multiplier unknowns), ``(nnz,)``.
+        vals: Entries, ``(nnz,)``.
+        num_owned: Reduced multiplier unknowns owned by this process.
+    """
+
+    def __init__(self, dofs, rows, cols, vals, num_owned: int):
+        self.dofs = np.asarray(dofs, dtype=np.int64)
+        self.rows = np.asarray(rows, dtype=np.int64)
+        self.cols = np.asarray(cols, dtype=np.int64)
+        self.vals = np.asarray(vals, dtype=np.float64)
+        self.num_owned = int(num_owned)
+
+
+def restriction_matrix(
+    space: EnrichedSpace, prolongation: MultiplierProlongation | None = None
+) -> PETSc.Mat:
+    """Build ``R`` (global sizes: full dofs x reduced unknowns). Collective.
+
+    Args:
+        space: The enriched space (its active dofs).
+        prolongation: Optional multiplier prolongation; its dofs are removed
+            from the identity part and replaced by its entries, whose column
+            numbers follow all active (non-prolongated) dofs.
+    """
+    imap, bs = space.W.dofmap.index_map, space.W.dofmap.index_map_bs
+    comm = imap.comm
+    n_owned = imap.size_local * bs
+    active = space.active[:n_owned].copy()
+    if prolongation is not None:
+        active[prolongation.dofs] = False
+    selected = np.flatnonzero(active)
+    n_sel = selected.size
+    n_mult = 0 if prolongation is None else prolongation.num_owned
+    n_red = n_sel + n_mult
+    offset = comm.exscan(n_red, op=MPI.SUM) or 0
+    sel_offset = offset
+    mult_offset = offset + n_sel
+    # Global column of multiplier unknown j: its owner's mult_offset + local position.
+    owners_offsets = comm.allgather((mult_offset, n_mult))
+    entries_rows = [selected]
+    entries_cols = [np.arange(n_sel) + sel_offset]
+    entries_vals = [np.ones(n_sel)]
+    if prolongation is not None and prolongation.vals.size:
+        starts = np.cumsum([0] + [n for _, n in owners_offsets])
+        global_mult = np.array([o for o, _ in owners_offsets])
+        owner = np.searchsorted(starts, prolongation.cols, side="right") - 1
+        entries_rows.append(prolongation.dofs[prolongation.rows])
+        entries_cols.append(global_mult[owner] + prolongation.cols - starts[owner])
+        entries_vals.append(prolongation.vals)
+    rows = np.concatenate(entries_rows)
+    cols = np.concatenate(entries_cols)
+    vals = np.concatenate(entries_vals)
+    keys, inverse = np.unique(np.c_[rows, cols], axis=0, return_inverse=True)
+    rows, cols = keys[:, 0], keys[:, 1]
+    vals = np.bincount(inverse.ravel(), weights=vals, minlength=keys.shape[0])
+    indptr = np.searchsorted(rows, np.arange(n_owned + 1)).astype(PETSc.IntType)
+    R = PETSc.Mat().createAIJ(((n_owned, PETSc.DETERMINE), (n_red, PETSc.DETERMINE)), comm=comm)
+    R.setPreallocationCSR((indptr, cols.astype(PETSc.IntType), vals))
+    R.assemble()
+    return R

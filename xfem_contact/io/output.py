@@ -1,0 +1,106 @@
+"""Results that ParaView and pyvista read, and JSON summaries.
+
+- :func:`write_fields`: VTX (ADIOS2) files of Lagrange functions, plus the
+  cell side indicator (-1, 0 = cut, +1) as XDMF, for thresholding per side.
+- :func:`write_lips`: a VTK unstructured grid (``.vtu``) made of the uncut cells
+  and the curved sub-triangles of the cut cells, each carrying the displacement
+  of its own side: the lips of the interface appear separate and discontinuous.
+- :func:`write_cut_geometry`: the cut itself (sub-triangles and interface pieces)
+  as ``.vtu`` files, for ``xfem-contact show`` and ParaView.
+- :func:`write_json`: a JSON summary (numpy values converted).
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+
+import dolfinx.fem
+import dolfinx.io
+import numpy as np
+
+from xfem_contact.fem.cutmesh import CutMesh
+
+
+def write_fields(directory: str | pathlib.Path, name: str, functions: list) -> list[pathlib.Path]:
+    """Write Lagrange ``functions`` (same space) to ``directory/name.bp`` (VTX). Collective."""
+    directory = pathlib.Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    path = directory / f"{name}.bp"
+    mesh = functions[0].function_space.mesh
+    with dolfinx.io.VTXWriter(mesh.comm, path, functions, engine="BP4") as writer:
+        writer.write(0.0)
+    return [path]
+
+
+def write_sides(directory: str | pathlib.Path, cut: CutMesh) -> pathlib.Path:
+    """Write the cell side indicator (DG0: -1, 0 for cut, +1) to ``sides.xdmf``. Collective."""
+    directory = pathlib.Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    side = cut.side_indicator()
+    path = directory / "sides.xdmf"
+    with dolfinx.io.XDMFFile(cut.mesh.comm, path, "w") as f:
+        f.write_mesh(cut.mesh)
+        f.write_function(side)
+    return path
+
+
+def _rank_path(path: pathlib.Path, comm) -> pathlib.Path:
+    """``path`` with suffix ``_r{rank}`` before the extension when run in parallel."""
+    if comm.size > 1:
+        path = path.with_name(f"{path.stem}_r{comm.rank}{path.suffix}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def write_lips(path: str | pathlib.Path, cut: CutMesh, u_minus, u_plus) -> pathlib.Path:
+    """Write a ``.vtu`` grid of uncut cells and sub-triangles with each side's displacement.
+
+    The grid is :func:`xfem_contact.io.pictures.deformed_lips_grid` (quadratic cells,
+    point data ``u`` in m, cell data ``side``, ``cut``, ``cell``). Local to each
+    process: rank ``r`` writes ``path`` with suffix ``_r{r}`` when run in parallel.
+    ``u_minus``, ``u_plus``: displacement Functions of sides -1 and +1.
+    """
+    from xfem_contact.io.vtk_grids import deformed_lips_grid
+
+    path = _rank_path(pathlib.Path(path), cut.mesh.comm)
+    deformed_lips_grid(cut, u_minus, u_plus).save(path)
+    return path
+
+
+def write_cut_geometry(directory: str | pathlib.Path, cut: CutMesh) -> list[pathlib.Path]:
+    """Write ``subcells.vtu`` (uncut cells and curved sub-triangles, cell data ``side``,
+    ``cut``, ``cell``) and ``interface.vtu`` (curved interface pieces) into ``directory``.
+
+    Local to each process (not collective): in parallel rank ``r`` writes
+    ``subcells_r{r}.vtu`` and ``interface_r{r}.vtu``. See :mod:`xfem_contact.io.pictures`.
+    """
+    from xfem_contact.io.vtk_grids import interface_grid, subcell_grid
+
+    directory, comm = pathlib.Path(directory), cut.mesh.comm
+    paths = []
+    for name, grid in (("subcells", subcell_grid(cut)), ("interface", interface_grid(cut))):
+        path = _rank_path(directory / f"{name}.vtu", comm)
+        grid.save(path)
+        paths.append(path)
+    return paths
+
+
+def _jsonable(value):
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist())
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def write_json(path: str | pathlib.Path, summary: dict) -> pathlib.Path:
+    """Write ``summary`` as indented JSON (numpy arrays and scalars converted)."""
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(_jsonable(summary), indent=2))
+    return path

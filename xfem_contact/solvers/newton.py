@@ -1,0 +1,176 @@
+"""Generalized Newton (PETSc SNES) on the reduced space ``y`` with ``x = R y``.
+
+Residual and Jacobian are assembled on the full mixed space with Dirichlet
+conditions (as :class:`dolfinx.fem.petsc.NonlinearProblem` does) and reduced:
+``F_r = R^T F(R y)``, ``J_r = R^T J R``. Every iterate is logged (residual norm
+and, through a callback, e.g. the contact status); failure raises with the
+whole history.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+import weakref
+from collections.abc import Callable
+
+import dolfinx.fem
+import dolfinx.fem.petsc
+import ufl
+from petsc4py import PETSc
+
+from xfem_contact.fem.forms import form
+
+DEFAULT_SNES_OPTIONS = {
+    "snes_type": "newtonls",
+    "snes_linesearch_type": "basic",
+    "snes_rtol": 1e-10,
+    "snes_atol": 1e-12,
+    "snes_stol": 0.0,
+    "snes_max_it": 30,
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+}
+
+
+@dataclasses.dataclass
+class NewtonReport:
+    """History of one solve: residual norms and per-iterate status lines."""
+
+    residuals: list[float] = dataclasses.field(default_factory=list)
+    status: list[dict] = dataclasses.field(default_factory=list)
+    reason: int = 0
+    #: Wall time (s) of residual/Jacobian assembly and of the whole solve
+    assembly_time: float = 0.0
+    total_time: float = 0.0
+
+    @property
+    def iterations(self) -> int:
+        return max(len(self.residuals) - 1, 0)
+
+    def table(self) -> str:
+        lines = []
+        for k, r in enumerate(self.residuals):
+            extra = self.status[k] if k < len(self.status) else {}
+            lines.append(
+                f"  iterate {k:2d}  |F| = {r:.3e}  "
+                + "  ".join(f"{key} {value}" for key, value in extra.items())
+            )
+        return "\n".join(lines)
+
+
+class NewtonFailure(RuntimeError):
+    """Newton did not converge; ``report`` holds the iteration history."""
+
+    def __init__(self, message: str, report: NewtonReport):
+        super().__init__(f"{message}\n{report.table()}")
+        self.report = report
+
+
+class RestrictedNewton:
+    """Solve ``F(w; v) = 0`` for ``w`` on the reduced space of ``R``.
+
+    Args:
+        residual: UFL residual form, linear in the test function.
+        w: The unknown (full mixed space); updated in place.
+        bcs: Dirichlet conditions on the full space.
+        R: Restriction operator (full x reduced), see :mod:`xfem_contact.fem.restriction`.
+        petsc_options: Overrides of :data:`DEFAULT_SNES_OPTIONS`.
+        petsc_options_prefix: Prefix of the SNES options.
+        status: Called with ``w`` at every iterate; returns a dict shown in the log.
+        log: Called with each log line (e.g. ``print``); ``None`` for silence.
+    """
+
+    def __init__(
+        self,
+        residual: ufl.Form,
+        w: dolfinx.fem.Function,
+        bcs: list,
+        R: PETSc.Mat,
+        petsc_options: dict | None = None,
+        petsc_options_prefix: str = "xfem_newton_",
+        status: Callable[[dolfinx.fem.Function], dict] | None = None,
+        log: Callable[[str], None] | None = None,
+    ):
+        self.w, self.bcs, self.R = w, bcs, R
+        self.F = form(residual)
+        self.J = form(ufl.derivative(residual, w, ufl.TrialFunction(w.function_space)))
+        self.b = dolfinx.fem.petsc.create_vector(self.F.function_spaces[0])
+        self.A = dolfinx.fem.petsc.create_matrix(self.J)
+        self.y = R.createVecRight()
+        self.F_r = R.createVecRight()
+        self.status, self.log = status, log
+        self._assemble_jacobian()
+        self.J_r = self.A.PtAP(R)
+        self.snes = PETSc.SNES().create(R.getComm())
+        self.snes.setOptionsPrefix(petsc_options_prefix)
+        opts = PETSc.Options()
+        for key, value in {**DEFAULT_SNES_OPTIONS, **(petsc_options or {})}.items():
+            opts[f"{petsc_options_prefix}{key}"] = value
+        self.snes.setFromOptions()
+        # PETSc keeps its callbacks alive, and the garbage collector cannot see through
+        # PETSc objects: callbacks hold this object weakly, or it would never be freed.
+        this = weakref.ref(self)
+        self.snes.setFunction(lambda snes, y, F: this()._residual(snes, y, F), self.F_r)
+        self.snes.setJacobian(lambda snes, y, J, P: this()._jacobian(snes, y, J, P), self.J_r)
+        self.snes.setMonitor(lambda snes, it, norm: this()._monitor(snes, it, norm))
+        self.report = NewtonReport()
+
+    def _update(self, y: PETSc.Vec) -> None:
+        x = self.w.x.petsc_vec
+        self.R.mult(y, x)
+        self.w.x.scatter_forward()
+
+    def _residual(self, snes, y, F_r):
+        start = time.perf_counter()
+        self._update(y)
+        x = self.w.x.petsc_vec
+        with self.b.localForm() as local:
+            local.set(0.0)
+        dolfinx.fem.petsc.assemble_vector(self.b, self.F)
+        dolfinx.fem.petsc.apply_lifting(self.b, [self.J], bcs=[self.bcs], x0=[x], alpha=-1.0)
+        self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        dolfinx.fem.petsc.set_bc(self.b, self.bcs, x, -1.0)
+        self.R.multTranspose(self.b, F_r)
+        self.report.assembly_time += time.perf_counter() - start
+
+    def _assemble_jacobian(self):
+        self.A.zeroEntries()
+        dolfinx.fem.petsc.assemble_matrix(self.A, self.J, bcs=self.bcs)
+        self.A.assemble()
+
+    def _jacobian(self, snes, y, J_r, P_r):
+        start = time.perf_counter()
+        self._update(y)
+        self._assemble_jacobian()
+        self.A.PtAP(self.R, result=J_r)
+        self.report.assembly_time += time.perf_counter() - start
+
+    def _monitor(self, snes, it, norm):
+        self.report.residuals.append(float(norm))
+        status = self.status(self.w) if self.status else {}
+        self.report.status.append(status)
+        if self.log:
+            self.log(
+                f"  Newton {it:2d}: |F| = {norm:.3e}  "
+                + "  ".join(f"{k} {v}" for k, v in status.items())
+            )
+
+    def solve(self) -> NewtonReport:
+        """Run SNES from the current reduced iterate. Raises :class:`NewtonFailure`."""
+        self.report = NewtonReport()
+        start = time.perf_counter()
+        self.snes.solve(None, self.y)
+        self.report.total_time = time.perf_counter() - start
+        self._update(self.y)
+        self.report.reason = self.snes.getConvergedReason()
+        if self.report.reason <= 0:
+            raise NewtonFailure(
+                f"Newton failed to converge (SNES reason {self.report.reason})", self.report
+            )
+        return self.report
+
+    def destroy(self):
+        for obj in (self.snes, self.A, self.J_r, self.b, self.y, self.F_r):
+            obj.destroy()
