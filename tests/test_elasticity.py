@@ -15,7 +15,7 @@ from xfem_contact.cases.paper import (
     straight_interface_exact,
     straight_interface_problem,
 )
-from xfem_contact.mechanics.elasticity import ElasticityProblem
+from xfem_contact.mechanics.presets import ElasticityProblem
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.solvers.linear import assemble_restricted
 

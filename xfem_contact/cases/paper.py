@@ -15,9 +15,8 @@ from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.forms import form
-from xfem_contact.mechanics.contact import ContactProblem
-from xfem_contact.mechanics.elasticity import ElasticityProblem
 from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.presets import ContactProblem, ElasticityProblem
 
 #: Paper case 2: inclusion centre (m), radius (m), Young's modulus (Pa)
 INCLUSION_CENTRE, INCLUSION_RADIUS, INCLUSION_E = (0.5, 0.5), 0.2, 100e6
@@ -114,7 +113,7 @@ def inclusion_errors(problem: ElasticityProblem, w: dolfinx.fem.Function) -> Int
     cut = problem.cut
     p_ex, t_ex = inclusion_exact_traction(cut.mesh, problem.loading)
     fields = ufl.split(w)
-    if isinstance(problem, ContactProblem):
+    if not problem.linear:
         lam_n, lam_t = problem.multipliers(fields)
     else:
         x = ufl.SpatialCoordinate(cut.mesh)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import itertools
 import time
+from collections.abc import Mapping
 
 import dolfinx.fem
 import dolfinx.mesh
@@ -15,12 +16,19 @@ import ufl
 from mpi4py import MPI
 
 from xfem_contact.geometry import cut
-from xfem_contact.geometry.levelset import CellMaps, LevelSet, LevelSetCallable, interpolate
+from xfem_contact.geometry.levelset import (
+    CellMaps,
+    LevelSet,
+    LevelSetCallable,
+    interpolate,
+    union,
+)
 from xfem_contact.quadrature import boundary
 from xfem_contact.quadrature import rules as quadrature
 from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart
 
 _SIDE_MINUS, _SIDE_PLUS, _INTERFACE = 1, 2, 3
+_INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + index
 _BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
 _counter = itertools.count()
 
@@ -39,6 +47,10 @@ class CutMesh:
         levelset: A callable ``phi(x)`` (``x`` of shape ``(3, n)``) or a
             scalar DOLFINx Function. With a callable the interface nodes lie
             on its exact zero set; with a Function, on its interpolant's.
+            Several interfaces: a mapping ``{name: callable}``; they are cut as
+            one level set, ``min_i phi_i`` (checked apart, see
+            :func:`xfem_contact.geometry.levelset.union`), and each keeps its
+            own measure (:meth:`interface_measure`) and rules.
         degree: Lagrange degree (1 or 2) the level set is interpolated in.
         quadrature_degree: Polynomial degree of the rules on each curved
             sub-triangle and on each interface segment.
@@ -70,13 +82,38 @@ class CutMesh:
         self._boundary_parts: dict[int, list[IntegrationPart]] = {}
         self.update(levelset)
 
-    def update(self, levelset: LevelSetCallable | dolfinx.fem.Function) -> None:
+    def update(
+        self, levelset: LevelSetCallable | dolfinx.fem.Function | Mapping[str, LevelSetCallable]
+    ) -> None:
         """Cut the mesh with a new level set (collective). Compiled forms are
-        reused: call :func:`xfem_contact.form` again to integrate on the new cut."""
+        reused: call :func:`xfem_contact.form` again to integrate on the new cut.
+        With several interfaces, give the same names as at construction."""
         mesh = self.mesh
         tdim = mesh.topology.dim
         cell_name = mesh.topology.cell_name()
         start = time.perf_counter()
+        components = None
+        if isinstance(levelset, Mapping):
+            components = dict(levelset)
+            names = tuple(components)
+            if not names:
+                raise ValueError("Give at least one interface level set")
+            known = getattr(self, "interface_names", names)
+            if names != known:
+                raise ValueError(f"update() needs the interfaces {list(known)}, got {list(names)}")
+            levelset = (
+                components[names[0]] if len(names) == 1 else union(mesh, components, self.degree)
+            )
+        elif getattr(self, "interface_names", ("interface",)) != ("interface",):
+            raise ValueError(
+                f"This CutMesh has the interfaces {list(self.interface_names)}: "
+                "update() takes a mapping of their level sets"
+            )
+        else:
+            names = ("interface",)
+        #: Names of the interfaces, in the order of their measure ids
+        self.interface_names: tuple[str, ...] = names
+        self._components = components
         self.levelset: LevelSet = interpolate(mesh, levelset, self.degree)
         maps = CellMaps(mesh, self.levelset)
         num_owned = mesh.topology.index_map(tdim).size_local
@@ -104,6 +141,9 @@ class CutMesh:
             ),
         }
         self.rules = rules
+        #: Interface (index into ``interface_names``) of every cut cell, shape ``(ncut,)``
+        self.cell_interface = _cell_interfaces(maps, cut_cells, rules[_INTERFACE], components)
+        self._interface_rules = {}
         self._cell_rules = {
             sid: CellRules(mesh, cut_cells, r.points, r.weights, r.offsets)
             for sid, r in rules.items()
@@ -134,6 +174,64 @@ class CutMesh:
     def interface_rules(self) -> quadrature.RuleSet:
         """Per-cut-cell interface rules (weights ``ds / |det J|``, physical normals)."""
         return self.rules[_INTERFACE]
+
+    def _interface_index(self, name: str | None) -> int | None:
+        """Index of an interface name; None for all of them (or the only one)."""
+        if name is None or len(self.interface_names) == 1 and name == self.interface_names[0]:
+            return None
+        if name not in self.interface_names:
+            raise ValueError(f"Unknown interface {name!r}; valid: {list(self.interface_names)}")
+        return self.interface_names.index(name)
+
+    def interface_rules_of(self, name: str | None = None) -> quadrature.RuleSet:
+        """Interface rules of one interface (the rules of other interfaces' cut cells
+        are empty, so rows keep indexing ``cut_cells``); all of them for ``None``."""
+        k = self._interface_index(name)
+        if k is None:
+            return self.interface_rules
+        if k not in self._interface_rules:
+            self._interface_rules[k] = self.interface_rules.select(self.cell_interface == k)
+        return self._interface_rules[k]
+
+    def interface_cells(self, name: str | None = None) -> npt.NDArray[np.int32]:
+        """Local indices of the (owned) cut cells of one interface, or of all."""
+        k = self._interface_index(name)
+        return self.cut_cells if k is None else self.cut_cells[self.cell_interface == k]
+
+    def cell_regions(self) -> dolfinx.fem.Function:
+        """DG0 function of the interface each cell belongs to (index into
+        :attr:`interface_names`): its cut cells, and the cells inside it or nearest to
+        it (owned and ghost cells). Collective."""
+        V0 = dolfinx.fem.functionspace(self.mesh, ("DG", 0))
+        regions = dolfinx.fem.Function(V0, name="region")
+        if self._components is not None and len(self._components) > 1:
+            owned = np.arange(self.cell_sides.size, dtype=np.int32)
+            x = dolfinx.mesh.compute_midpoints(self.mesh, self.mesh.topology.dim, owned).T
+            phi = np.array([np.asarray(f(x), dtype=np.float64) for f in self._components.values()])
+            index = np.argmin(phi, axis=0)
+            index[self.cut_cells] = self.cell_interface
+            regions.x.array[V0.dofmap.list[owned, 0]] = index
+            regions.x.scatter_forward()
+        return regions
+
+    def interface_measure(self, name: str | None = None) -> ufl.Measure:
+        """Measure of one interface (:attr:`dGamma` when there is only one)."""
+        k = self._interface_index(name)
+        if k is None:
+            return self.dGamma
+        return ufl.Measure(
+            "dx", domain=self.mesh, subdomain_data=self, subdomain_id=_INTERFACE0 + k
+        )
+
+    def normal_at(self, rules: quadrature.RuleSet) -> npt.NDArray[np.float64]:
+        """The unit normal :attr:`normal` (``grad phi_h / |grad phi_h|``) evaluated at
+        every point of per-cut-cell ``rules``, shape ``(npoints, gdim)`` (local)."""
+        cells = self.cut_cells[rules.point_rows]
+        J = self.maps.jacobian(cells, rules.points)
+        grad = np.linalg.solve(
+            np.transpose(J, (0, 2, 1)), self.maps.grad_ref(cells, rules.points)[..., None]
+        )[..., 0]
+        return grad / np.linalg.norm(grad, axis=1)[:, None]
 
     # -- measures -----------------------------------------------------------
     def dx(self, side: int, metadata: dict | None = None) -> ufl.Measure:
@@ -252,6 +350,14 @@ class CutMesh:
         """Standard and runtime parts of a measure id (for :func:`xfem_contact.form`)."""
         if subdomain_id >= _BOUNDARY0:
             return self._boundary(subdomain_id - _BOUNDARY0)
+        if subdomain_id >= _INTERFACE0:
+            k = subdomain_id - _INTERFACE0
+            if k not in self._cell_rules:
+                r = self.interface_rules_of(self.interface_names[k])
+                self._cell_rules[k + _INTERFACE0] = CellRules(
+                    self.mesh, self.cut_cells, r.points, r.weights, r.offsets
+                )
+            return [IntegrationPart("cell", rules=self._cell_rules[subdomain_id])]
         if subdomain_id not in self._cell_rules:
             raise ValueError(f"Unknown CutMesh measure id {subdomain_id}")
         parts = []
@@ -259,3 +365,28 @@ class CutMesh:
             parts.append(IntegrationPart("cell", entities=self._standard[subdomain_id]))
         parts.append(IntegrationPart("cell", rules=self._cell_rules[subdomain_id]))
         return parts
+
+
+def _cell_interfaces(
+    maps: CellMaps,
+    cut_cells: npt.NDArray[np.int32],
+    rules: quadrature.RuleSet,
+    components: dict[str, LevelSetCallable] | None,
+) -> npt.NDArray[np.int32]:
+    """Which interface cuts each cut cell: the one whose level set is nearest zero
+    on average over the cell's interface points and its reference centre (the
+    interfaces cut no common cell, so the nearest is the one that cuts it)."""
+    ncut = cut_cells.size
+    if components is None or len(components) == 1:
+        return np.zeros(ncut, dtype=np.int32)
+    rows = np.r_[rules.point_rows, np.arange(ncut)]
+    centre = np.full((ncut, rules.points.shape[1]), 1.0 / 3.0)
+    if maps.mesh.topology.cell_name() == "quadrilateral":
+        centre[:] = 0.5
+    x = maps.push_forward(cut_cells[rows], np.r_[rules.points, centre])
+    x3 = np.zeros((3, x.shape[0]))
+    x3[: x.shape[1]] = x.T
+    distance = np.abs([np.asarray(phi(x3), dtype=np.float64) for phi in components.values()])
+    npts = np.bincount(rows, minlength=ncut)[:, None]
+    totals = np.stack([np.bincount(rows, weights=d, minlength=ncut) for d in distance], axis=1)
+    return np.argmin(totals / np.maximum(npts, 1), axis=1).astype(np.int32)

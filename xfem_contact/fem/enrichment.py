@@ -11,6 +11,7 @@ solve by a PETSc index set: the system has exactly standard + enriched dofs.
 from __future__ import annotations
 
 import typing
+from collections.abc import Sequence
 
 import basix.ufl
 import dolfinx.fem
@@ -49,6 +50,9 @@ class EnrichedSpace:
         min_support_fraction: A side's dofs whose support holds less than this
             fraction of the support's area on that side are dropped (set
             inactive) to keep the operator well conditioned; 0 keeps all.
+        multipliers: Instead of ``multiplier``, one multiplier field per entry
+            ``(components, interface name)`` (fields 2, 3, ... of ``W``), each
+            active on the cut cells of its interface only (``None``: all).
     """
 
     def __init__(
@@ -57,6 +61,7 @@ class EnrichedSpace:
         degree: int,
         multiplier: int = 0,
         min_support_fraction: float = 0.0,
+        multipliers: Sequence[tuple[int, str | None]] | None = None,
     ):
         if degree not in (1, 2):
             raise ValueError(f"Displacement degree must be 1 or 2, got {degree}")
@@ -68,13 +73,20 @@ class EnrichedSpace:
         cell = mesh.basix_cell()
         displacement = basix.ufl.element("Lagrange", cell, degree, shape=(gdim,))
         elements = [displacement, displacement]
+        if multipliers is None:
+            multipliers = [(multiplier, None)] if multiplier else []
+        multipliers = [(int(c), name) for c, name in multipliers]
+        for components, _ in multipliers:
+            if components not in (1, gdim):
+                raise ValueError(f"A multiplier must have 1 or {gdim} components, got {components}")
+            shape = () if components == 1 else (gdim,)
+            elements.append(basix.ufl.element("Lagrange", cell, 1, shape=shape))
         if multiplier not in (0, 1, gdim):
             raise ValueError(f"multiplier must have 0, 1 or {gdim} components, got {multiplier}")
-        if multiplier:
-            shape = () if multiplier == 1 else (gdim,)
-            elements.append(basix.ufl.element("Lagrange", cell, 1, shape=shape))
-        self.multiplier_components = multiplier
-        self.has_multiplier = multiplier > 0
+        #: ``(field, components, interface name)`` of each multiplier field
+        self.multiplier_fields = [(2 + k, c, name) for k, (c, name) in enumerate(multipliers)]
+        self.multiplier_components = multipliers[0][0] if multipliers else 0
+        self.has_multiplier = bool(multipliers)
         self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
         self.min_support_fraction = min_support_fraction
         self._active = self._active_dofs()
@@ -119,12 +131,12 @@ class EnrichedSpace:
                 fraction = self._side_fraction(field, side)
                 support &= fraction >= self.min_support_fraction
             active |= support
-        if self.has_multiplier:
-            rules = cut.interface_rules  # interface
+        for field, _, name in self.multiplier_fields:
+            rules = cut.interface_rules_of(name)
             length = np.zeros(cut.cut_cells.size)
             np.add.at(length, rules.point_rows, rules.weights * _abs_det_at(cut, rules))
             carrying = cut.cut_cells[length > 0.0]
-            active |= self._mark(2, carrying) > 0
+            active |= self._mark(field, carrying) > 0
         return active
 
     def _side_fraction(self, field: int, side: int) -> np.ndarray:
@@ -162,7 +174,7 @@ class EnrichedSpace:
         nowned = imap.size_local * bs
         comm = self.cut.mesh.comm
         counts = []
-        for field in range(3 if self.has_multiplier else 2):
+        for field in range(2 + len(self.multiplier_fields)):
             dofs = np.unique(self.W.sub(field).dofmap.list.ravel())
             dofs = dofs[dofs < nowned]
             counts.append(comm.allreduce(int(self._active[dofs].sum()), op=MPI.SUM))
@@ -170,7 +182,7 @@ class EnrichedSpace:
             self.cut.mesh, ("Lagrange", self.degree, (self.cut.mesh.geometry.dim,))
         )
         standard = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
-        multiplier = counts[2] if self.has_multiplier else 0
+        multiplier = sum(counts[2:])
         return DofCounts(standard, counts[0] + counts[1] - standard, multiplier)
 
 

@@ -52,7 +52,8 @@ def evaluate_at_rules(
     return evaluate_reference(u, rule_cells(cut, rules), rules.points)
 
 
-def interface_points(cut: CutMesh) -> npt.NDArray[np.float64]:
-    """Physical coordinates of the interface quadrature points, shape ``(npoints, gdim)``."""
-    rules = cut.interface_rules
+def interface_points(cut: CutMesh, rules: RuleSet | None = None) -> npt.NDArray[np.float64]:
+    """Physical coordinates of the interface quadrature points (of ``rules``, default
+    all interfaces'), shape ``(npoints, gdim)`` (local)."""
+    rules = cut.interface_rules if rules is None else rules
     return cut.maps.push_forward(rule_cells(cut, rules), rules.points)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import dataclasses
 import typing
 
+import dolfinx.fem
+import numpy as np
 import ufl
 
 
@@ -42,6 +44,32 @@ class Material:
         if self.plane == "stress":
             return 2.0 * self.mu * lmbda / (lmbda + 2.0 * self.mu)
         return lmbda
+
+    def stress(self, u) -> ufl.core.expr.Expr:
+        """Cauchy stress (Pa) of displacement ``u`` (m), small strain."""
+        eps = ufl.sym(ufl.grad(u))
+        return 2.0 * self.mu * eps + self.lmbda * ufl.tr(eps) * ufl.Identity(len(u))
+
+
+class MaterialField:
+    """A side whose material changes from region to region (cellwise constant).
+
+    Several inclusions of one scene are all side -1; each may be of its own
+    material. ``mu``, ``lmbda`` and ``E`` are DG0 Functions, so :meth:`stress` is the
+    same UFL law as :meth:`Material.stress`.
+
+    Args:
+        regions: DG0 Function holding each cell's region index (owned and ghost cells).
+        materials: The material of each region, indexed by region.
+    """
+
+    def __init__(self, regions: dolfinx.fem.Function, materials: typing.Sequence[Material]):
+        self.materials = tuple(materials)
+        index = np.rint(regions.x.array).astype(np.int64)
+        V0 = regions.function_space
+        self.E, self.mu, self.lmbda = (dolfinx.fem.Function(V0) for _ in range(3))
+        for f, key in ((self.E, "E"), (self.mu, "mu"), (self.lmbda, "lmbda")):
+            f.x.array[:] = np.array([getattr(m, key) for m in self.materials])[index]
 
     def stress(self, u) -> ufl.core.expr.Expr:
         """Cauchy stress (Pa) of displacement ``u`` (m), small strain."""

@@ -20,6 +20,9 @@ from xfem_contact.mechanics.materials import Material
 class PlainElasticityProblem:
     """Small-strain elasticity with Dirichlet data and boundary loads (SI units)."""
 
+    #: One linear solve
+    linear = True
+
     def __init__(self, mesh: dolfinx.mesh.Mesh, degree: int, material: Material):
         self.mesh, self.material = mesh, material
         self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (mesh.geometry.dim,)))

@@ -60,6 +60,28 @@ class RuleSet:
         """Number of rules (cut cells)."""
         return int(self.offsets.size - 1)
 
+    def select(self, keep: npt.NDArray[np.bool_]) -> RuleSet:
+        """The same rules with those of the rows not in ``keep`` emptied.
+
+        Args:
+            keep: Per rule (cut-cell row), shape ``(num_rules,)``.
+
+        Returns:
+            A :class:`RuleSet` with the same number of rules (rows keep their
+            meaning), holding only the points of the kept rules.
+        """
+        keep = np.asarray(keep, dtype=bool)
+        if keep.shape != (self.num_rules,):
+            raise ValueError(f"keep must have shape ({self.num_rules},), got {keep.shape}")
+        points = keep[self.point_rows]
+        counts = np.where(keep, np.diff(self.offsets), 0)
+        return RuleSet(
+            self.points[points],
+            self.weights[points],
+            _offsets(counts),
+            None if self.normals is None else self.normals[points],
+        )
+
 
 @functools.cache
 def _p2_triangle() -> basix.finite_element.FiniteElement:

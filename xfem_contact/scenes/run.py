@@ -19,10 +19,9 @@ from xfem_contact.geometry.levelset import union
 from xfem_contact.io.gmsh import GmshMesh, facets, read_gmsh
 from xfem_contact.io.meshes import annulus
 from xfem_contact.io.output import write_json
-from xfem_contact.mechanics.contact import ContactProblem
-from xfem_contact.mechanics.elasticity import ElasticityProblem
 from xfem_contact.mechanics.loading import load_steps
 from xfem_contact.mechanics.plain import PlainElasticityProblem
+from xfem_contact.mechanics.presets import ContactProblem, ElasticityProblem
 from xfem_contact.scenes.expressions import compile_expression
 from xfem_contact.scenes.scene import InterfaceSpec, Scene
 from xfem_contact.solvers.newton import NewtonFailure
@@ -250,7 +249,7 @@ def solve_step(
     """
     if isinstance(problem, PlainElasticityProblem):
         return problem.solve(petsc_options), 1, {}
-    if isinstance(problem, ContactProblem):
+    if not problem.linear:
         report = problem.solve(petsc_options=petsc_options, log=log)
         problem.accept_step()
         return problem.w, report.iterations, report.status[-1]
@@ -300,7 +299,7 @@ def run(
                     failure.report,
                 ) from None
             iterations.append(its)
-            if isinstance(problem, ContactProblem):
+            if not problem.linear:
                 residuals.append(problem.last_report.residuals)
             result.update(solution)
             for writer in series:
@@ -327,7 +326,7 @@ def run(
     else:
         dofs = problem.space.dof_counts()
         summary["dofs"] = dofs._asdict() | {"total": dofs.total}
-    if isinstance(problem, ContactProblem):
+    if not problem.linear:
         summary["contact_status"] = status
         summary["newton_residuals"] = residuals
         summary["interface_samples"] = problem.interface_samples()

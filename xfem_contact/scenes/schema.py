@@ -9,9 +9,8 @@ from __future__ import annotations
 import dataclasses
 import pathlib
 
-from xfem_contact.mechanics.contact import CONTACT_LAWS
-from xfem_contact.mechanics.elasticity import INTERFACE_LAWS
 from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.presets import CONTACT_LAWS, INTERFACE_LAWS
 
 LAWS = INTERFACE_LAWS + CONTACT_LAWS
 SHAPES = ("circle", "ellipse", "line", "half-plane", "expression")

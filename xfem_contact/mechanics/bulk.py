@@ -1,0 +1,136 @@
+"""Bulk models of the two sides of a cut mesh, with the ghost penalty.
+
+:class:`SmallStrain`: linear elasticity per side, ``sum_s int_s sigma_s(u_s) :
+eps(v_s)``, plus the ghost penalty that keeps the operator well conditioned under
+tiny cuts. A new bulk model (e.g. large rotations) provides the same ``form``.
+SI units (Pa, m).
+"""
+
+from __future__ import annotations
+
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.mechanics.laws.base import Fields
+from xfem_contact.mechanics.materials import Material, MaterialField
+
+SIDES = (-1, 1)
+
+
+def cell_size(mesh: dolfinx.mesh.Mesh) -> dolfinx.fem.Function:
+    """Cell diameters h (m) as a DG0 function (largest vertex distance; owned and
+    ghost cells): unlike ``ufl.CellDiameter`` it also serves curved (Q2-geometry)
+    cells. Collective."""
+    V0 = dolfinx.fem.functionspace(mesh, ("DG", 0))
+    h = dolfinx.fem.Function(V0, name="h")
+    tdim = mesh.topology.dim
+    num_cells = mesh.topology.index_map(tdim).size_local
+    num_cells += mesh.topology.index_map(tdim).num_ghosts
+    cells = np.arange(num_cells, dtype=np.int32)
+    h.x.array[V0.dofmap.list[cells, 0]] = mesh.h(tdim, cells)
+    return h
+
+
+class SmallStrain:
+    """Small-strain elasticity of both sides plus the ghost penalty.
+
+    Args:
+        cut: The cut mesh.
+        materials: ``{-1: m, 1: m}``, each a :class:`Material` or a
+            :class:`MaterialField` (a side whose material varies by region).
+        degree: Displacement degree (the ghost penalty jumps derivatives 1..degree).
+        h: Cell diameters (DG0, m).
+        ghost_penalty: Dimensionless weight ``gamma``: for each side,
+            ``gamma * 2 mu * sum_k h^(2k-1) [d^k u][d^k v]`` on the interior facets of
+            cut cells, k = 1..degree (zero for smooth solutions: exact polynomial
+            fields stay exact). 0 disables it.
+    """
+
+    def __init__(
+        self,
+        cut: CutMesh,
+        materials: dict[int, Material | MaterialField],
+        degree: int,
+        h: dolfinx.fem.Function,
+        ghost_penalty: float = 0.01,
+    ):
+        if ghost_penalty < 0:
+            raise ValueError(f"ghost_penalty must be >= 0, got {ghost_penalty}")
+        self.cut, self.materials, self.degree, self.h = cut, materials, degree, h
+        self.ghost_penalty = ghost_penalty
+
+    def form(self, u: Fields, v: Fields) -> ufl.Form:
+        """Elastic energy of both sides plus the ghost penalty (UFL, bilinear in trial
+        ``u`` or linear in ``v`` for a coefficient ``u``)."""
+        a = sum(
+            ufl.inner(self.materials[s].stress(u[i]), ufl.sym(ufl.grad(v[i]))) * self.cut.dx(s)
+            for i, s in enumerate(SIDES)
+        )
+        if self.ghost_penalty > 0:
+            a += self._ghost_penalty(u, v)
+        return a
+
+    def _ghost_penalty(self, trial, test) -> ufl.Form:
+        dS = ufl.Measure("dS", domain=self.cut.mesh, subdomain_data=ghost_penalty_facets(self.cut))
+        h = ufl.avg(self.h)
+        terms = []
+        for i, s in enumerate(SIDES):
+            mu = self.materials[s].mu
+            scale = (
+                self.ghost_penalty * 2.0 * (ufl.avg(mu) if isinstance(mu, ufl.Coefficient) else mu)
+            )
+            du, dv = ufl.grad(trial[i]), ufl.grad(test[i])
+            for k in range(1, self.degree + 1):
+                terms.append(
+                    scale * h ** (2 * k - 1) * ufl.inner(ufl.jump(du), ufl.jump(dv)) * dS(i + 1)
+                )
+                du, dv = ufl.grad(du), ufl.grad(dv)
+        return sum(terms[1:], terms[0])
+
+
+def ghost_penalty_facets(cut: CutMesh) -> list[tuple[int, np.ndarray]]:
+    """Interior-facet integration entities of the ghost penalty: id 1 (side -1) and
+    2 (side +1) hold the owned interior facets with a cut cell on one side and a
+    cell touching that side on the other. Collective (a DG0 scatter)."""
+    mesh, tdim = cut.mesh, cut.mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    num_facets = mesh.topology.index_map(tdim - 1).size_local
+    counts = np.diff(f2c.offsets[: num_facets + 1])
+    interior = np.flatnonzero(counts == 2).astype(np.int32)
+    cells = f2c.array[f2c.offsets[interior][:, None] + np.arange(2)]
+    side = cut.side_indicator()
+    all_sides = np.rint(side.x.array[side.function_space.dofmap.list[:, 0]]).astype(np.int8)
+    sides = all_sides[cells]
+    entries = []
+    for sid, s in ((1, -1), (2, 1)):
+        touches = (sides == s) | (sides == 0)
+        chosen = interior[np.all(touches, axis=1) & np.any(sides == 0, axis=1)]
+        entries.append(
+            (
+                sid,
+                dolfinx.fem.compute_integration_domains(
+                    dolfinx.fem.IntegralType.interior_facet, mesh.topology, chosen
+                ),
+            )
+        )
+    return entries
+
+
+def check_ghosts(mesh: dolfinx.mesh.Mesh) -> None:
+    """In parallel, the ghost penalty and the interface data need the cells across
+    shared facets: refuse a mesh distributed without ghost cells. Collective."""
+    comm = mesh.comm
+    if comm.size == 1:
+        return
+    ghosts = mesh.topology.index_map(mesh.topology.dim).num_ghosts
+    if comm.allreduce(ghosts, op=MPI.SUM) == 0:
+        raise ValueError(
+            "The mesh is distributed without ghost cells; create it with "
+            "partitioner=dolfinx.mesh.create_cell_partitioner(dolfinx.mesh.GhostMode."
+            "shared_facet) (see xfem_contact.io.meshes.ghosted_partitioner)"
+        )

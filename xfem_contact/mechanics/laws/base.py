@@ -1,0 +1,164 @@
+"""What an interface law is: the context it is given and the contract it fulfils.
+
+A :class:`~xfem_contact.mechanics.problem.Problem` composes one law object per
+interface. A law
+
+- declares the multiplier field it needs (:meth:`InterfaceLaw.multiplier_components`);
+- contributes its terms to the residual ``F(w; v)`` (:meth:`InterfaceLaw.residual`,
+  UFL on the interface's measure) and, for laws that couple two cells (large
+  sliding), an assembled contribution (:meth:`InterfaceLaw.coupling`);
+- evaluates its state at the interface rule points (:meth:`InterfaceLaw.state`)
+  *from the same definitions and the same normal* as the residual it enforces, so
+  the reported status is what was solved.
+
+Conventions: the normal ``n`` points from side -1 to side +1, ``t`` is ``n``
+turned by +90 degrees, the jump is ``[u] = u_+ - u_-`` and the multiplier is the
+traction ``sigma n`` on side -1 (Pa, compression negative). SI units.
+"""
+
+from __future__ import annotations
+
+import abc
+import dataclasses
+import typing
+
+import dolfinx.fem
+import numpy as np
+import numpy.typing as npt
+import ufl
+
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.evaluation import evaluate_at_rules
+from xfem_contact.mechanics.materials import Material
+from xfem_contact.quadrature.rules import RuleSet
+
+
+class Fields(typing.NamedTuple):
+    """The fields a law acts on: both sides' displacements (m) and its multiplier
+    (Pa; ``None`` for laws without one). UFL trial, test or coefficient parts."""
+
+    minus: typing.Any
+    plus: typing.Any
+    multiplier: typing.Any = None
+
+    @property
+    def jump(self):
+        """``[u] = u_+ - u_-`` (m)."""
+        return self.plus - self.minus
+
+
+@dataclasses.dataclass(frozen=True)
+class InterfaceContext:
+    """One interface as a law sees it (built by the problem; local to a process).
+
+    Attributes:
+        cut: The cut mesh.
+        name: The interface's name (``cut.interface_names``).
+        measure: Its interface measure (arc length, m).
+        rules: Its interface rules (rows index ``cut.cut_cells``).
+        materials: The constant materials on its two sides, ``{-1: inside, 1: outside}``.
+        cell_size: Cell diameters ``h`` (m), DG0.
+        cut_cells: 1 on the cut cells of this interface, 0 elsewhere (UFL, cellwise).
+        field: Index of the law's multiplier field in the mixed space (None without).
+        w_old: The last accepted state (origin of incremental laws' slip).
+    """
+
+    cut: CutMesh
+    name: str
+    measure: ufl.Measure
+    rules: RuleSet
+    materials: dict[int, Material]
+    cell_size: dolfinx.fem.Function
+    cut_cells: typing.Any
+    field: int | None
+    w_old: dolfinx.fem.Function
+
+    @property
+    def normal(self) -> ufl.core.expr.Expr:
+        """Unit normal ``grad phi_h / |grad phi_h|`` (UFL)."""
+        return self.cut.normal
+
+    def frame(self) -> tuple:
+        """Unit normal ``n`` and tangent ``t`` (UFL)."""
+        n = self.normal
+        return n, ufl.as_vector([-n[1], n[0]])
+
+    def fields(self, parts) -> Fields:
+        """The law's :class:`Fields` of a split mixed function or argument."""
+        return Fields(parts[0], parts[1], None if self.field is None else parts[self.field])
+
+    # -- the same quantities at the rule points (numpy, local) -----------------------
+    def frame_at(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """``n`` and ``t`` at the rule points, each ``(npoints, gdim)``: the UFL normal
+        evaluated there (not the curve's own normal)."""
+        n = self.cut.normal_at(self.rules)
+        return n, np.c_[-n[:, 1], n[:, 0]]
+
+    def values_at(self, w: dolfinx.fem.Function, field: int) -> npt.NDArray[np.float64]:
+        """Values of field ``field`` of ``w`` at the rule points, ``(npoints, value_size)``."""
+        return evaluate_at_rules(w.sub(field), self.cut, self.rules)
+
+    def jump_at(self, w: dolfinx.fem.Function) -> npt.NDArray[np.float64]:
+        """``[u]`` of ``w`` at the rule points, ``(npoints, gdim)`` (m)."""
+        return self.values_at(w, 1) - self.values_at(w, 0)
+
+    def cell_size_at(self) -> npt.NDArray[np.float64]:
+        """``h`` (m) of the cell of every rule point, ``(npoints,)``."""
+        h = self.cell_size
+        cells = self.cut.cut_cells[self.rules.point_rows]
+        return h.x.array[h.function_space.dofmap.list[cells, 0]]
+
+
+class Ops(typing.NamedTuple):
+    """Pointwise min/max, so that one definition of a law serves UFL and numpy."""
+
+    minimum: typing.Callable
+    maximum: typing.Callable
+
+
+UFL_OPS = Ops(ufl.min_value, ufl.max_value)
+NUMPY_OPS = Ops(np.minimum, np.maximum)
+
+
+class InterfaceLaw(abc.ABC):
+    """An interface law (abstract). Subclasses set :attr:`name` and :attr:`linear`."""
+
+    #: The law's name in scenes and messages
+    name: typing.ClassVar[str]
+    #: Whether the law's residual is linear in the unknowns (one linear solve)
+    linear: typing.ClassVar[bool]
+    #: Whether the law acts on the increment since the last accepted state
+    incremental: typing.ClassVar[bool] = False
+
+    def multiplier_components(self, gdim: int) -> int:
+        """Number of components of the law's multiplier field (0: none)."""
+        return 0
+
+    def residual(self, ctx: InterfaceContext, u: Fields, v: Fields) -> ufl.Form | None:
+        """The law's terms of the residual ``F(w; v)`` (UFL), or None.
+
+        ``u`` holds the parts of the unknown (or trial functions for linear laws:
+        the terms are then the bilinear form), ``v`` the test functions.
+        """
+        return None
+
+    def coupling(self, ctx: InterfaceContext):
+        """An assembled contribution beyond UFL cell integrals (laws coupling two
+        cells, e.g. large sliding), or None."""
+        return None
+
+    def prolongation(self, ctx: InterfaceContext, space):
+        """A multiplier prolongation (LBB restriction) of the law's field, or None."""
+        return None
+
+    def state(self, ctx: InterfaceContext, w: dolfinx.fem.Function) -> dict[str, np.ndarray]:
+        """The law's state at this process's rule points, each ``(npoints,)``."""
+        return {}
+
+    def status(self, state: dict[str, np.ndarray]) -> dict[str, int]:
+        """Local counts of rule points by status (e.g. contact, stick, slip)."""
+        return {}
+
+    def describe(self) -> dict:
+        """The law's name and options (for summaries)."""
+        return {"law": self.name}

@@ -1,0 +1,208 @@
+"""Contact laws in small sliding: mixed augmented-Lagrangian formulation.
+
+Unknowns: the displacement of each side (``u_-``, ``u_+``, m) and the interface
+multipliers (Pa): the normal pressure ``lambda_n`` and, with friction, the
+tangential traction ``lambda_t``; ``lambda = lambda_n n + lambda_t t`` is the
+traction ``sigma n`` on side -1, compression negative. With the jump
+``[u] = u_+ - u_-``, gap ``g_n = [u].n`` and slip ``g_t = [u].t`` (sticking: the
+tangential jump from the reference state) or slip increment ``g_t = [u - u_old].t``
+(Coulomb, path dependent: ``u_old`` the last accepted load step), the
+Alart-Curnier augmented multipliers are (:meth:`ContactLaw.augmented`)
+
+    P_n = min(0, lambda_n + r g_n)
+    P_t = lambda_t + r g_t                                 (sticking)
+    P_t = clamp(lambda_t + r g_t, mu P_n, -mu P_n)          (Coulomb)
+
+and the law's residual terms (Ben Dhia's mixed form; generalized Newton through
+``ufl.derivative``):
+
+    int (P_n [v].n + P_t [v].t) - int (1/r) ((lambda_n - P_n) mu_n + (lambda_t - P_t) mu_t)
+
+minus the LBB terms. ``r = augmentation * E / h`` (Pa/m, ``E`` the mean of the two
+sides' moduli, ``h`` the cell diameter). The same :meth:`ContactLaw.augmented`
+evaluates the reported state at the rule points, with the same normal.
+"""
+
+from __future__ import annotations
+
+import dolfinx.fem
+import numpy as np
+import ufl
+
+from xfem_contact.mechanics.laws.base import (
+    NUMPY_OPS,
+    UFL_OPS,
+    Fields,
+    InterfaceContext,
+    Ops,
+)
+from xfem_contact.mechanics.laws.multiplier import MultiplierLaw
+
+
+class ContactLaw(MultiplierLaw):
+    """Unilateral contact (abstract base of the three laws below).
+
+    Args:
+        augmentation: Dimensionless factor of ``r = augmentation * E / h`` (> 0).
+        lbb, multiplier_stabilization, multiplier_extension: See
+            :class:`~xfem_contact.mechanics.laws.multiplier.MultiplierLaw`.
+    """
+
+    linear = False
+    #: Whether the law has a tangential multiplier
+    tangential = True
+
+    def __init__(self, augmentation: float = 1.0, **lbb_options):
+        if not augmentation > 0.0:
+            raise ValueError(f"The augmentation parameter must be > 0, got {augmentation}")
+        super().__init__(**lbb_options)
+        self.augmentation = augmentation
+
+    def describe(self) -> dict:
+        return super().describe() | {"augmentation": self.augmentation}
+
+    def multiplier_components(self, gdim: int) -> int:
+        return gdim if self.tangential else 1
+
+    # -- one definition for UFL and numpy --------------------------------------------
+    def augmentation_coefficient(self, ctx: InterfaceContext, h):
+        """``r = augmentation * E / h`` (Pa/m) for ``h`` a UFL or numpy cell size (m)."""
+        E = 0.5 * (ctx.materials[-1].E + ctx.materials[1].E)
+        return self.augmentation * E / h
+
+    def friction_bound(self, P_n, ops: Ops):
+        """The bound of ``|P_t|`` (Pa) given ``P_n``; None for no bound."""
+        return None
+
+    def augmented(self, lam_n, lam_t, gap, slip, r, ops: Ops) -> tuple:
+        """Augmented multipliers ``(P_n, P_t)`` (Pa; ``P_t`` None without a tangential
+        multiplier) from the multipliers, gap and slip (increment) and ``r``."""
+        P_n = ops.minimum(0.0, lam_n + r * gap)
+        if lam_t is None:
+            return P_n, None
+        trial = lam_t + r * slip
+        bound = self.friction_bound(P_n, ops)
+        if bound is None:
+            return P_n, trial
+        return P_n, ops.maximum(-bound, ops.minimum(bound, trial))
+
+    def multipliers(self, u: Fields) -> tuple:
+        """``(lambda_n, lambda_t or None)`` of the law's fields."""
+        if not self.tangential:
+            return u.multiplier, None
+        return u.multiplier[0], u.multiplier[1]
+
+    def traction_vector(self, ctx: InterfaceContext, u: Fields):
+        """Cartesian multiplier vector ``lambda_n n + lambda_t t`` (UFL)."""
+        n, t = ctx.frame()
+        lam_n, lam_t = self.multipliers(u)
+        return lam_n * n if lam_t is None else lam_n * n + lam_t * t
+
+    # -- the residual ----------------------------------------------------------------
+    def residual(self, ctx: InterfaceContext, u: Fields, v: Fields) -> ufl.Form:
+        n, t = ctx.frame()
+        r = self.augmentation_coefficient(ctx, ctx.cell_size)
+        lam_n, lam_t = self.multipliers(u)
+        mu_n, mu_t = self.multipliers(v)
+        slip_jump = u.jump
+        if self.incremental:
+            slip_jump = slip_jump - ctx.fields(ufl.split(ctx.w_old)).jump
+        P_n, P_t = self.augmented(
+            lam_n, lam_t, ufl.dot(u.jump, n), ufl.dot(slip_jump, t), r, UFL_OPS
+        )
+        interface = P_n * ufl.dot(v.jump, n) - (lam_n - P_n) * mu_n / r
+        if P_t is not None:
+            interface += P_t * ufl.dot(v.jump, t) - (lam_t - P_t) * mu_t / r
+        F = interface * ctx.measure
+        lbb = self.lbb_terms(ctx, self.traction_vector(ctx, u), self.traction_vector(ctx, v), u, v)
+        if lbb is not None:
+            F -= lbb
+        if self.incremental and self.multiplier_stabilization > 0:
+            # The tangential law is incremental (slip of the step): its share of the
+            # stabilisation is measured from the last accepted step too, so that the
+            # steps telescope (sticking in n steps = in one). Jacobian unchanged.
+            old = ctx.fields(ufl.split(ctx.w_old))
+            _, old_t = self.multipliers(old)
+            old_residual = old_t - ufl.dot(self.interface_traction(ctx, old), t)
+            F += self.stabilization_scale(ctx) * old_residual * mu_t * ctx.measure
+        return F
+
+    # -- the state at the rule points ------------------------------------------------
+    def state(self, ctx: InterfaceContext, w: dolfinx.fem.Function) -> dict[str, np.ndarray]:
+        """Point values at this process's rule points of the interface, each
+        ``(npoints,)``: ``gap``, ``slip`` and ``slip_increment`` (the slip the
+        tangential law sees: of the load step for Coulomb, else the slip) (m), the
+        multipliers ``lambda_n``, ``lambda_t``, the augmented (applied) tractions
+        ``P_n``, ``P_t`` (Pa; tangential ones zero when frictionless), the trial
+        tangential traction ``trial_t`` (Pa) and ``r`` (Pa/m)."""
+        n, t = ctx.frame_at()
+        jump, lam = ctx.jump_at(w), ctx.values_at(w, ctx.field)
+        r = self.augmentation_coefficient(ctx, ctx.cell_size_at())
+        gap = np.sum(jump * n, axis=1)
+        slip = np.sum(jump * t, axis=1)
+        slip_increment = slip
+        if self.incremental:
+            slip_increment = slip - np.sum(ctx.jump_at(ctx.w_old) * t, axis=1)
+        lam_n = lam[:, 0]
+        lam_t = lam[:, 1] if self.tangential else None
+        P_n, P_t = self.augmented(lam_n, lam_t, gap, slip_increment, r, NUMPY_OPS)
+        lam_t = np.zeros_like(lam_n) if lam_t is None else lam_t
+        return {
+            "gap": gap,
+            "slip": slip,
+            "slip_increment": slip_increment,
+            "lambda_n": lam_n,
+            "lambda_t": lam_t,
+            "P_n": P_n,
+            "P_t": np.zeros_like(P_n) if P_t is None else P_t,
+            "r": r,
+            "trial_t": lam_t + r * slip_increment,
+        }
+
+    def status(self, state: dict[str, np.ndarray]) -> dict[str, int]:
+        """Local counts of rule points in contact and, with friction, stick / slip."""
+        contact = state["P_n"] < 0.0
+        counts = {"contact": int(contact.sum())}
+        if self.tangential:
+            bound = self.friction_bound(state["P_n"], NUMPY_OPS)
+            stick = contact if bound is None else contact & (np.abs(state["trial_t"]) <= bound)
+            counts |= {"stick": int(stick.sum()), "slip": int((contact & ~stick).sum())}
+        return counts
+
+
+class Frictionless(ContactLaw):
+    """Frictionless contact: a normal multiplier only."""
+
+    name = "frictionless"
+    tangential = False
+
+
+class Sticking(ContactLaw):
+    """Contact with no slip: the tangential jump is held at zero while in contact."""
+
+    name = "sticking"
+
+
+class Coulomb(ContactLaw):
+    """Coulomb friction, incremental: ``|P_t| <= mu |P_n|`` on the slip of the step.
+
+    Args:
+        friction: Coulomb coefficient ``mu`` (>= 0).
+    """
+
+    name = "coulomb"
+    incremental = True
+
+    def __init__(self, friction: float, **options):
+        if friction is None:
+            raise ValueError("The 'coulomb' law needs a friction coefficient (friction=...)")
+        if not friction >= 0.0:
+            raise ValueError(f"The friction coefficient must be >= 0, got {friction}")
+        super().__init__(**options)
+        self.friction = friction
+
+    def describe(self) -> dict:
+        return super().describe() | {"friction": self.friction}
+
+    def friction_bound(self, P_n, ops: Ops):
+        return -self.friction * P_n

@@ -1,0 +1,141 @@
+"""The vital-vertex restriction (:mod:`xfem_contact.mechanics.lbb`) applied to a
+multiplier field of an enriched space, in parallel: the prolongation ``R`` uses."""
+
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.restriction import MultiplierProlongation
+from xfem_contact.mechanics import lbb as lbb_module
+
+
+def vital_vertex_prolongation(
+    cut: CutMesh, space, field: int = 2, interface: str | None = None
+) -> MultiplierProlongation:
+    """Multiplier prolongation from the vital vertices of the cut edges. Collective.
+
+    Cut edges (end vertices on opposite sides of the interpolated level set) of
+    the cut cells are gathered globally, vital vertices chosen identically on
+    every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`), and each multiplier
+    dof of a vertex on a cut edge expressed by :func:`xfem_contact.mechanics.lbb.prolongation`.
+    Multiplier dofs of vertices on no cut edge stay free unknowns.
+
+    Args:
+        cut: The cut mesh.
+        space: The :class:`~xfem_contact.fem.enrichment.EnrichedSpace`.
+        field: The multiplier field of ``space.W``.
+        interface: The interface whose cut cells carry the field (None: all).
+    """
+    mesh = cut.mesh
+    tdim = mesh.topology.dim
+    comm = mesh.comm
+    mesh.topology.create_connectivity(tdim, 1)
+    mesh.topology.create_connectivity(1, 0)
+    c2e = mesh.topology.connectivity(tdim, 1)
+    e2v = mesh.topology.connectivity(1, 0)
+    vmap = mesh.topology.index_map(0)
+    # Vertex sides from the level set at vertices (0 counts as +1)
+    phi = cut.levelset.function
+    V = phi.function_space
+    c2v = mesh.topology.connectivity(tdim, 0)
+    nv_cell = c2v.offsets[1] - c2v.offsets[0]
+    cell_vertices = c2v.array.reshape(-1, nv_cell)
+    vertex_phi = np.zeros(vmap.size_local + vmap.num_ghosts)
+    vertex_phi[cell_vertices] = phi.x.array[V.dofmap.list[:, :nv_cell]]
+    vertex_side = np.where(vertex_phi < 0.0, -1, 1).astype(np.int8)
+    ne_cell = c2e.offsets[1] - c2e.offsets[0]
+    cut_cells = cut.interface_cells(interface)
+    edges = np.unique(c2e.array.reshape(-1, ne_cell)[cut_cells].ravel())
+    ends = e2v.array.reshape(-1, 2)[edges]
+    crossing = vertex_side[ends[:, 0]] != vertex_side[ends[:, 1]]
+    ends = ends[crossing]
+    global_ends = vmap.local_to_global(ends.ravel()).reshape(-1, 2)
+    all_ends = np.concatenate(comm.allgather(global_ends))
+    all_sides = np.concatenate(comm.allgather(vertex_side[ends]))
+    vital = lbb_module.vital_vertices(all_ends, all_sides)
+    rows, cols, vals, reduced = lbb_module.prolongation(all_ends, vital)
+    # Vertices of cut cells on no cut edge (e.g. the far corner of a quadrilateral
+    # cut near one vertex) take the mean of the prolongated rows of the cut-edge
+    # vertices of their cut cells.
+    cut_vertices = vmap.local_to_global(cell_vertices[cut_cells].ravel()).reshape(-1, nv_cell)
+    cut_vertices = np.concatenate(comm.allgather(cut_vertices)).reshape(-1, nv_cell)
+    on_edge = np.isin(cut_vertices, rows)
+    pairs = {
+        (f, nb)
+        for cell, mask in zip(cut_vertices, on_edge, strict=True)
+        for f in cell[~mask]
+        for nb in cell[mask]
+    }
+    if pairs:
+        extra_rows, extra_cols, extra_vals = [], [], []
+        neighbours: dict[int, list[int]] = {}
+        for f, nb in sorted(pairs):
+            neighbours.setdefault(int(f), []).append(int(nb))
+        for f, nbs in neighbours.items():
+            for nb in nbs:
+                sel = rows == nb
+                extra_rows.append(np.full(sel.sum(), f))
+                extra_cols.append(cols[sel])
+                extra_vals.append(vals[sel] / len(nbs))
+        rows = np.concatenate([rows, *extra_rows])
+        cols = np.concatenate([cols, *extra_cols])
+        vals = np.concatenate([vals, *extra_vals])
+    # Multiplier dofs per vertex (P1: cell-local dof i sits at cell vertex i)
+    comps = {f: c for f, c, _ in space.multiplier_fields}[field]
+    mdofs = space.W.sub(field).dofmap.list.reshape(cell_vertices.shape[0], nv_cell, comps)
+    dof_of_vertex = np.full((vertex_phi.size, comps), -1, dtype=np.int64)
+    dof_of_vertex[cell_vertices] = mdofs
+    # Reduced multiplier unknowns, numbered rank-major: each process owns the
+    # unknowns of the vital vertices it owns, in increasing global id.
+    owned_global = vmap.local_to_global(np.arange(vmap.size_local, dtype=np.int32))
+    vital_owned = reduced[np.isin(reduced, owned_global)]
+    rank_major = np.concatenate(comm.allgather(vital_owned))
+    position = np.empty(rank_major.size, dtype=np.int64)
+    position[np.searchsorted(reduced, rank_major)] = np.arange(rank_major.size)
+    # Prolongation rows of owned vertices
+    keep = np.isin(rows, owned_global)
+    row_vertices, inverse = np.unique(rows[keep], return_inverse=True)
+    local = row_vertices - vmap.local_range[0]  # owned vertices are numbered contiguously
+    nrow = row_vertices.size
+    dofs = np.concatenate([dof_of_vertex[local, c] for c in range(comps)])
+    prow = np.concatenate([inverse.ravel() + c * nrow for c in range(comps)])
+    pcol = np.concatenate([position[cols[keep]] * comps + c for c in range(comps)])
+    pval = np.tile(vals[keep], comps)
+    return MultiplierProlongation(dofs, prow, pcol, pval, num_owned=vital_owned.size * comps)
+
+
+def combine_prolongations(
+    prolongations: list[MultiplierProlongation], comm: MPI.Comm
+) -> MultiplierProlongation | None:
+    """One prolongation for several multiplier fields. Collective.
+
+    Each input numbers its reduced unknowns rank-major (the unknowns owned by rank 0
+    first); the result numbers, on each rank, the unknowns of the first input, then
+    of the second, ..., keeping the rank-major order across ranks.
+    """
+    if not prolongations:
+        return None
+    if len(prolongations) == 1:
+        return prolongations[0]
+    owned = np.array([comm.allgather(p.num_owned) for p in prolongations])  # (inputs, ranks)
+    rank_total = owned.sum(axis=0)
+    rank_start = np.concatenate([[0], np.cumsum(rank_total)[:-1]])
+    within = np.concatenate([np.zeros((1, owned.shape[1]), int), np.cumsum(owned, 0)[:-1]])
+    dofs, rows, cols, vals, row0 = [], [], [], [], 0
+    for k, p in enumerate(prolongations):
+        starts = np.concatenate([[0], np.cumsum(owned[k])])
+        owner = np.searchsorted(starts, p.cols, side="right") - 1
+        cols.append(rank_start[owner] + within[k, owner] + p.cols - starts[owner])
+        dofs.append(p.dofs)
+        rows.append(p.rows + row0)
+        vals.append(p.vals)
+        row0 += p.dofs.size
+    return MultiplierProlongation(
+        np.concatenate(dofs),
+        np.concatenate(rows),
+        np.concatenate(cols),
+        np.concatenate(vals),
+        num_owned=int(owned[:, comm.rank].sum()),
+    )

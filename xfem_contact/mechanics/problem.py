@@ -1,0 +1,317 @@
+"""A mechanics problem on a cut mesh: one bulk model composed with one law per interface.
+
+:class:`Problem` owns the enriched space (a displacement per side, one multiplier
+field per law that needs one), the bulk model of each side, the loads and the
+Dirichlet data, and composes the interface laws (:mod:`xfem_contact.mechanics.laws`):
+the residual is the bulk's plus each law's terms minus the loads. Linear laws only:
+one KSP solve; any contact law: generalized Newton (SNES). Both solve on the active
+dofs through the one restriction operator ``R`` (:mod:`xfem_contact.fem.restriction`).
+SI units (Pa, m).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Mapping
+
+import dolfinx.fem
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.enrichment import EnrichedSpace
+from xfem_contact.fem.evaluation import interface_points
+from xfem_contact.fem.forms import form
+from xfem_contact.fem.restriction import restriction_matrix
+from xfem_contact.mechanics.bulk import SIDES, SmallStrain, cell_size, check_ghosts
+from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw, make_law
+from xfem_contact.mechanics.lbb_space import combine_prolongations
+from xfem_contact.mechanics.loading import Loads
+from xfem_contact.mechanics.materials import Material, MaterialField
+from xfem_contact.solvers.linear import solve_restricted
+from xfem_contact.solvers.newton import NewtonReport, RestrictedNewton
+
+#: Materials: one for both sides, or ``{-1: m, 1: m}`` where side -1 may map
+#: interface names to the material inside each
+Materials = Material | Mapping[int, Material | Mapping[str, Material]]
+
+
+@dataclasses.dataclass
+class Solution:
+    """Displacements per side (m) and the multipliers (Pa) of a linear solve."""
+
+    w: dolfinx.fem.Function
+    space: EnrichedSpace
+
+    def field(self, i: int) -> dolfinx.fem.Function:
+        """Collapsed copy of field ``i``: 0 side -1, 1 side +1, 2.. multipliers."""
+        return self.w.sub(i).collapse()
+
+
+class Problem(Loads):
+    """Elasticity of the two sides of a cut mesh with a law on each interface.
+
+    Args:
+        cut: The cut mesh.
+        degree: Displacement degree (1 or 2); multipliers are P1 on the vertices of
+            the cut cells (the paper's P2-P1 element for degree 2).
+        materials: One :class:`Material`, or ``{-1: inside, 1: outside}``; with several
+            interfaces ``inside`` may be ``{interface name: Material}``.
+        interfaces: A law (object or name) for every interface, or
+            ``{interface name: law}`` (names of ``cut.interface_names``).
+        ghost_penalty: Weight of the ghost penalty (see :class:`SmallStrain`).
+        min_support_fraction: See :class:`EnrichedSpace`. Default: keep every dof
+            when the ghost penalty is on (it defines the field's extension over empty
+            supports), else drop dofs with no support on their side.
+
+    Collective.
+    """
+
+    def __init__(
+        self,
+        cut: CutMesh,
+        degree: int,
+        materials: Materials,
+        interfaces: InterfaceLaw | str | Mapping[str, InterfaceLaw | str] = "free",
+        *,
+        ghost_penalty: float = 0.01,
+        min_support_fraction: float | None = None,
+    ):
+        self.cut, self.mesh = cut, cut.mesh
+        self.laws = _laws(cut, interfaces)
+        side_materials, law_materials = _materials(cut, materials)
+        if min_support_fraction is None:
+            min_support_fraction = 0.0 if ghost_penalty > 0 else 1e-12
+        gdim = self.mesh.geometry.dim
+        multipliers = [(law.multiplier_components(gdim), name) for name, law in self.laws.items()]
+        self.space = EnrichedSpace(
+            cut,
+            degree,
+            multipliers=[(c, n) for c, n in multipliers if c > 0],
+            min_support_fraction=min_support_fraction,
+        )
+        check_ghosts(self.mesh)
+        super().__init__(self.mesh, self.space)
+        self.cell_size = cell_size(self.mesh)
+        self.side_indicator = cut.side_indicator()
+        self.bulk = SmallStrain(cut, side_materials, degree, self.cell_size, ghost_penalty)
+        self.materials = side_materials
+        self.w = dolfinx.fem.Function(self.space.W, name="w")
+        #: The last accepted load step (its jump is the origin of incremental slips)
+        self.w_old = dolfinx.fem.Function(self.space.W, name="w_old")
+        fields = {name: field for field, _, name in self.space.multiplier_fields}
+        self.contexts = {
+            name: self._context(name, law_materials[name], fields.get(name)) for name in self.laws
+        }
+        self._newton: RestrictedNewton | None = None
+
+    def _context(self, name: str, materials: dict, field: int | None) -> InterfaceContext:
+        cut = self.cut
+        if len(cut.interface_names) == 1:
+            on_cut_cells = 1.0 - abs(self.side_indicator)  # 1 on cut cells, 0 elsewhere
+        else:
+            indicator = dolfinx.fem.Function(self.side_indicator.function_space)
+            dofs = indicator.function_space.dofmap.list[cut.interface_cells(name), 0]
+            indicator.x.array[dofs] = 1.0
+            indicator.x.scatter_forward()
+            on_cut_cells = indicator
+        return InterfaceContext(
+            cut=cut,
+            name=name,
+            measure=cut.interface_measure(name),
+            rules=cut.interface_rules_of(name),
+            materials=materials,
+            cell_size=self.cell_size,
+            cut_cells=on_cut_cells,
+            field=field,
+            w_old=self.w_old,
+        )
+
+    @property
+    def ghost_penalty(self) -> float:
+        """Weight of the ghost penalty."""
+        return self.bulk.ghost_penalty
+
+    @property
+    def linear(self) -> bool:
+        """Whether every law is linear (one KSP solve instead of Newton)."""
+        return all(law.linear for law in self.laws.values())
+
+    def law(self, name: str | None = None) -> InterfaceLaw:
+        """The law of interface ``name`` (of the only interface for ``None``)."""
+        return self.laws[self._name(name)]
+
+    def _name(self, name: str | None) -> str:
+        if name is None:
+            if len(self.laws) > 1:
+                raise ValueError(f"Name the interface: one of {list(self.laws)}")
+            return next(iter(self.laws))
+        if name not in self.laws:
+            raise ValueError(f"Unknown interface {name!r}; valid: {list(self.laws)}")
+        return name
+
+    # -- forms -----------------------------------------------------------------------
+    def _interface_terms(self, u, v) -> list:
+        terms = []
+        for name, law in self.laws.items():
+            ctx = self.contexts[name]
+            term = law.residual(ctx, ctx.fields(u), ctx.fields(v))
+            if term is not None:
+                terms.append(term)
+        return terms
+
+    def bilinear_form(self) -> ufl.Form:
+        """``a(u, v)`` of a linear problem (bulk plus the laws' terms, UFL)."""
+        if not self.linear:
+            raise ValueError("A problem with a contact law has a residual, not a bilinear form")
+        u, v = self.space.trial(), self.space.test()
+        return sum(self._interface_terms(u, v), self.bulk.form(u, v))
+
+    def residual(self) -> ufl.Form:
+        """The residual ``F(w; v)`` (UFL, linear in the test functions)."""
+        u, v = ufl.split(self.w), self.space.test()
+        F = sum(self._interface_terms(u, v), self.bulk.form(u, v))
+        if self._rhs:
+            F -= sum(self._rhs[1:], self._rhs[0])
+        return F
+
+    def multipliers(self, fields, name: str | None = None) -> tuple:
+        """``(lambda_n, lambda_t or None)`` (UFL) of a split mixed function, for a
+        contact law (the Cartesian multiplier vector for ``bonded``)."""
+        name = self._name(name)
+        law, ctx = self.laws[name], self.contexts[name]
+        if hasattr(law, "multipliers"):
+            return law.multipliers(ctx.fields(fields))
+        return fields[ctx.field], None
+
+    # -- solve -----------------------------------------------------------------------
+    def restriction(self):
+        """The restriction operator ``R`` (full x reduced) of the active dofs and the
+        laws' multiplier prolongations. Collective."""
+        prolongations = [
+            p
+            for name, law in self.laws.items()
+            if (p := law.prolongation(self.contexts[name], self.space)) is not None
+        ]
+        return restriction_matrix(self.space, combine_prolongations(prolongations, self.mesh.comm))
+
+    def solve(
+        self, petsc_options: dict | None = None, log: Callable[[str], None] | None = None
+    ) -> Solution | NewtonReport:
+        """Solve on the active dofs; ``self.w`` holds the result. Collective.
+
+        Linear problems: one KSP solve, returns a :class:`Solution`. With a contact
+        law: generalized Newton (SNES) from ``self.w``, a ``log`` line per iterate,
+        returns the :class:`~xfem_contact.solvers.newton.NewtonReport`.
+
+        Raises:
+            NewtonFailure: with the iteration history, if SNES does not converge.
+        """
+        if self.linear:
+            a, L = form(self.bilinear_form()), form(self.linear_form())
+            w, _ = solve_restricted(a, L, self._bcs, self.space, petsc_options)
+            self.w.x.array[:] = w.x.array
+            return Solution(w, self.space)
+        if self._newton is None:
+            self._newton = RestrictedNewton(
+                self.residual(),
+                self.w,
+                self._bcs,
+                self.restriction(),
+                petsc_options,
+                status=self.interface_status,
+                log=log,
+            )
+        return self._newton.solve()
+
+    @property
+    def last_report(self) -> NewtonReport | None:
+        """The report of the last Newton solve (None before the first)."""
+        return None if self._newton is None else self._newton.report
+
+    def accept_step(self) -> None:
+        """Accept the current solution as the end of a load step: incremental laws
+        (Coulomb) measure the slip of the next step from it."""
+        self.w.x.scatter_forward()
+        self.w_old.x.array[:] = self.w.x.array
+
+    # -- interface state -------------------------------------------------------------
+    def interface_state(
+        self, w: dolfinx.fem.Function | None = None, name: str | None = None
+    ) -> dict[str, np.ndarray]:
+        """The law's state at this process's rule points of interface ``name``
+        (see the law's ``state``), for ``w`` (default: the solution)."""
+        name = self._name(name)
+        return self.laws[name].state(self.contexts[name], self.w if w is None else w)
+
+    def interface_status(self, w: dolfinx.fem.Function) -> dict:
+        """Global counts of interface rule points by status (contact / stick / slip),
+        prefixed by the interface name when there are several. Collective."""
+        counts = {}
+        for name, law in self.laws.items():
+            local = law.status(law.state(self.contexts[name], w))
+            prefix = f"{name} " if len(self.laws) > 1 else ""
+            counts |= {prefix + k: v for k, v in local.items()}
+        comm = self.mesh.comm
+        return {k: comm.allreduce(v, op=MPI.SUM) for k, v in counts.items()}
+
+    def interface_samples(self, name: str | None = None) -> dict[str, list[float]]:
+        """The state of the solution at the rule points of all processes (for plots
+        and summaries): ``x``, ``y`` (m) and the law's state (``gap``, ``slip``,
+        ``lambda_n``, ``lambda_t``, and ``P_n``, ``P_t`` for contact laws), each a
+        list over the points. Collective."""
+        name = self._name(name)
+        ctx = self.contexts[name]
+        state = self.laws[name].state(ctx, self.w)
+        points = interface_points(self.cut, ctx.rules)
+        local = {"x": points[:, 0], "y": points[:, 1]}
+        keys = ("gap", "slip", "lambda_n", "lambda_t", "P_n", "P_t")
+        local |= {k: state[k] for k in keys if k in state}
+        comm = self.mesh.comm
+        return {k: np.concatenate(comm.allgather(v)).tolist() for k, v in local.items()}
+
+
+def _laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
+    """One law object per interface name of ``cut``."""
+    names = cut.interface_names
+    if not isinstance(interfaces, Mapping):
+        interfaces = {name: interfaces for name in names}
+    if set(interfaces) != set(names):
+        raise ValueError(f"Give a law for each interface {list(names)}; got {sorted(interfaces)}")
+    laws = {}
+    for name in names:
+        law = interfaces[name]
+        laws[name] = make_law(law) if isinstance(law, str) else law
+        if not isinstance(laws[name], InterfaceLaw):
+            raise ValueError(f"Interface {name!r}: {law!r} is not an interface law")
+    return laws
+
+
+def _materials(cut: CutMesh, materials: Materials):
+    """Per side (Material or MaterialField) and per interface ({-1, 1}: Material)."""
+    if isinstance(materials, Material):
+        materials = {-1: materials, 1: materials}
+    missing = [s for s in SIDES if s not in materials]
+    if missing:
+        raise ValueError(f"Give a Material for sides -1 and +1 (missing: {missing})")
+    names = cut.interface_names
+    inside = materials[-1]
+    if isinstance(inside, Mapping):
+        if set(inside) != set(names):
+            raise ValueError(
+                f"Side -1 materials must name the interfaces {list(names)}; got {sorted(inside)}"
+            )
+        per_interface = dict(inside)
+    else:
+        per_interface = {name: inside for name in names}
+    if not all(isinstance(m, Material) for m in [*per_interface.values(), materials[1]]):
+        raise ValueError("Give a Material for sides -1 and +1")
+    distinct = len({per_interface[n] for n in names}) > 1
+    side_minus = (
+        MaterialField(cut.cell_regions(), [per_interface[n] for n in names])
+        if distinct
+        else per_interface[names[0]]
+    )
+    law_materials = {name: {-1: per_interface[name], 1: materials[1]} for name in names}
+    return {-1: side_minus, 1: materials[1]}, law_materials
