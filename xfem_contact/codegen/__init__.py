@@ -12,6 +12,9 @@ function on :func:`marker_element`, a quadrature element on fixed placeholder
 points. FFCx builds the integral's intermediate representation on those points;
 the marker's dofs carry, per cell, the rule index and the address of the rule
 registry, and the marker counts as 1 in the integrand.
+
+The first step of the layout: it imports FFCx, UFL, Basix and numpy and no other
+``xfem_contact`` sub-package, so that FFCx can load it on its own.
 """
 
 from xfem_contact.codegen import expression, file, form, integral
