@@ -352,7 +352,7 @@ class CutMesh:
             return self._boundary(subdomain_id - _BOUNDARY0)
         if subdomain_id >= _INTERFACE0:
             k = subdomain_id - _INTERFACE0
-            if k not in self._cell_rules:
+            if subdomain_id not in self._cell_rules:
                 r = self.interface_rules_of(self.interface_names[k])
                 self._cell_rules[k + _INTERFACE0] = CellRules(
                     self.mesh, self.cut_cells, r.points, r.weights, r.offsets

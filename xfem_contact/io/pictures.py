@@ -252,23 +252,25 @@ def render_folder(
         )
     else:
         say(f"skipped cut.png: no subcells*.vtu in {folder}")
-    samples = summary.get("interface_samples")
-    if isinstance(samples, dict) and samples.get("lambda_n"):
+    interfaces = summary.get("interfaces") or {}
+    if len(interfaces) > 1:  # one plot per interface
+        plots = {f"pressure_{k}.png": (k, v.get("samples")) for k, v in interfaces.items()}
+    else:
+        plots = {"pressure.png": (None, summary.get("interface_samples"))}
+    for file, (interface, samples) in plots.items():
+        if not (isinstance(samples, dict) and samples.get("lambda_n")):
+            say(f"skipped {file}: summary.json has no interface samples with lambda_n")
+            continue
         s, label = interface_abscissa(samples["x"], samples["y"])
         written.append(
             plot_pressure(
                 s,
                 samples["lambda_n"],
-                folder / "pressure.png",
+                folder / file,
                 xlabel=label,
-                title=f"{name}: contact pressure",
+                title=f"{name}: " + (f"{interface}, " if interface else "") + "contact pressure",
                 applied=samples.get("P_n"),
             )
-        )
-    else:
-        say(
-            "skipped pressure.png: summary.json has no interface_samples with lambda_n "
-            "(contact scenes only)"
         )
     for path in written:
         say(f"wrote {path}")

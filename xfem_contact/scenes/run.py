@@ -15,13 +15,13 @@ from mpi4py import MPI
 
 from xfem_contact.fem import forms
 from xfem_contact.fem.cutmesh import CutMesh
-from xfem_contact.geometry.levelset import union
 from xfem_contact.io.gmsh import GmshMesh, facets, read_gmsh
 from xfem_contact.io.meshes import annulus
 from xfem_contact.io.output import write_json
+from xfem_contact.mechanics.laws import ContactLaw, make_law
 from xfem_contact.mechanics.loading import load_steps
 from xfem_contact.mechanics.plain import PlainElasticityProblem
-from xfem_contact.mechanics.presets import ContactProblem, ElasticityProblem
+from xfem_contact.mechanics.problem import Problem
 from xfem_contact.scenes.expressions import compile_expression
 from xfem_contact.scenes.scene import InterfaceSpec, Scene
 from xfem_contact.solvers.newton import NewtonFailure
@@ -121,14 +121,10 @@ def create_mesh(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> MeshedDomain:
     return MeshedDomain(mesh)
 
 
-def interface_levelset(scene: Scene, mesh: dolfinx.mesh.Mesh) -> Callable:
-    """The level set of the scene's interfaces: one, or the union of several (checked
-    apart, see :func:`xfem_contact.geometry.levelset.union`). Collective."""
-    if len(scene.interfaces) == 1:
-        return levelset(scene.interfaces[0])
-    return union(
-        mesh, {spec.name: levelset(spec) for spec in scene.interfaces}, scene.levelset_degree
-    )
+def interface_levelsets(scene: Scene) -> dict[str, Callable]:
+    """The level sets of the scene's interfaces by name (a :class:`CutMesh` cuts
+    several as one, checked apart: see :func:`xfem_contact.geometry.levelset.union`)."""
+    return {spec.name: levelset(spec) for spec in scene.interfaces}
 
 
 def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
@@ -149,37 +145,38 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             "pairing": False,
         }
     else:
-        spec = scene.interfaces[0]  # the interfaces share law and materials
         cut = CutMesh(
             mesh,
-            interface_levelset(scene, mesh),
+            interface_levelsets(scene),
             degree=scene.levelset_degree,
             quadrature_degree=scene.quadrature_degree,
         )
-        materials = {-1: scene.materials[spec.inside], 1: scene.materials[spec.outside]}
-        if spec.law in ContactProblem.LAWS:
-            problem = ContactProblem(
-                cut,
-                scene.degree,
-                materials,
-                spec.law,
-                friction=spec.friction,
-                augmentation=spec.augmentation,
-                lbb=spec.lbb,
+        laws = {
+            spec.name: make_law(
+                spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb
             )
-            solver = "SNES (generalized Newton)"
-        else:
-            problem = ElasticityProblem(cut, scene.degree, materials, spec.law)
-            solver = "KSP (one linear solve per load step)"
-        comps = problem.space.multiplier_components
+            for spec in scene.interfaces
+        }
+        materials = {
+            -1: {spec.name: scene.materials[spec.inside] for spec in scene.interfaces},
+            1: scene.materials[scene.interfaces[0].outside],  # shared (see the schema)
+        }
+        problem = Problem(cut, scene.degree, materials, laws)
+        gdim = mesh.geometry.dim
         effects = {
-            "interface": spec.law,
+            "interface": scene.interfaces[0].law if len(laws) == 1 else None,
             "interfaces": [s.name for s in scene.interfaces],
+            "laws": {name: law.describe() for name, law in laws.items()},
             "cut": True,
             "enrichment": True,
-            "multipliers": comps,
-            "tangential_multiplier": comps > 1 and spec.law != "bonded",
-            "solver": solver,
+            "multipliers": sum(c for _, c, _ in problem.space.multiplier_fields),
+            "tangential_multiplier": any(
+                isinstance(law, ContactLaw) and law.multiplier_components(gdim) > 1
+                for law in laws.values()
+            ),
+            "solver": "KSP (one linear solve per load step)"
+            if problem.linear
+            else "SNES (generalized Newton)",
             "pairing": False,
         }
     for load in scene.loads:
@@ -209,7 +206,8 @@ class Result:
     """The output fields of a problem as collapsed Functions, refreshed after each solve.
 
     Plain problems have one field ``u``; cut problems ``u_minus``, ``u_plus`` and,
-    with an interface law that needs one, ``multiplier``.
+    with an interface law that needs one, ``multiplier`` (``multiplier_NAME`` per
+    interface when several have one).
     """
 
     def __init__(self, problem):
@@ -220,9 +218,11 @@ class Result:
             self._maps = [None]
         else:
             W = problem.space.W
+            fields = problem.space.multiplier_fields
             self.names = ["u_minus", "u_plus"]
-            if problem.space.has_multiplier:
-                self.names.append("multiplier")
+            self.names += [
+                "multiplier" if len(fields) == 1 else f"multiplier_{name}" for _, _, name in fields
+            ]
             self.fields, self._maps = [], []
             for i, name in enumerate(self.names):
                 V, dofs = W.sub(i).collapse()
@@ -329,7 +329,13 @@ def run(
     if not problem.linear:
         summary["contact_status"] = status
         summary["newton_residuals"] = residuals
-        summary["interface_samples"] = problem.interface_samples()
+    if not isinstance(problem, PlainElasticityProblem):
+        samples = {name: problem.interface_samples(name) for name in problem.laws}
+        summary["interfaces"] = {
+            name: law.describe() | {"samples": samples[name]} for name, law in problem.laws.items()
+        }
+        if not problem.linear and len(samples) == 1:
+            summary["interface_samples"] = next(iter(samples.values()))
     summary["forms_compiled"] = len(forms._cache) - compiled_before
     cut_timings = getattr(getattr(problem, "cut", None), "timings", {})
     timings = dict(cut_timings) | {

@@ -225,17 +225,16 @@ def load_scene(
 
 
 def _check_shared(interfaces: list[InterfaceSpec]) -> None:
-    """Interfaces of one scene are cut as one level set (the union of their insides):
-    they must agree in law, parameters and materials."""
+    """Interfaces of one scene lie in one body: they must agree in the outside
+    material and the kinematics (laws, their options and inside materials may differ)."""
     for k, spec in enumerate(interfaces[1:], start=1):
         for key in SHARED_INTERFACE_KEYS:
             mine, first = getattr(spec, key), getattr(interfaces[0], key)
             if mine != first:
                 raise NotImplementedError(
                     f"interfaces[{k}].{key} = {mine!r} differs from interfaces[0].{key} = "
-                    f"{first!r}: the interfaces of one scene are cut as one level set (the "
-                    f"union of their insides) and must share {list(SHARED_INTERFACE_KEYS)}; "
-                    "interfaces with different laws or materials are not available yet"
+                    f"{first!r}: the interfaces of one scene lie in one body and must share "
+                    f"{list(SHARED_INTERFACE_KEYS)}"
                 )
     names = [spec.name for spec in interfaces]
     if len(set(names)) != len(names):

@@ -9,10 +9,10 @@ from __future__ import annotations
 import dataclasses
 import pathlib
 
+from xfem_contact.mechanics.laws import CONTACT_LAWS, LINEAR_LAWS
 from xfem_contact.mechanics.materials import Material
-from xfem_contact.mechanics.presets import CONTACT_LAWS, INTERFACE_LAWS
 
-LAWS = INTERFACE_LAWS + CONTACT_LAWS
+LAWS = LINEAR_LAWS + CONTACT_LAWS
 SHAPES = ("circle", "ellipse", "line", "half-plane", "expression")
 LOAD_TYPES = ("pressure", "traction", "displacement", "point_displacement", "body_force")
 KINEMATICS = ("small", "large")
@@ -23,16 +23,9 @@ BUILTIN_PARTS = {
     "annulus": ("inner", "outer", "boundary"),
     "gmsh": ("boundary",),  # plus the file's named 1-D physical groups
 }
-#: Keys in which the interfaces of one scene must agree (they are cut as one level set)
-SHARED_INTERFACE_KEYS = (
-    "law",
-    "friction",
-    "augmentation",
-    "lbb",
-    "kinematics",
-    "inside",
-    "outside",
-)
+#: Keys in which the interfaces of one scene must agree: they lie in one body (the
+#: outside material) and share the kinematics; laws and inside materials may differ
+SHARED_INTERFACE_KEYS = ("kinematics", "outside")
 
 #: Allowed keys of each table, with their meaning (the schema in one place)
 SCHEMA = {
