@@ -6,6 +6,7 @@ import xfem_contact
 
 # isort: split
 import dolfinx.fem
+import dolfinx.mesh
 import numpy as np
 import pytest
 from mpi4py import MPI
@@ -270,9 +271,11 @@ def test_two_inclusions_under_hydrostatic_pressure():
     assert abs(total - sum(length(c) for c in alone)) < 1e-13
     assert abs(total - 2 * 2 * np.pi * 0.12) < 1e-3 * total
     summary = run(scene, log=None)
-    s = {k: np.array(v) for k, v in summary["interface_samples"].items()}
-    assert (s["x"] < 0.5).any() and (s["x"] > 0.5).any()  # both interfaces in contact
-    assert np.all(np.abs(s["P_n"] + 1.0) < 2e-2)
+    assert "interface_samples" not in summary  # one set of samples per interface instead
+    for name, side in (("inc0", -1), ("inc1", 1)):
+        s = {k: np.array(v) for k, v in summary["interfaces"][name]["samples"].items()}
+        assert np.all(np.sign(s["x"] - 0.5) == side)  # the samples of that interface only
+        assert np.all(np.abs(s["P_n"] + 1.0) < 2e-2)
 
 
 @pytest.mark.parametrize(
@@ -281,13 +284,78 @@ def test_two_inclusions_under_hydrostatic_pressure():
         ({"centre": [0.3, 0.5]}, ValueError, "overlap"),  # intersecting
         ({"centre": [0.28, 0.5], "radius": 0.05}, ValueError, "overlap"),  # nested
         ({"centre": [0.5, 0.5]}, ValueError, "cut the same"),  # 1 mesh cell apart
-        ({"law": "bonded"}, NotImplementedError, "interfaces\\[1\\].law"),
+        ({"outside": "other"}, NotImplementedError, "interfaces\\[1\\].outside"),
         ({"name": "inc0"}, ValueError, "unique"),
     ],
 )
 def test_several_interfaces_errors(change, error, message):
+    data = two_inclusions(**change)
+    data["materials"]["other"] = {"E": 1e9, "nu": 0.0}
     with pytest.raises(error, match=message):
-        build(load_scene(two_inclusions(**change)))
+        build(load_scene(data))
+
+
+def two_laws(which=("bonded", "coulomb")) -> dict:
+    """A plate under uniform compression with a bonded inclusion (left) and a Coulomb
+    inclusion (right, friction 1: it sticks), both of the plate's material, far apart;
+    ``which`` keeps one or both. The exact stress is uniform, diag(-1, -2) Pa."""
+    data = base()
+    data["mesh"] = {"corners": [[0, 0], [2, 1]], "cells": [20, 10]}
+    specs = {
+        "bonded": {"name": "bonded", "centre": [0.5, 0.5], "law": "bonded"},
+        "coulomb": {"name": "coulomb", "centre": [1.5, 0.5], "law": "coulomb", "friction": 1.0},
+    }
+    data["interfaces"] = [{"shape": "circle", "radius": 0.2} | specs[k] for k in which]
+    data["loads"] = [
+        {"part": "left", "type": "pressure", "value": 1.0},
+        {"part": "right", "type": "pressure", "value": 1.0},
+        {"part": "bottom", "type": "pressure", "value": 2.0},
+        {"part": "top", "type": "pressure", "value": 2.0},
+        {"type": "point_displacement", "point": [1.0, 0.0], "component": 0, "value": 0.0},
+        {"type": "point_displacement", "point": [1.0, 1.0], "component": 0, "value": 0.0},
+        {"type": "point_displacement", "point": [0.0, 0.5], "component": 1, "value": 0.0},
+    ]
+    return data
+
+
+def test_two_laws_in_one_plate_equal_each_law_alone():
+    """Each interface keeps its own law, multiplier field, measure and samples: with both
+    inclusions of the plate's material the stress stays uniform, so the two-law scene
+    gives each interface the multipliers of that law's one-inclusion scene."""
+    both = run(load_scene(two_laws()), log=None)
+    assert both["effects"]["laws"]["bonded"]["law"] == "bonded"
+    assert both["effects"]["laws"]["coulomb"]["friction"] == 1.0
+    assert both["fields"] == ["u_minus", "u_plus", "multiplier_bonded", "multiplier_coulomb"]
+    assert both["effects"]["solver"].startswith("SNES")
+    for name in ("bonded", "coulomb"):
+        alone = run(load_scene(two_laws((name,))), log=None)
+        a, b = (s["interfaces"][name]["samples"] for s in (both, alone))
+        order_a, order_b = (np.lexsort(np.round([s["x"], s["y"]], 10)) for s in (a, b))
+        scale = np.abs(b["lambda_n"]).max()  # the traction scale (2 Pa)
+        for key in ("lambda_n", "lambda_t"):
+            x, y = np.array(a[key])[order_a], np.array(b[key])[order_b]
+            assert x.size == y.size > 0
+            assert np.abs(x - y).max() < 1e-6 * scale, (name, key)
+        theta = np.arctan2(
+            np.array(a["y"]) - 0.5, np.array(a["x"]) - (0.5 if name == "bonded" else 1.5)
+        )
+        exact = -1.5 + 0.5 * np.cos(2 * theta)  # n.sigma.n of diag(-1, -2)
+        assert np.abs(np.array(a["lambda_n"]) - exact).max() < 0.05
+
+
+def test_materials_differ_by_inclusion():
+    """The bundled two-inclusion scene: the stiff material only inside its own inclusion."""
+    scene = load_scene(bundled_scenes()["two_inclusions"])
+    problem, effects = build(scene)
+    E = problem.materials[-1].E  # a DG0 field: side -1 holds two materials
+    cut = problem.cut
+    x = dolfinx.mesh.compute_midpoints(cut.mesh, 2, np.arange(cut.cell_sides.size, dtype=np.int32))
+    inside_a = np.hypot(x[:, 0] - 0.5, x[:, 1] - 0.5) < 0.15
+    inside_b = np.hypot(x[:, 0] - 1.5, x[:, 1] - 0.5) < 0.15
+    values = E.x.array[E.function_space.dofmap.list[: cut.cell_sides.size, 0]]
+    assert np.all(values[inside_a] == 1e9) and np.all(values[inside_b] == 100e6)
+    assert effects["interfaces"] == ["bonded_stiff", "coulomb"]
+    assert set(effects["laws"]) == {"bonded_stiff", "coulomb"}
 
 
 # -- gmsh meshes ----------------------------------------------------------------------------
