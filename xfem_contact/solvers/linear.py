@@ -14,12 +14,7 @@ from petsc4py import PETSc
 
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.restriction import restriction_matrix
-
-DEFAULT_PETSC_OPTIONS = {
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-}
+from xfem_contact.solvers.options import merged_options, set_petsc_options
 
 
 def assemble_restricted(
@@ -78,8 +73,8 @@ def solve_restricted(
         L: Linear form on ``space.W``.
         bcs: Dirichlet conditions on ``space.W``.
         space: The enriched space; the solution lives on ``space.W``.
-        petsc_options: Overrides of the linear solver defaults
-            (:func:`xfem_contact.solvers.options.petsc_options`), without prefix.
+        petsc_options: PETSc options (without prefix) overriding the ``"linear"``
+            defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
         petsc_options_prefix: Prefix of the KSP options in the PETSc options database.
         R: Restriction operator, global shape ``(dim W, n_reduced)``; by default
             ``restriction_matrix(space)`` (the active dofs), built and destroyed
@@ -99,9 +94,7 @@ def solve_restricted(
     ksp = PETSc.KSP().create(A.getComm())
     ksp.setOperators(A)
     ksp.setOptionsPrefix(petsc_options_prefix)
-    opts = PETSc.Options()
-    for key, value in {**DEFAULT_PETSC_OPTIONS, **(petsc_options or {})}.items():
-        opts[f"{petsc_options_prefix}{key}"] = value
+    set_petsc_options(petsc_options_prefix, merged_options("linear", petsc_options))
     ksp.setFromOptions()
     y = R.createVecRight()
     ksp.solve(b, y)

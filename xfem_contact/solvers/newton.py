@@ -20,18 +20,7 @@ import ufl
 from petsc4py import PETSc
 
 from xfem_contact.fem.forms import form
-
-DEFAULT_SNES_OPTIONS = {
-    "snes_type": "newtonls",
-    "snes_linesearch_type": "basic",
-    "snes_rtol": 1e-10,
-    "snes_atol": 1e-12,
-    "snes_stol": 0.0,
-    "snes_max_it": 30,
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-}
+from xfem_contact.solvers.options import merged_options, set_petsc_options
 
 
 @dataclasses.dataclass
@@ -76,7 +65,8 @@ class RestrictedNewton:
         w: The unknown (full mixed space); updated in place.
         bcs: Dirichlet conditions on the full space.
         R: Restriction operator (full x reduced), see :mod:`xfem_contact.fem.restriction`.
-        petsc_options: Overrides of :data:`DEFAULT_SNES_OPTIONS`.
+        petsc_options: PETSc options (without prefix) overriding the ``"newton"``
+            defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
         petsc_options_prefix: Prefix of the SNES options.
         status: Called with ``w`` at every iterate; returns a dict shown in the log.
         log: Called with each log line (e.g. ``print``); ``None`` for silence.
@@ -105,9 +95,7 @@ class RestrictedNewton:
         self.J_r = self.A.PtAP(R)
         self.snes = PETSc.SNES().create(R.getComm())
         self.snes.setOptionsPrefix(petsc_options_prefix)
-        opts = PETSc.Options()
-        for key, value in {**DEFAULT_SNES_OPTIONS, **(petsc_options or {})}.items():
-            opts[f"{petsc_options_prefix}{key}"] = value
+        set_petsc_options(petsc_options_prefix, merged_options("newton", petsc_options))
         self.snes.setFromOptions()
         # PETSc keeps its callbacks alive, and the garbage collector cannot see through
         # PETSc objects: callbacks hold this object weakly, or it would never be freed.
