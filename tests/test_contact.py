@@ -6,8 +6,8 @@ import pytest
 from mpi4py import MPI
 
 from xfem_contact.cases.paper import inclusion_errors, inclusion_problem
-from xfem_contact.mechanics.presets import ContactProblem
 from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.presets import ContactProblem
 from xfem_contact.solvers.newton import NewtonFailure
 
 SIZES = [10, 20, 40]

@@ -15,9 +15,10 @@ from xfem_contact.cases.paper import (
     straight_interface_exact,
     straight_interface_problem,
 )
-from xfem_contact.mechanics.presets import ElasticityProblem
+from xfem_contact.fem.restriction import restriction_matrix
 from xfem_contact.mechanics.materials import Material
-from xfem_contact.solvers.linear import assemble_restricted
+from xfem_contact.mechanics.presets import ElasticityProblem
+from xfem_contact.solvers.linear import assemble_restricted, solve_restricted
 
 
 def integrate(expr):
@@ -117,14 +118,15 @@ def condition_number(eta, degree, n=6):
     cut = xfem_contact.CutMesh(mesh, lambda x: x[1] - y0, degree=1)
     problem = ElasticityProblem(cut, degree, Material(1.0, 0.3), "free")
     problem.add_displacement(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 0.0)
-    A, b, index_set = assemble_restricted(
+    R = restriction_matrix(problem.space)
+    A, b = assemble_restricted(
         xfem_contact.form(problem.bilinear_form()),
         xfem_contact.form(problem.linear_form()),
         problem._bcs,
-        problem.space,
+        R,
     )
     dense = A.convert("dense").getDenseArray().copy()
-    for obj in (A, b, index_set):
+    for obj in (A, b, R):
         obj.destroy()
     return np.linalg.cond(dense)
 
@@ -135,6 +137,27 @@ def test_condition_number_bounded_under_tiny_cuts(degree):
     ratios = [condition_number(eta, degree) / reference for eta in 10.0 ** -np.arange(1, 11)]
     print(f"\ndegree {degree}: cond(eta)/cond(0.5) for eta = 1e-1..1e-10:", np.round(ratios, 2))
     assert max(ratios) < 10.0
+
+
+@pytest.mark.mpi
+def test_solve_with_a_given_restriction_operator():
+    """An explicit R (here the default one) gives the same solution and is not destroyed."""
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 6, 6)
+    cut = xfem_contact.CutMesh(mesh, lambda x: x[1] - 0.55, degree=1)
+    problem = ElasticityProblem(cut, 1, Material(1.0, 0.3), "bonded")
+    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
+    problem.add_displacement(lambda x: np.isclose(x[1], 1.0), 0.01)
+    a = xfem_contact.form(problem.bilinear_form())
+    L = xfem_contact.form(problem.linear_form())
+    w, _ = solve_restricted(a, L, problem._bcs, problem.space)
+    R = restriction_matrix(problem.space)
+    w_R, reason = solve_restricted(a, L, problem._bcs, problem.space, R=R)
+    assert reason > 0
+    scale = mesh.comm.allreduce(np.abs(w.x.array).max(), op=MPI.MAX)
+    assert scale > 0.0
+    np.testing.assert_allclose(w_R.x.array, w.x.array, rtol=0, atol=1e-12 * scale)
+    assert R.getSize()[1] == problem.space.dof_counts().total
+    R.destroy()
 
 
 # -- input errors --------------------------------------------------------------------

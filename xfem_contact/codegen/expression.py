@@ -1,5 +1,5 @@
 """Expression code generation: FFCx's C generator, unchanged."""
 
-from ffcx.codegeneration.C.expression import generator
+from xfem_contact.codegen.compat import c_expression_generator as generator
 
 __all__ = ["generator"]

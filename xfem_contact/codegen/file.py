@@ -1,5 +1,6 @@
 """File-level code generation: FFCx's C generator, unchanged."""
 
-from ffcx.codegeneration.C.file import generator, suffixes
+from xfem_contact.codegen.compat import c_file_generator as generator
+from xfem_contact.codegen.compat import c_file_suffixes as suffixes
 
 __all__ = ["generator", "suffixes"]

@@ -1,5 +1,5 @@
 """Form code generation: FFCx's C generator, unchanged."""
 
-from ffcx.codegeneration.C.form import generator
+from xfem_contact.codegen.compat import c_form_generator as generator
 
 __all__ = ["generator"]

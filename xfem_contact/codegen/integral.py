@@ -12,12 +12,10 @@ from __future__ import annotations
 
 import contextlib
 
-import ffcx.codegeneration.C.integral as c_integral
-import ffcx.codegeneration.lnodes as L
 import numpy as np
-from ffcx.codegeneration.integral_generator import IntegralGenerator
-from ffcx.ir.elementtables import piecewise_ttypes
 
+from xfem_contact.codegen.compat import IntegralGenerator, c_integral, piecewise_ttypes
+from xfem_contact.codegen.compat import lnodes as L
 from xfem_contact.codegen.tables import RuntimeIntegral, runtime_integral
 
 _NQ = "xc_nq"

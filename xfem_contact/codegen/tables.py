@@ -12,12 +12,12 @@ import typing
 import numpy as np
 import numpy.typing as npt
 import ufl
-from ffcx.ir.elementtables import (
+
+from xfem_contact.codegen.compat import (
     get_ffcx_table_values,
     get_modified_terminal_element,
     piecewise_ttypes,
 )
-
 from xfem_contact.codegen.runtime_abi import is_marker_element, is_placeholder_rule, kernel_key
 
 

@@ -5,7 +5,8 @@ field as one displacement per side, ``u = u_-`` on side -1 and ``u = u_+`` on
 side +1, each living on the cells its side touches. We use the latter: a mixed
 space ``(u_-, u_+[, lambda])`` whose dofs outside the support of their side (or,
 for the multiplier, outside the cut cells) are *inactive* and removed from every
-solve by a PETSc index set: the system has exactly standard + enriched dofs.
+solve by the restriction operator of :mod:`xfem_contact.fem.restriction`: the
+system has exactly standard + enriched dofs.
 """
 
 from __future__ import annotations
@@ -20,7 +21,6 @@ import numpy as np
 import numpy.typing as npt
 import ufl
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from xfem_contact.fem.cutmesh import CutMesh
 
@@ -160,13 +160,6 @@ class EnrichedSpace:
     def active(self) -> npt.NDArray[np.bool_]:
         """Active flags of the local (owned + ghost) dofs of ``W``."""
         return self._active
-
-    def index_set(self) -> PETSc.IS:
-        """Global indices of the active owned dofs (collective use)."""
-        imap, bs = self.W.dofmap.index_map, self.W.dofmap.index_map_bs
-        nowned = imap.size_local * bs
-        local = np.flatnonzero(self._active[:nowned]).astype(PETSc.IntType)
-        return PETSc.IS().createGeneral(local + imap.local_range[0] * bs, comm=imap.comm)
 
     def dof_counts(self) -> DofCounts:
         """Global active dof counts: standard, enriched and multiplier."""

@@ -19,11 +19,9 @@ import numpy as np
 import ufl
 from dolfinx.fem import IntegralType
 from dolfinx.fem.forms import CompiledForm, compile_form, create_form, get_integration_domains
-from ffcx.analysis import analyze_ufl_objects
-from ffcx.ir.representation import compute_ir
-from ffcx.options import get_options
 
 from xfem_contact.codegen import LANGUAGE
+from xfem_contact.codegen.compat import analyze_ufl_objects, compute_ir, get_options
 from xfem_contact.codegen.tables import RuntimeIntegral, runtime_integral
 from xfem_contact.quadrature.cell_rules import CellRules
 

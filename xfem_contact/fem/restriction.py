@@ -3,8 +3,10 @@
 Full dofs ``x = R y``: ``R`` selects the active dofs of an
 :class:`~xfem_contact.fem.enrichment.EnrichedSpace` (identity columns) and, where a
 multiplier prolongation is given (LBB restriction, :mod:`xfem_contact.mechanics.lbb`),
-expresses multiplier dofs as combinations of fewer reduced unknowns. Systems are
-solved as ``R^T J R y = -R^T F``. Collective.
+expresses multiplier dofs as combinations of fewer reduced unknowns. Both solvers
+use it: the linear solves (:mod:`xfem_contact.solvers.linear`) solve
+``R^T A R y = R^T b``, Newton (:mod:`xfem_contact.solvers.newton`) solves
+``R^T J R dy = -R^T F``.
 """
 
 from __future__ import annotations
@@ -18,6 +20,11 @@ from xfem_contact.fem.enrichment import EnrichedSpace
 
 class MultiplierProlongation:
     """Multiplier dofs as combinations of reduced unknowns (local rows, global columns).
+
+    The process-local part of a sparse ``(m, n_mult)`` matrix in coordinate form:
+    row ``k`` expresses the multiplier dof ``dofs[k]`` of ``W`` in the
+    ``n_mult`` (global) reduced multiplier unknowns, of which this process owns
+    ``num_owned`` (consecutive, in rank order). Not collective.
 
     Attributes:
         dofs: Local (owned) multiplier dofs of ``W`` the prolongation replaces, ``(m,)``.
@@ -38,13 +45,22 @@ class MultiplierProlongation:
 def restriction_matrix(
     space: EnrichedSpace, prolongation: MultiplierProlongation | None = None
 ) -> PETSc.Mat:
-    """Build ``R`` (global sizes: full dofs x reduced unknowns). Collective.
+    """Build the restriction operator ``R`` with ``x = R y``. Collective.
+
+    Columns (reduced unknowns) are numbered process by process: on each, first
+    its owned active dofs in increasing order (an identity column each), then
+    its ``prolongation.num_owned`` multiplier unknowns.
 
     Args:
-        space: The enriched space (its active dofs).
+        space: The enriched space; its active owned dofs are kept.
         prolongation: Optional multiplier prolongation; its dofs are removed
-            from the identity part and replaced by its entries, whose column
-            numbers follow all active (non-prolongated) dofs.
+            from the identity part and replaced by its entries.
+
+    Returns:
+        ``R`` as a PETSc AIJ matrix of global shape ``(dim W, n_reduced)``;
+        its rows are laid out as the dofs of ``space.W`` (owned dofs of each
+        process), its columns as the reduced unknowns above. The caller
+        destroys it.
     """
     imap, bs = space.W.dofmap.index_map, space.W.dofmap.index_map_bs
     comm = imap.comm

@@ -11,6 +11,9 @@ import pathlib
 
 from xfem_contact.mechanics.laws import CONTACT_LAWS, LINEAR_LAWS
 from xfem_contact.mechanics.materials import Material
+from xfem_contact.solvers.options import defaults
+
+_NEWTON = defaults("newton")  # the [solver] defaults are the Newton solver's
 
 LAWS = LINEAR_LAWS + CONTACT_LAWS
 SHAPES = ("circle", "ellipse", "line", "half-plane", "expression")
@@ -70,9 +73,9 @@ SCHEMA = {
     },
     "solver": {
         "load_steps": "number of equal load steps (>= 1, default 1)",
-        "max_iterations": "Newton iterations per step (default 30)",
-        "rtol": "relative Newton tolerance (default 1e-10)",
-        "atol": "absolute Newton tolerance (default 1e-12)",
+        "max_iterations": f"Newton iterations per step (default {_NEWTON['snes_max_it']})",
+        "rtol": f"relative Newton tolerance (default {_NEWTON['snes_rtol']})",
+        "atol": f"absolute Newton tolerance (default {_NEWTON['snes_atol']})",
         "petsc": "table of extra PETSc options (without prefix)",
     },
     "part": {"where": "boolean expression of x, y selecting boundary facets"},

@@ -1,4 +1,10 @@
-"""Linear solves restricted to the active dofs of an enriched space (PETSc KSP)."""
+"""Linear solves on the reduced space ``y`` with ``x = R y`` (PETSc KSP).
+
+The same restriction as :class:`~xfem_contact.solvers.newton.RestrictedNewton`:
+``a`` and ``L`` are assembled on the full mixed space with Dirichlet conditions
+and reduced with the operator ``R`` of :mod:`xfem_contact.fem.restriction`,
+``A_r = R^T A R`` (PETSc PtAP) and ``b_r = R^T b``; the solution is ``x = R y``.
+"""
 
 from __future__ import annotations
 
@@ -7,25 +13,33 @@ import dolfinx.fem.petsc
 from petsc4py import PETSc
 
 from xfem_contact.fem.enrichment import EnrichedSpace
-
-DEFAULT_PETSC_OPTIONS = {
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-}
+from xfem_contact.fem.restriction import restriction_matrix
+from xfem_contact.solvers.options import merged_options, set_petsc_options
 
 
 def assemble_restricted(
     a: dolfinx.fem.Form,
     L: dolfinx.fem.Form,
     bcs: list[dolfinx.fem.DirichletBC],
-    space: EnrichedSpace,
-) -> tuple[PETSc.Mat, PETSc.Vec, PETSc.IS]:
-    """Assemble ``a``, ``L`` with Dirichlet conditions, keep the active dofs. Collective.
+    R: PETSc.Mat,
+) -> tuple[PETSc.Mat, PETSc.Vec]:
+    """Assemble ``a`` and ``L`` with Dirichlet conditions and reduce them by ``R``.
+
+    Collective.
+
+    Args:
+        a: Bilinear form on the full mixed space ``W`` (test and trial).
+        L: Linear form on ``W``.
+        bcs: Dirichlet conditions on ``W``, applied as
+            :func:`dolfinx.fem.petsc.assemble_matrix` (unit diagonal) and
+            :func:`dolfinx.fem.petsc.set_bc` do.
+        R: Restriction operator, global shape ``(dim W, n_reduced)``, see
+            :func:`xfem_contact.fem.restriction.restriction_matrix`. Not modified.
 
     Returns:
-        The restricted matrix and right-hand side, and the index set of the
-        active dofs in the full space (caller destroys all three).
+        The reduced matrix ``R^T A R``, global shape ``(n_reduced, n_reduced)``,
+        and right-hand side ``R^T b``, global size ``n_reduced``, both laid out
+        as the columns of ``R``. The caller destroys both.
     """
     A = dolfinx.fem.petsc.assemble_matrix(a, bcs=bcs)
     A.assemble()
@@ -33,14 +47,12 @@ def assemble_restricted(
     dolfinx.fem.petsc.apply_lifting(b, [a], bcs=[bcs])
     b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     dolfinx.fem.petsc.set_bc(b, bcs)
-    index_set = space.index_set()
-    A_r = A.createSubMatrix(index_set, index_set)
-    sub = b.getSubVector(index_set)
-    b_r = sub.copy()
-    b.restoreSubVector(index_set, sub)
+    A_r = A.PtAP(R)
+    b_r = R.createVecRight()
+    R.multTranspose(b, b_r)
     A.destroy()
     b.destroy()
-    return A_r, b_r, index_set
+    return A_r, b_r
 
 
 def solve_restricted(
@@ -50,30 +62,48 @@ def solve_restricted(
     space: EnrichedSpace,
     petsc_options: dict | None = None,
     petsc_options_prefix: str = "xfem_linear_",
+    R: PETSc.Mat | None = None,
 ) -> tuple[dolfinx.fem.Function, int]:
-    """Solve ``a(u, v) = L(v)`` on the active dofs (one KSP solve). Collective.
+    """Solve ``a(u, v) = L(v)`` on the reduced space of ``R`` (one KSP solve).
+
+    Collective.
+
+    Args:
+        a: Bilinear form on ``space.W``.
+        L: Linear form on ``space.W``.
+        bcs: Dirichlet conditions on ``space.W``.
+        space: The enriched space; the solution lives on ``space.W``.
+        petsc_options: PETSc options (without prefix) overriding the ``"linear"``
+            defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
+        petsc_options_prefix: Prefix of the KSP options in the PETSc options database.
+        R: Restriction operator, global shape ``(dim W, n_reduced)``; by default
+            ``restriction_matrix(space)`` (the active dofs), built and destroyed
+            here. A given ``R`` is not destroyed.
 
     Returns:
-        The solution in the full mixed space (inactive dofs zero) and the
-        KSP's converged reason.
+        The solution ``x = R y`` on ``space.W`` (zero on inactive dofs, ghosts
+        updated) and the KSP's converged reason (> 0).
+
+    Raises:
+        RuntimeError: The KSP diverged (converged reason < 0).
     """
-    A, b, index_set = assemble_restricted(a, L, bcs, space)
+    own_R = R is None
+    if own_R:
+        R = restriction_matrix(space)
+    A, b = assemble_restricted(a, L, bcs, R)
     ksp = PETSc.KSP().create(A.getComm())
     ksp.setOperators(A)
     ksp.setOptionsPrefix(petsc_options_prefix)
-    opts = PETSc.Options()
-    for key, value in {**DEFAULT_PETSC_OPTIONS, **(petsc_options or {})}.items():
-        opts[f"{petsc_options_prefix}{key}"] = value
+    set_petsc_options(petsc_options_prefix, merged_options("linear", petsc_options))
     ksp.setFromOptions()
+    y = R.createVecRight()
+    ksp.solve(b, y)
     w = dolfinx.fem.Function(space.W)
-    x = w.x.petsc_vec
-    x_r = x.getSubVector(index_set)
-    ksp.solve(b, x_r)
-    x.restoreSubVector(index_set, x_r)
+    R.mult(y, w.x.petsc_vec)
     w.x.scatter_forward()
     reason = ksp.getConvergedReason()
     if reason < 0:
         raise RuntimeError(f"Linear solve failed: KSP converged reason {reason}")
-    for obj in (ksp, A, b, index_set):
+    for obj in (ksp, A, b, y, *([R] if own_R else [])):
         obj.destroy()
     return w, reason

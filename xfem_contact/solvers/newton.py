@@ -2,9 +2,10 @@
 
 Residual and Jacobian are assembled on the full mixed space with Dirichlet
 conditions (as :class:`dolfinx.fem.petsc.NonlinearProblem` does) and reduced:
-``F_r = R^T F(R y)``, ``J_r = R^T J R``. Every iterate is logged (residual norm
-and, through a callback, e.g. the contact status); failure raises with the
-whole history.
+``F_r = R^T F(R y)``, ``J_r = R^T J R`` (PETSc PtAP), the same restriction as the
+linear solves of :mod:`xfem_contact.solvers.linear`. Every iterate is logged
+(residual norm and, through a callback, e.g. the contact status); failure raises
+with the whole history. Default options: :mod:`xfem_contact.solvers.options`.
 """
 
 from __future__ import annotations
@@ -20,23 +21,19 @@ import ufl
 from petsc4py import PETSc
 
 from xfem_contact.fem.forms import form
-
-DEFAULT_SNES_OPTIONS = {
-    "snes_type": "newtonls",
-    "snes_linesearch_type": "basic",
-    "snes_rtol": 1e-10,
-    "snes_atol": 1e-12,
-    "snes_stol": 0.0,
-    "snes_max_it": 30,
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-}
+from xfem_contact.solvers.options import merged_options, set_petsc_options
 
 
 @dataclasses.dataclass
 class NewtonReport:
-    """History of one solve: residual norms and per-iterate status lines."""
+    """History of one solve: residual norms and per-iterate status lines.
+
+    Attributes:
+        residuals: Norm of the reduced residual ``R^T F`` at each iterate, the
+            initial one first (``iterations + 1`` entries).
+        status: The status callback's dict at each iterate (same length).
+        reason: SNES converged reason (> 0 converged, < 0 diverged).
+    """
 
     residuals: list[float] = dataclasses.field(default_factory=list)
     status: list[dict] = dataclasses.field(default_factory=list)
@@ -47,9 +44,11 @@ class NewtonReport:
 
     @property
     def iterations(self) -> int:
+        """Number of Newton steps taken."""
         return max(len(self.residuals) - 1, 0)
 
     def table(self) -> str:
+        """The history, one line per iterate. Not collective."""
         lines = []
         for k, r in enumerate(self.residuals):
             extra = self.status[k] if k < len(self.status) else {}
@@ -69,16 +68,25 @@ class NewtonFailure(RuntimeError):
 
 
 class RestrictedNewton:
-    """Solve ``F(w; v) = 0`` for ``w`` on the reduced space of ``R``.
+    """Solve ``F(w; v) = 0`` for ``w = R y`` on the reduced space of ``R``.
+
+    Construction is collective (it compiles the forms, assembles the Jacobian
+    once for the sparsity of ``R^T J R`` and creates the SNES). The reduced
+    iterate ``y`` starts at zero and is kept between calls of :meth:`solve`.
 
     Args:
-        residual: UFL residual form, linear in the test function.
-        w: The unknown (full mixed space); updated in place.
-        bcs: Dirichlet conditions on the full space.
-        R: Restriction operator (full x reduced), see :mod:`xfem_contact.fem.restriction`.
-        petsc_options: Overrides of :data:`DEFAULT_SNES_OPTIONS`.
-        petsc_options_prefix: Prefix of the SNES options.
-        status: Called with ``w`` at every iterate; returns a dict shown in the log.
+        residual: UFL residual form, linear in the test function, on the full
+            mixed space ``W`` of ``w``.
+        w: The unknown on ``W``; set to ``R y`` at every iterate and after the solve.
+        bcs: Dirichlet conditions on ``W``.
+        R: Restriction operator, global shape ``(dim W, n_reduced)``, see
+            :func:`xfem_contact.fem.restriction.restriction_matrix`. Kept, not
+            copied, and not destroyed by :meth:`destroy`.
+        petsc_options: PETSc options (without prefix) overriding the ``"newton"``
+            defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
+        petsc_options_prefix: Prefix of the SNES options in the PETSc options database.
+        status: Called with ``w`` at every iterate, on every process; returns a
+            dict shown in the log.
         log: Called with each log line (e.g. ``print``); ``None`` for silence.
     """
 
@@ -105,9 +113,7 @@ class RestrictedNewton:
         self.J_r = self.A.PtAP(R)
         self.snes = PETSc.SNES().create(R.getComm())
         self.snes.setOptionsPrefix(petsc_options_prefix)
-        opts = PETSc.Options()
-        for key, value in {**DEFAULT_SNES_OPTIONS, **(petsc_options or {})}.items():
-            opts[f"{petsc_options_prefix}{key}"] = value
+        set_petsc_options(petsc_options_prefix, merged_options("newton", petsc_options))
         self.snes.setFromOptions()
         # PETSc keeps its callbacks alive, and the garbage collector cannot see through
         # PETSc objects: callbacks hold this object weakly, or it would never be freed.
@@ -158,7 +164,14 @@ class RestrictedNewton:
             )
 
     def solve(self) -> NewtonReport:
-        """Run SNES from the current reduced iterate. Raises :class:`NewtonFailure`."""
+        """Run SNES from the current reduced iterate. Collective.
+
+        Returns:
+            The history of this solve; ``w`` holds the solution ``R y``.
+
+        Raises:
+            NewtonFailure: SNES did not converge (reason <= 0); it holds the history.
+        """
         self.report = NewtonReport()
         start = time.perf_counter()
         self.snes.solve(None, self.y)
@@ -172,5 +185,6 @@ class RestrictedNewton:
         return self.report
 
     def destroy(self):
+        """Destroy the PETSc objects made here (not ``R``). Collective."""
         for obj in (self.snes, self.A, self.J_r, self.b, self.y, self.F_r):
             obj.destroy()

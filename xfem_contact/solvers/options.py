@@ -1,0 +1,109 @@
+"""Default PETSc options of the solvers, in one table.
+
+:data:`SOLVER_OPTIONS` is declarative, in the style of ``ffcx/options.py``: each
+entry maps a PETSc option name (without prefix) to its type, default value, a
+help string, the allowed values (``None``: whatever PETSc accepts) and the
+solvers it is a default of:
+
+- ``"linear"``: the KSP of :func:`xfem_contact.solvers.linear.solve_restricted`;
+- ``"newton"``: the SNES of :class:`xfem_contact.solvers.newton.RestrictedNewton`
+  (its KSP options are those of the linear solve in every Newton step).
+
+Options given by the caller override these defaults and are passed to PETSc
+unchecked, as are any other PETSc options of the same prefix.
+"""
+
+from __future__ import annotations
+
+import typing
+
+from petsc4py import PETSc
+
+#: The solvers that have defaults in :data:`SOLVER_OPTIONS`
+SOLVERS = ("linear", "newton")
+
+OptionValue = str | int | float
+
+
+class Option(typing.NamedTuple):
+    """One PETSc option: its type, default, meaning and the solvers using the default."""
+
+    type: type
+    default: OptionValue
+    help: str
+    allowed: tuple[OptionValue, ...] | None
+    solvers: tuple[str, ...]
+
+
+_BOTH = ("linear", "newton")
+_NEWTON = ("newton",)
+
+#: Default PETSc options (names without prefix) of the linear and Newton solvers
+SOLVER_OPTIONS: dict[str, Option] = {
+    "ksp_type": Option(
+        str, "preonly", "Krylov method; preonly applies the preconditioner once", None, _BOTH
+    ),
+    "pc_type": Option(str, "lu", "preconditioner; lu is a direct solve", None, _BOTH),
+    "pc_factor_mat_solver_type": Option(
+        str, "mumps", "package of the LU factorisation (MUMPS: also in parallel)", None, _BOTH
+    ),
+    "snes_type": Option(str, "newtonls", "nonlinear solver: Newton's method", None, _NEWTON),
+    "snes_linesearch_type": Option(
+        str, "basic", "line search; basic takes the full Newton step", None, _NEWTON
+    ),
+    "snes_rtol": Option(
+        float, 1e-10, "relative tolerance on the residual norm (reduced space)", None, _NEWTON
+    ),
+    "snes_atol": Option(
+        float, 1e-12, "absolute tolerance on the residual norm (reduced space)", None, _NEWTON
+    ),
+    "snes_stol": Option(
+        float, 0.0, "tolerance on the step relative to the iterate; 0 disables it", None, _NEWTON
+    ),
+    "snes_max_it": Option(int, 30, "maximum number of Newton iterations per solve", None, _NEWTON),
+}
+
+
+def defaults(solver: str) -> dict[str, OptionValue]:
+    """The default PETSc options of one solver. Not collective.
+
+    Args:
+        solver: One of :data:`SOLVERS`.
+
+    Returns:
+        A new dict, option name (without prefix) to default value.
+    """
+    if solver not in SOLVERS:
+        raise ValueError(f"Unknown solver {solver!r}, expected one of {SOLVERS}")
+    return {name: opt.default for name, opt in SOLVER_OPTIONS.items() if solver in opt.solvers}
+
+
+def merged_options(solver: str, overrides: dict | None = None) -> dict[str, OptionValue]:
+    """The defaults of ``solver`` updated by ``overrides``. Not collective.
+
+    Args:
+        solver: One of :data:`SOLVERS`.
+        overrides: PETSc options (names without prefix) that replace or extend
+            the defaults; not checked.
+
+    Returns:
+        A new dict, option name (without prefix) to value.
+    """
+    return {**defaults(solver), **(overrides or {})}
+
+
+def set_petsc_options(prefix: str, options: dict[str, OptionValue]) -> None:
+    """Write ``options`` under ``prefix`` into the global PETSc options database.
+
+    Not collective: each process writes its own database, so call it on every
+    process with the same options before a collective ``setFromOptions``.
+    Options already in the database under ``prefix`` and not in ``options`` are
+    kept.
+
+    Args:
+        prefix: Options prefix, e.g. ``"xfem_linear_"``.
+        options: Option name (without prefix) to value.
+    """
+    database = PETSc.Options()
+    for key, value in options.items():
+        database[f"{prefix}{key}"] = value
