@@ -14,6 +14,19 @@ __version__ = "0.1.0"
 
 from xfem_contact.fem.cutmesh import CutMesh  # noqa: E402
 from xfem_contact.fem.forms import form  # noqa: E402
+from xfem_contact.mechanics.materials import Material  # noqa: E402
+from xfem_contact.mechanics.presets import ContactProblem, ElasticityProblem  # noqa: E402
+from xfem_contact.mechanics.problem import Problem  # noqa: E402
 from xfem_contact.quadrature.cell_rules import CellRules  # noqa: E402
+from xfem_contact.solvers.newton import NewtonFailure  # noqa: E402
 
-__all__ = ["CellRules", "CutMesh", "form"]
+__all__ = [
+    "CellRules",
+    "ContactProblem",
+    "CutMesh",
+    "ElasticityProblem",
+    "Material",
+    "NewtonFailure",
+    "Problem",
+    "form",
+]

@@ -105,6 +105,12 @@ class Problem(Loads):
             name: self._context(name, law_materials[name], fields.get(name)) for name in self.laws
         }
         self._newton: RestrictedNewton | None = None
+        for name, law in self.laws.items():
+            if law.coupling(self.contexts[name]) is not None:
+                raise NotImplementedError(
+                    f"Interface {name!r}: the {law.name!r} law couples two cells, and the "
+                    "Newton solver does not assemble such couplings yet"
+                )
 
     def _context(self, name: str, materials: dict, field: int | None) -> InterfaceContext:
         cut = self.cut
