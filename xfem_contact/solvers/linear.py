@@ -4,6 +4,7 @@ The same restriction as :class:`~xfem_contact.solvers.newton.RestrictedNewton`:
 ``a`` and ``L`` are assembled on the full mixed space with Dirichlet conditions
 and reduced with the operator ``R`` of :mod:`xfem_contact.fem.restriction`,
 ``A_r = R^T A R`` (PETSc PtAP) and ``b_r = R^T b``; the solution is ``x = R y``.
+The solver factors the symmetrically scaled ``D A_r D`` (:mod:`xfem_contact.solvers.scaling`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from petsc4py import PETSc
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.restriction import restriction_matrix
 from xfem_contact.solvers.options import merged_options, set_petsc_options
+from xfem_contact.solvers.scaling import saddle_point_scaling
 
 
 def assemble_restricted(
@@ -91,6 +93,9 @@ def solve_restricted(
     if own_R:
         R = restriction_matrix(space)
     A, b = assemble_restricted(a, L, bcs, R)
+    D = saddle_point_scaling(A)  # solve D A D y_s = D b, y = D y_s
+    A.diagonalScale(D, D)
+    b.pointwiseMult(b, D)
     ksp = PETSc.KSP().create(A.getComm())
     ksp.setOperators(A)
     ksp.setOptionsPrefix(petsc_options_prefix)
@@ -98,12 +103,13 @@ def solve_restricted(
     ksp.setFromOptions()
     y = R.createVecRight()
     ksp.solve(b, y)
+    y.pointwiseMult(y, D)
     w = dolfinx.fem.Function(space.W)
     R.mult(y, w.x.petsc_vec)
     w.x.scatter_forward()
     reason = ksp.getConvergedReason()
     if reason < 0:
         raise RuntimeError(f"Linear solve failed: KSP converged reason {reason}")
-    for obj in (ksp, A, b, y, *([R] if own_R else [])):
+    for obj in (ksp, A, b, y, D, *([R] if own_R else [])):
         obj.destroy()
     return w, reason

@@ -22,6 +22,7 @@ from petsc4py import PETSc
 
 from xfem_contact.fem.forms import form
 from xfem_contact.solvers.options import merged_options, set_petsc_options
+from xfem_contact.solvers.scaling import scaled_restriction
 
 
 @dataclasses.dataclass
@@ -71,8 +72,11 @@ class RestrictedNewton:
     """Solve ``F(w; v) = 0`` for ``w = R y`` on the reduced space of ``R``.
 
     Construction is collective (it compiles the forms, assembles the Jacobian
-    once for the sparsity of ``R^T J R`` and creates the SNES). The reduced
-    iterate ``y`` starts at zero and is kept between calls of :meth:`solve`.
+    once, for the sparsity of ``R^T J R`` and the scaling ``D`` of
+    :mod:`xfem_contact.solvers.scaling`, and creates the SNES). SNES iterates on the
+    scaled unknowns ``y`` with ``w = R D y``, so the residual norms it reports are
+    those of ``D R^T F``. The iterate ``y`` starts at zero and is kept between calls
+    of :meth:`solve`.
 
     Args:
         residual: UFL residual form, linear in the test function, on the full
@@ -80,8 +84,8 @@ class RestrictedNewton:
         w: The unknown on ``W``; set to ``R y`` at every iterate and after the solve.
         bcs: Dirichlet conditions on ``W``.
         R: Restriction operator, global shape ``(dim W, n_reduced)``, see
-            :func:`xfem_contact.fem.restriction.restriction_matrix`. Kept, not
-            copied, and not destroyed by :meth:`destroy`.
+            :func:`xfem_contact.fem.restriction.restriction_matrix`. Not modified:
+            the solver keeps its own scaled copy ``R D`` (:attr:`R`).
         petsc_options: PETSc options (without prefix) overriding the ``"newton"``
             defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
         petsc_options_prefix: Prefix of the SNES options in the PETSc options database.
@@ -110,7 +114,12 @@ class RestrictedNewton:
         self.F_r = R.createVecRight()
         self.status, self.log = status, log
         self._assemble_jacobian()
-        self.J_r = self.A.PtAP(R)
+        # Solve for y_s with x = R D y_s, D the scaling of the first Jacobian (well
+        # scaled saddle points: see xfem_contact.solvers.scaling)
+        first = self.A.PtAP(R)
+        self.R = scaled_restriction(R, first)
+        first.destroy()
+        self.J_r = self.A.PtAP(self.R)
         self.snes = PETSc.SNES().create(R.getComm())
         self.snes.setOptionsPrefix(petsc_options_prefix)
         set_petsc_options(petsc_options_prefix, merged_options("newton", petsc_options))
@@ -186,5 +195,5 @@ class RestrictedNewton:
 
     def destroy(self):
         """Destroy the PETSc objects made here (not ``R``). Collective."""
-        for obj in (self.snes, self.A, self.J_r, self.b, self.y, self.F_r):
+        for obj in (self.snes, self.A, self.J_r, self.b, self.y, self.F_r, self.R):
             obj.destroy()
