@@ -2,13 +2,13 @@
 
 A FEniCSx (DOLFINx 0.11) plugin. Import it before or after ``dolfinx``: the
 PyPI wheel ``dolfinx-solver-real`` needs ``dolfinx_solver`` imported first, which
-is done here when that wheel is installed.
+the start-up hook installed with this package does before any ``import dolfinx``
+(see ``xfem_contact/_bootstrap.py``), and which is done here too.
 """
 
-try:  # The PyPI wheel loads its MPI/PETSc libraries through this module.
-    import dolfinx_solver  # noqa: F401
-except ImportError:  # conda/apt DOLFINx: nothing to do
-    pass
+from xfem_contact._bootstrap import load_dolfinx_solver
+
+load_dolfinx_solver()  # the PyPI wheel: MPI first; conda/apt DOLFINx: nothing to do
 
 __version__ = "0.1.0"
 
