@@ -10,10 +10,12 @@ from xfem_contact._bootstrap import load_dolfinx_solver
 
 load_dolfinx_solver()  # the PyPI wheel: MPI first; conda/apt DOLFINx: nothing to do
 
-__version__ = "0.1.0"
+from xfem_contact._version import package_version, versions  # noqa: E402
+
+__version__ = package_version()
 
 from xfem_contact.fem.cutmesh import CutMesh  # noqa: E402
 from xfem_contact.fem.forms import form  # noqa: E402
 from xfem_contact.quadrature.cell_rules import CellRules  # noqa: E402
 
-__all__ = ["CellRules", "CutMesh", "form"]
+__all__ = ["CellRules", "CutMesh", "form", "versions"]
