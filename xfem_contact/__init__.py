@@ -2,15 +2,17 @@
 
 A FEniCSx (DOLFINx 0.11) plugin. Import it before or after ``dolfinx``: the
 PyPI wheel ``dolfinx-solver-real`` needs ``dolfinx_solver`` imported first, which
-is done here when that wheel is installed.
+the start-up hook installed with this package does before any ``import dolfinx``
+(see ``xfem_contact/_bootstrap.py``), and which is done here too.
 """
 
-try:  # The PyPI wheel loads its MPI/PETSc libraries through this module.
-    import dolfinx_solver  # noqa: F401
-except ImportError:  # conda/apt DOLFINx: nothing to do
-    pass
+from xfem_contact._bootstrap import load_dolfinx_solver
 
-__version__ = "0.1.0"
+load_dolfinx_solver()  # the PyPI wheel: MPI first; conda/apt DOLFINx: nothing to do
+
+from xfem_contact._version import package_version, versions  # noqa: E402
+
+__version__ = package_version()
 
 from xfem_contact.fem.cutmesh import CutMesh  # noqa: E402
 from xfem_contact.fem.forms import form  # noqa: E402
@@ -29,4 +31,5 @@ __all__ = [
     "NewtonFailure",
     "Problem",
     "form",
+    "versions",
 ]

@@ -3,6 +3,7 @@
 xfem-contact run SCENE.toml --out DIR [--quiet]   (also under mpiexec -n 2)
 xfem-contact scenes
 xfem-contact show DIR
+xfem-contact --version                           (xfem-contact, DOLFINx, Basix, FFCx, UFL, PETSc)
 """
 
 from __future__ import annotations
@@ -53,8 +54,25 @@ def _show(args) -> int:
     return 0
 
 
+class _Version(argparse.Action):
+    """``--version``: one ``name version`` line per package, then exit. An action
+    rather than ``action="version"``, which would import DOLFINx for every command."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        kwargs.setdefault("help", "print the versions of xfem-contact and its stack, then exit")
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from xfem_contact import versions
+
+        for name, version in versions().items():
+            print(f"{name:14s}{version or 'not available'}")
+        parser.exit()
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="xfem-contact", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("run", help="run a scene (a TOML file or a bundled scene name)")
     p.add_argument("scene")
