@@ -63,7 +63,8 @@ def layer_violations(relative: str, source: str) -> list[str]:
     """The imports of the module at ``relative`` (a path like ``xfem_contact/fem/forms.py``)
     that break the layering: a sub-package may import itself and the sub-packages before
     it in ``LAYERS``, never a later step nor the names of the package root (the public
-    face, free to import any step). Modules at the root may import anything."""
+    face, free to import any step), except the private root modules (``_version``,
+    ``_bootstrap``: plumbing below every step). Modules at the root may import anything."""
     parts = pathlib.PurePosixPath(relative).with_suffix("").parts
     is_package = parts[-1] == "__init__"
     parts = parts[:-1] if is_package else parts
@@ -79,6 +80,8 @@ def layer_violations(relative: str, source: str) -> list[str]:
         top = name.split(".")
         if top[0] != PACKAGE:
             continue
+        if len(top) > 1 and top[1].startswith("_") and top[1] not in ("__init__",):
+            continue  # private root modules (_version, _bootstrap): below every step
         if len(top) == 1 or top[1] not in LAYERS:  # the root, its modules or its names
             message = f"{relative}:{line}: {step} imports {name} from the package root"
             bad.setdefault((line, None), message)

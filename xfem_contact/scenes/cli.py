@@ -63,7 +63,7 @@ class _Version(argparse.Action):
         super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
 
     def __call__(self, parser, namespace, values, option_string=None):
-        from xfem_contact import versions
+        from xfem_contact._version import versions
 
         for name, version in versions().items():
             print(f"{name:14s}{version or 'not available'}")
