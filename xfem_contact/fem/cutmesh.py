@@ -140,6 +140,7 @@ class CutMesh:
                 lambda rows, X: maps.grad_ref(cut_cells[rows], X),
             ),
         }
+        rules[_INTERFACE] = _without_slivers(mesh, cut_cells, rules[_INTERFACE], maps)
         self.rules = rules
         #: Interface (index into ``interface_names``) of every cut cell, shape ``(ncut,)``
         self.cell_interface = _cell_interfaces(maps, cut_cells, rules[_INTERFACE], components)
@@ -390,3 +391,27 @@ def _cell_interfaces(
     npts = np.bincount(rows, minlength=ncut)[:, None]
     totals = np.stack([np.bincount(rows, weights=d, minlength=ncut) for d in distance], axis=1)
     return np.argmin(totals / np.maximum(npts, 1), axis=1).astype(np.int32)
+
+
+#: Interface pieces shorter than this fraction of their cell's size are round-off
+SLIVER_TOLERANCE = 64 * np.finfo(np.float64).eps
+
+
+def _without_slivers(
+    mesh: dolfinx.mesh.Mesh,
+    cut_cells: npt.NDArray[np.int32],
+    rules: quadrature.RuleSet,
+    maps: CellMaps,
+) -> quadrature.RuleSet:
+    """The interface rules without the cells whose interface length is round-off
+    (below ``SLIVER_TOLERANCE`` times the cell size): a cell touched by the interface
+    at a node got a piece of length 3e-17 or none depending on the order of the
+    cell's vertices, i.e. on the number of processes, and with it multiplier dofs."""
+    if rules.weights.size == 0:
+        return rules
+    J = maps.jacobian(cut_cells[rules.point_rows], rules.points)
+    length = np.bincount(
+        rules.point_rows, rules.weights * np.abs(np.linalg.det(J)), minlength=cut_cells.size
+    )
+    h = mesh.h(mesh.topology.dim, cut_cells)
+    return rules.select(length > SLIVER_TOLERANCE * h)

@@ -36,6 +36,10 @@ class LevelSet(typing.NamedTuple):
         return self.function.function_space.ufl_element().embedded_superdegree
 
 
+#: Nodal level-set values within this fraction of ``max |phi|`` count as exactly zero
+ZERO_TOLERANCE = 64 * np.finfo(np.float64).eps
+
+
 def interpolate(
     mesh: dolfinx.mesh.Mesh,
     levelset: LevelSetCallable | dolfinx.fem.Function,
@@ -77,6 +81,15 @@ def interpolate(
         raise ValueError(f"The level set has NaN/inf values (first at x = {where})")
     lo = comm.allreduce(values.min(initial=np.inf), op=MPI.MIN)
     hi = comm.allreduce(values.max(initial=-np.inf), op=MPI.MAX)
+    # Canonical nodal values. A node shared by several cells is interpolated from one
+    # of them, which one depending on the cell numbering (so on the number of
+    # processes), and a node on the zero line then gets +-1e-17 by round-off: the sign
+    # decides whether a cell touching the interface at that node is cut (a sliver of
+    # length 1e-9 appeared on 1 rank and not on 2, moving the multipliers by 2e-8).
+    # Values within a few ulps of the level set's scale are zero (side +1), and ghosts
+    # take their owner's value.
+    values[np.abs(values) <= ZERO_TOLERANCE * max(abs(lo), abs(hi))] = 0.0
+    phi.x.scatter_forward()
     if not (lo < 0.0 <= hi):
         raise ValueError(
             f"The level set never crosses zero on the mesh (its nodal values lie in "

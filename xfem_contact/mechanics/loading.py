@@ -176,7 +176,7 @@ class Loads:
         f = self.load_factor.scaled(self._ufl(force))
         for s in (-1, 1) if side is None else (side,):
             v = self.space.test()[0 if s == -1 else 1]
-            self._rhs.append(ufl.inner(f, v) * self.cut.dx(s))
+            self._rhs.append(ufl.inner(f, v) * self.space.cut.dx(s))
 
     def linear_form(self) -> ufl.Form:
         if not self._rhs:

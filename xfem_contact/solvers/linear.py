@@ -15,7 +15,7 @@ from petsc4py import PETSc
 
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.restriction import restriction_matrix
-from xfem_contact.solvers.options import merged_options, set_petsc_options
+from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.scaling import saddle_point_scaling
 
 
@@ -77,7 +77,8 @@ def solve_restricted(
         space: The enriched space; the solution lives on ``space.W``.
         petsc_options: PETSc options (without prefix) overriding the ``"linear"``
             defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
-        petsc_options_prefix: Prefix of the KSP options in the PETSc options database.
+        petsc_options_prefix: Base of the KSP's options prefix (made unique per solve;
+            the options are removed from the PETSc database after use).
         R: Restriction operator, global shape ``(dim W, n_reduced)``; by default
             ``restriction_matrix(space)`` (the active dofs), built and destroyed
             here. A given ``R`` is not destroyed.
@@ -98,11 +99,14 @@ def solve_restricted(
     b.pointwiseMult(b, D)
     ksp = PETSc.KSP().create(A.getComm())
     ksp.setOperators(A)
-    ksp.setOptionsPrefix(petsc_options_prefix)
-    set_petsc_options(petsc_options_prefix, merged_options("linear", petsc_options))
-    ksp.setFromOptions()
+    prefix = unique_prefix(petsc_options_prefix)
+    ksp.setOptionsPrefix(prefix)
+    options = merged_options("linear", petsc_options)
+    with applied_options(prefix, options):
+        ksp.setFromOptions()
     y = R.createVecRight()
-    ksp.solve(b, y)
+    with applied_options(prefix, options):  # the factorisation reads options too
+        ksp.solve(b, y)
     y.pointwiseMult(y, D)
     w = dolfinx.fem.Function(space.W)
     R.mult(y, w.x.petsc_vec)

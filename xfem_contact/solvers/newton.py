@@ -21,7 +21,7 @@ import ufl
 from petsc4py import PETSc
 
 from xfem_contact.fem.forms import form
-from xfem_contact.solvers.options import merged_options, set_petsc_options
+from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.scaling import scaled_restriction
 
 
@@ -30,15 +30,18 @@ class NewtonReport:
     """History of one solve: residual norms and per-iterate status lines.
 
     Attributes:
-        residuals: Norm of the reduced residual ``R^T F`` at each iterate, the
-            initial one first (``iterations + 1`` entries).
+        residuals: Norm of the scaled reduced residual ``D R^T F`` at each iterate,
+            the initial one first (``iterations + 1`` entries).
         status: The status callback's dict at each iterate (same length).
         reason: SNES converged reason (> 0 converged, < 0 diverged).
+        final_residual: The residual norm evaluated after the solve (checked
+            against the tolerances; NaN before).
     """
 
     residuals: list[float] = dataclasses.field(default_factory=list)
     status: list[dict] = dataclasses.field(default_factory=list)
     reason: int = 0
+    final_residual: float = float("nan")
     #: Wall time (s) of residual/Jacobian assembly and of the whole solve
     assembly_time: float = 0.0
     total_time: float = 0.0
@@ -73,10 +76,11 @@ class RestrictedNewton:
 
     Construction is collective (it compiles the forms, assembles the Jacobian
     once, for the sparsity of ``R^T J R`` and the scaling ``D`` of
-    :mod:`xfem_contact.solvers.scaling`, and creates the SNES). SNES iterates on the
-    scaled unknowns ``y`` with ``w = R D y``, so the residual norms it reports are
-    those of ``D R^T F``. The iterate ``y`` starts at zero and is kept between calls
-    of :meth:`solve`.
+    :mod:`xfem_contact.solvers.scaling`, and creates the SNES under a unique options
+    prefix, removing its options from the PETSc database afterwards). SNES iterates on
+    the scaled unknowns ``y`` with ``w = R D y``, so the residual norms it reports are
+    those of ``D R^T F``. Each :meth:`solve` starts from the current ``w`` (projected
+    on the range of ``R D``) and checks the final residual against the tolerances.
 
     Args:
         residual: UFL residual form, linear in the test function, on the full
@@ -121,9 +125,13 @@ class RestrictedNewton:
         first.destroy()
         self.J_r = self.A.PtAP(self.R)
         self.snes = PETSc.SNES().create(R.getComm())
-        self.snes.setOptionsPrefix(petsc_options_prefix)
-        set_petsc_options(petsc_options_prefix, merged_options("newton", petsc_options))
-        self.snes.setFromOptions()
+        # Options live in the PETSc database only while PETSc may read them (here and
+        # during each solve, when the factorisation reads e.g. mat_mumps_* options)
+        self._prefix = unique_prefix(petsc_options_prefix)
+        self._options = merged_options("newton", petsc_options)
+        self.snes.setOptionsPrefix(self._prefix)
+        with applied_options(self._prefix, self._options):
+            self.snes.setFromOptions()
         # PETSc keeps its callbacks alive, and the garbage collector cannot see through
         # PETSc objects: callbacks hold this object weakly, or it would never be freed.
         this = weakref.ref(self)
@@ -172,6 +180,26 @@ class RestrictedNewton:
                 + "  ".join(f"{k} {v}" for k, v in status.items())
             )
 
+    def _start_from_w(self) -> None:
+        """``y`` from the current ``w``: the least-squares ``(R^T R)^-1 R^T w`` (exact
+        when ``w`` lies in the range of ``R``, e.g. after a previous solve)."""
+        RtR = self.R.transposeMatMult(self.R)
+        rhs = self.R.createVecRight()
+        self.R.multTranspose(self.w.x.petsc_vec, rhs)
+        ksp = PETSc.KSP().create(self.R.getComm())
+        ksp.setOperators(RtR)
+        ksp.setType("cg")
+        ksp.getPC().setType("jacobi")
+        ksp.setTolerances(rtol=1e-14, atol=0.0, max_it=1000)
+        ksp.solve(rhs, self.y)
+        for obj in (ksp, RtR, rhs):
+            obj.destroy()
+
+    def final_residual(self) -> float:
+        """``|D R^T F(w)|`` at the current iterate (collective)."""
+        self._residual(None, self.y, self.F_r)
+        return self.F_r.norm()
+
     def solve(self) -> NewtonReport:
         """Run SNES from the current reduced iterate. Collective.
 
@@ -183,13 +211,26 @@ class RestrictedNewton:
         """
         self.report = NewtonReport()
         start = time.perf_counter()
-        self.snes.solve(None, self.y)
+        self._start_from_w()
+        with applied_options(self._prefix, self._options):
+            self.snes.solve(None, self.y)
         self.report.total_time = time.perf_counter() - start
         self._update(self.y)
         self.report.reason = self.snes.getConvergedReason()
         if self.report.reason <= 0:
             raise NewtonFailure(
                 f"Newton failed to converge (SNES reason {self.report.reason})", self.report
+            )
+        # Success is what the tolerances say, whatever SNES reports (e.g. ksponly)
+        rtol, atol, _, _ = self.snes.getTolerances()
+        final = self.final_residual()
+        bound = max(atol, rtol * self.report.residuals[0]) if self.report.residuals else atol
+        self.report.final_residual = final
+        if not final <= bound * (1.0 + 1e-8):
+            raise NewtonFailure(
+                f"SNES reported convergence (reason {self.report.reason}) but the final "
+                f"residual {final:.3e} exceeds max(atol, rtol |F_0|) = {bound:.3e}",
+                self.report,
             )
         return self.report
 

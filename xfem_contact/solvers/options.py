@@ -15,6 +15,8 @@ unchecked, as are any other PETSc options of the same prefix.
 
 from __future__ import annotations
 
+import contextlib
+import itertools
 import typing
 
 from petsc4py import PETSc
@@ -107,3 +109,28 @@ def set_petsc_options(prefix: str, options: dict[str, OptionValue]) -> None:
     database = PETSc.Options()
     for key, value in options.items():
         database[f"{prefix}{key}"] = value
+
+
+_prefixes = itertools.count()
+
+
+def unique_prefix(base: str) -> str:
+    """``base`` made unique in this process (``"xfem_newton_"`` -> ``"xfem_newton_3_"``),
+    as DOLFINx's ``NonlinearProblem`` does, so two solvers never share options.
+    Not collective, but the same on every process when solvers are created in the same
+    order (they are: construction is collective)."""
+    return f"{base.rstrip('_')}_{next(_prefixes)}_"
+
+
+@contextlib.contextmanager
+def applied_options(prefix: str, options: dict[str, OptionValue]):
+    """Write ``options`` under ``prefix`` into the PETSc options database for the
+    duration of the block (wrap the ``setFromOptions`` call), then remove them: the
+    database holds nothing of ours afterwards. Not collective."""
+    set_petsc_options(prefix, options)
+    try:
+        yield
+    finally:
+        database = PETSc.Options()
+        for key in options:
+            database.delValue(f"{prefix}{key}")
