@@ -81,34 +81,6 @@ def test_active_set_changes_and_contact_conditions_hold():
     assert report.iterations <= 10
 
 
-@pytest.mark.mpi
-def test_parallel_equals_serial():
-    """The same case on this communicator and on each process alone."""
-    results = []
-    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
-        problem = inclusion_problem(10, 2, "sticking", comm=comm)
-        problem.solve()
-        results.append(inclusion_errors(problem, problem.w))
-    assert results[0].pressure == pytest.approx(results[1].pressure, rel=1e-9)
-    assert results[0].tangential == pytest.approx(results[1].tangential, rel=1e-9)
-
-
-@pytest.mark.mpi
-@pytest.mark.parametrize("degree", [1, 2])
-def test_annulus_parallel_equals_serial(degree):
-    """Curved-cell annulus meshes are built by ``dolfinx.mesh.create_mesh``, whose
-    default partitioner makes no ghost cells: the ghost penalty then missed the
-    facets between processes and 2 ranks differed from 1 in the 3rd digit."""
-    from xfem_contact.cases.paper import annulus_pressure_error, annulus_problem
-
-    errors = []
-    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
-        problem = annulus_problem(6, 24, degree, comm=comm)
-        problem.solve()
-        errors.append(annulus_pressure_error(problem))
-    assert errors[0] == pytest.approx(errors[1], rel=1e-9)
-
-
 def test_newton_failure_reports_history():
     problem = inclusion_problem(10, 2, "coulomb", loading="pull", friction=1.0)
     with pytest.raises(NewtonFailure, match="iterate"):

@@ -1,0 +1,40 @@
+"""Helpers of the parallel-equals-serial tests: fields gathered and sorted by position."""
+
+import numpy as np
+
+
+def _by_position(points: np.ndarray) -> np.ndarray:
+    """Order of points ``(n, 2)``, sorted by rounded coordinates (x, then y)."""
+    rounded = np.round(np.asarray(points, dtype=np.float64), 7)
+    return np.lexsort((rounded[:, 1], rounded[:, 0]))
+
+
+def gathered_fields(problem) -> dict[str, np.ndarray]:
+    """The fields of a solved cut problem on every process, sorted by position.
+    Collective.
+
+    Returns ``lambda_n``, ``lambda_t`` at the interface rule points (Pa) and
+    ``u_minus``, ``u_plus`` at the displacement dofs (m, shape ``(n, 2)``).
+    """
+    comm = problem.mesh.comm
+    samples = problem.interface_samples()
+    order = _by_position(np.c_[samples["x"], samples["y"]])
+    fields = {k: np.asarray(samples[k])[order] for k in ("lambda_n", "lambda_t")}
+    for field, name in ((0, "u_minus"), (1, "u_plus")):
+        V, dofs = problem.space.W.sub(field).collapse()
+        owned = V.dofmap.index_map.size_local
+        x = V.tabulate_dof_coordinates()[:owned, :2]
+        values = problem.w.x.array[np.asarray(dofs)].reshape(-1, 2)[:owned]
+        x, values = (np.concatenate(comm.allgather(a)) for a in (x, values))
+        fields[name] = values[_by_position(x)]
+    return fields
+
+
+def max_relative_difference(a: dict, b: dict) -> dict[str, float]:
+    """Per field: max |a - b| over max |b| (the multipliers share the scale of
+    ``lambda_n``, the displacements that of both sides)."""
+    scales = {
+        "lambda": np.abs(b["lambda_n"]).max(),
+        "u": max(np.abs(b["u_minus"]).max(), np.abs(b["u_plus"]).max()),
+    }
+    return {k: float(np.abs(a[k] - b[k]).max() / scales[k.split("_")[0]]) for k in b}
