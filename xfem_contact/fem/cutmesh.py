@@ -152,6 +152,8 @@ class CutMesh:
         self._standard = {_SIDE_MINUS: owned[side == -1], _SIDE_PLUS: owned[side == 1]}
         self.maps = maps
         self._boundary_parts = {}
+        #: Incremented by every cut (what was built on an older cut is stale)
+        self.revision = getattr(self, "revision", -1) + 1
         self.num_cut_cells_global = mesh.comm.allreduce(ncut, op=MPI.SUM)
         #: Wall time (s) of the last update: level set + classification +
         #: sub-triangulation ("cut"), and per-cell rules ("quadrature")

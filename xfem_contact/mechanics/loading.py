@@ -103,6 +103,9 @@ class Loads:
         self._x = ufl.SpatialCoordinate(mesh)
         #: Scales every load and prescribed displacement
         self.load_factor = LoadFactor(mesh)
+        #: Incremented by every load or Dirichlet condition added (solvers built for an
+        #: older revision are rebuilt)
+        self.loads_revision = 0
 
     def facets(self, part: Facets) -> np.ndarray:
         """Local exterior facet indices of a boundary part; error if it is empty."""
@@ -134,6 +137,7 @@ class Loads:
             self.load_factor.track(g)
             dofs = dolfinx.fem.locate_dofs_topological((sub, V), fdim, facets)
             self._bcs.append(dolfinx.fem.dirichletbc(g, dofs, sub))
+            self.loads_revision += 1
 
     def add_point_displacement(self, point, value: float, component: int) -> None:
         """Fix one displacement component at a mesh node (e.g. to remove rigid modes)."""
@@ -152,6 +156,7 @@ class Loads:
             g.x.array[:] = value
             self.load_factor.track(g)
             self._bcs.append(dolfinx.fem.dirichletbc(g, dofs, sub))
+            self.loads_revision += 1
         if found == 0:
             raise ValueError(f"No mesh node at {point.tolist()} to fix")
 
@@ -164,6 +169,7 @@ class Loads:
         for s in (-1, 1) if side is None else (side,):
             v = self.space.test()[0 if s == -1 else 1]
             self._rhs.append(ufl.inner(t, v) * self.space.cut.ds(s, facets))
+            self.loads_revision += 1
 
     def add_pressure(self, part: Facets, pressure: Load, side: int | None = None) -> None:
         """Pressure (Pa, positive pushes into the body) on a boundary part: t = -p n."""
@@ -177,6 +183,7 @@ class Loads:
         for s in (-1, 1) if side is None else (side,):
             v = self.space.test()[0 if s == -1 else 1]
             self._rhs.append(ufl.inner(f, v) * self.space.cut.dx(s))
+            self.loads_revision += 1
 
     def linear_form(self) -> ufl.Form:
         if not self._rhs:

@@ -30,7 +30,7 @@ from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loading import Loads
 from xfem_contact.mechanics.materials import Material, MaterialField
 from xfem_contact.solvers.linear import solve_restricted
-from xfem_contact.solvers.newton import NewtonReport, RestrictedNewton
+from xfem_contact.solvers.newton import NewtonFailure, NewtonReport, RestrictedNewton
 
 #: Materials: one for both sides, or ``{-1: m, 1: m}`` where side -1 may map
 #: interface names to the material inside each
@@ -105,6 +105,8 @@ class Problem(Loads):
             name: self._context(name, law_materials[name], fields.get(name)) for name in self.laws
         }
         self._newton: RestrictedNewton | None = None
+        self._newton_key = None
+        self._cut_revision = cut.revision
         for name, law in self.laws.items():
             if law.coupling(self.contexts[name]) is not None:
                 raise NotImplementedError(
@@ -209,16 +211,30 @@ class Problem(Loads):
 
         Linear problems: one KSP solve, returns a :class:`Solution`. With a contact
         law: generalized Newton (SNES) from ``self.w``, a ``log`` line per iterate,
-        returns the :class:`~xfem_contact.solvers.newton.NewtonReport`.
+        returns the :class:`~xfem_contact.solvers.newton.NewtonReport`. The Newton
+        solver is kept between solves and rebuilt when loads, Dirichlet conditions
+        or ``petsc_options`` changed since.
 
         Raises:
-            NewtonFailure: with the iteration history, if SNES does not converge.
+            NewtonFailure: with the iteration history, if SNES does not converge;
+                ``self.w`` then holds the state from before this solve.
+            ValueError: the cut was updated after the problem was built.
         """
+        if self.cut.revision != self._cut_revision:
+            raise ValueError(
+                "The cut changed (cut.update) after this problem was built: its enriched "
+                f"space, rules and forms follow the old interface (cut revision "
+                f"{self._cut_revision}, now {self.cut.revision}); build a new Problem"
+            )
         if self.linear:
             a, L = form(self.bilinear_form()), form(self.linear_form())
             w, _ = solve_restricted(a, L, self._bcs, self.space, petsc_options)
             self.w.x.array[:] = w.x.array
             return Solution(w, self.space)
+        key = (self.loads_revision, repr(sorted((petsc_options or {}).items())))
+        if self._newton is not None and key != self._newton_key:
+            self._newton.destroy()  # loads or solver options changed since it was built
+            self._newton = None
         if self._newton is None:
             self._newton = RestrictedNewton(
                 self.residual(),
@@ -229,7 +245,17 @@ class Problem(Loads):
                 status=self.interface_status,
                 log=log,
             )
-        return self._newton.solve()
+            self._newton_key = key
+        self._newton.log = log
+        accepted = self.w.x.array.copy()
+        try:
+            return self._newton.solve()
+        except NewtonFailure as failure:
+            self.w.x.array[:] = accepted  # the state before this solve, not the diverged one
+            raise NewtonFailure(
+                f"{str(failure).splitlines()[0]}; w restored to the state before this solve",
+                failure.report,
+            ) from None
 
     @property
     def last_report(self) -> NewtonReport | None:

@@ -1,0 +1,87 @@
+"""Solvers that cannot go stale or lie: what changes after a solve is used or refused,
+a failed solve keeps the last good state, Newton starts from ``w``, success means the
+tolerances hold, and no PETSc option of ours outlives its solve."""
+
+import xfem_contact  # noqa: F401
+
+# isort: split
+import numpy as np
+import pytest
+from petsc4py import PETSc
+
+from xfem_contact import NewtonFailure
+from xfem_contact.cases.paper import inclusion_problem
+
+
+def multipliers(problem) -> np.ndarray:
+    return np.asarray(problem.interface_samples()["lambda_n"])
+
+
+def our_options() -> list[str]:
+    return [k for k in PETSc.Options().getAll() if k.startswith("xfem_")]
+
+
+def sides(x):
+    return np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0)
+
+
+def test_loads_added_after_a_solve_are_used():
+    """Sticking is linear in the loads: adding the same loads again doubles lambda."""
+    problem = inclusion_problem(8, 1, "sticking")
+    problem.solve()
+    once = multipliers(problem)
+    problem.add_pressure(sides, 1.0)
+    problem.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 2.0)
+    problem.solve()
+    assert np.allclose(multipliers(problem), 2.0 * once, rtol=1e-8, atol=1e-10)
+
+
+def test_solver_options_given_after_a_solve_are_used():
+    problem = inclusion_problem(8, 1, "sticking")
+    problem.solve()
+    problem.solve(petsc_options={"snes_rtol": 1e-6, "snes_atol": 1e-9})
+    rtol, atol, _, _ = problem._newton.snes.getTolerances()
+    assert (rtol, atol) == (1e-6, 1e-9)
+
+
+def test_a_new_cut_is_refused():
+    problem = inclusion_problem(8, 1, "sticking")
+    problem.solve()
+    problem.cut.update(lambda x: np.hypot(x[0] - 0.5, x[1] - 0.5) - 0.25)
+    with pytest.raises(ValueError, match="cut.update"):
+        problem.solve()
+
+
+def test_failure_keeps_the_state_before_the_solve():
+    problem = inclusion_problem(10, 2, "coulomb", loading="pull", friction=1.0)
+    problem.add_pressure(sides, -0.5)  # a harder load, several Newton steps
+    before = problem.w.x.array.copy()
+    with pytest.raises(NewtonFailure, match="restored") as failure:
+        problem.solve(petsc_options={"snes_max_it": 1})
+    assert failure.value.report.iterations == 1
+    assert np.array_equal(problem.w.x.array, before)
+
+
+def test_newton_starts_from_w():
+    """A converged w given to a new problem: converged before any step."""
+    solved = inclusion_problem(10, 2, "coulomb", loading="pull", friction=1.0)
+    assert solved.solve().iterations > 1
+    fresh = inclusion_problem(10, 2, "coulomb", loading="pull", friction=1.0)
+    fresh.w.x.array[:] = solved.w.x.array
+    assert fresh.solve().iterations == 0
+
+
+def test_ksponly_cannot_pass_as_converged():
+    """One linear step of a problem that needs several does not meet the tolerances."""
+    problem = inclusion_problem(10, 2, "coulomb", loading="pull", friction=1.0)
+    with pytest.raises(NewtonFailure, match="final residual"):
+        problem.solve(petsc_options={"snes_type": "ksponly"})
+
+
+def test_no_option_outlives_its_solve():
+    problem = inclusion_problem(8, 1, "sticking", lbb="stabilized")
+    problem.solve(petsc_options={"snes_linesearch_type": "bt"})
+    assert our_options() == []
+    bonded = inclusion_problem(8, 1, "bonded")
+    bonded.solve(petsc_options={"ksp_type": "preonly"})
+    assert our_options() == []
