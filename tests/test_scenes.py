@@ -347,6 +347,34 @@ def test_cli_run_and_summary(tmp_path_factory):
     assert summary["ranks"] == MPI.COMM_WORLD.size
 
 
+def test_write_json_is_atomic(tmp_path):
+    """A failure while writing leaves the previous summary whole and no temporary file:
+    a disk that fills up after 1000 bytes (a file size limit), a value JSON cannot hold."""
+    import resource
+    import signal
+
+    from xfem_contact.io.output import write_json
+
+    path = tmp_path / "summary.json"
+    write_json(path, {"scene": "previous"})
+    big = {"scene": "new", "samples": list(range(20000))}
+    limits = resource.getrlimit(resource.RLIMIT_FSIZE)
+    handler = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past it: OSError
+    try:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (1000, limits[1]))
+        with pytest.raises(OSError):
+            write_json(path, big)
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, limits)
+        signal.signal(signal.SIGXFSZ, handler)
+    with pytest.raises(TypeError):
+        write_json(path, big | {"bad": object()})
+    assert json.loads(path.read_text()) == {"scene": "previous"}
+    assert [p.name for p in tmp_path.iterdir()] == ["summary.json"]
+    write_json(path, {"scene": "new", "x": np.float64(1.5), "a": np.arange(2)})
+    assert json.loads(path.read_text()) == {"scene": "new", "x": 1.5, "a": [0, 1]}
+
+
 def test_run_contact_scene_reports_newton():
     summary = run(load_scene(bundled_scenes()["hydrostatic_frictionless"]), out=None, log=None)
     assert summary["effects"]["solver"].startswith("SNES")
