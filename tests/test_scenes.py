@@ -1,6 +1,7 @@
 """Scenes: validation errors, effect selection, TOML round trip, CLI."""
 
 import json
+import math
 
 import xfem_contact
 
@@ -32,6 +33,25 @@ def base(**interface):
     if interface:
         data["interfaces"] = [{"shape": "circle", "centre": [0.5, 0.5], "radius": 0.2, **interface}]
     return data
+
+
+def to_toml(data: dict) -> str:
+    """A scene dict as TOML text: one ``key = value`` line per table (inline tables)."""
+
+    def value(v):
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, float) and not math.isfinite(v):
+            return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
+        if isinstance(v, int | float):
+            return repr(v)
+        if isinstance(v, str):
+            return json.dumps(v)
+        if isinstance(v, list | tuple):
+            return "[" + ", ".join(map(value, v)) + "]"
+        return "{" + ", ".join(f"{json.dumps(k)} = {value(x)}" for k, x in v.items()) + "}"
+
+    return "".join(f"{json.dumps(key)} = {value(v)}\n" for key, v in data.items())
 
 
 @pytest.mark.parametrize(
@@ -345,6 +365,85 @@ def test_cli_run_and_summary(tmp_path_factory):
     assert summary["fields"] == ["u_minus", "u_plus"]
     assert summary["dofs"]["enriched"] == 2 * 3 * 41
     assert summary["ranks"] == MPI.COMM_WORLD.size
+
+
+def circle_without_radius() -> str:
+    data = base(law="bonded")
+    del data["interfaces"][0]["radius"]
+    return to_toml(data)
+
+
+@pytest.mark.parametrize(
+    "text, line",
+    [
+        (
+            circle_without_radius(),
+            "interfaces[0].radius: required for shape 'circle' (its parameters: centre, radius)",
+        ),
+        (
+            "[mesh\ncells = [2, 2]\n[materials.m]\nE = 1.0\nnu = 0.0\n",
+            "line 1, column 6: TOML syntax error: Expected ']' at the end of a table declaration",
+        ),
+        (
+            to_toml(base()).replace('"value" = 1.0', '"value" = 1e400'),
+            "loads[1].value: must be a finite number, got inf",
+        ),
+        (
+            to_toml(base()).replace('"value" = 1.0', '"value" = "9**9**9*x"'),
+            "loads[1].value: '9**9**9*x' raises to the power '9 ** 9': the exponent of ** must "
+            "be a number of size at most 16",
+        ),
+        (b"\xff\xfe".decode("latin-1"), "file: not UTF-8 text (byte 0: invalid start byte)"),
+    ],
+    ids=["missing radius", "TOML syntax", "inf", "huge power", "not UTF-8"],
+)
+def test_cli_bad_input_is_one_line_and_exit_2(tmp_path, capsys, text, line):
+    path = tmp_path / "scene.toml"
+    path.write_bytes(text.encode("latin-1" if "\xff" in text else "utf-8"))
+    args = ["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]
+    assert cli.main(args) == 2
+    captured = capsys.readouterr()
+    assert captured.err.splitlines() == [f"error: {path}: {line}"]
+    assert captured.out == "" and not (tmp_path / "out").exists()
+    assert cli.main([*args, "--debug"]) == 2  # the traceback too, then the same line
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == "Traceback (most recent call last):" and err[-1] == f"error: {path}: {line}"
+
+
+def test_cli_missing_scene_file_exit_2(capsys):
+    assert cli.main(["run", "nowhere.toml"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith("error: nowhere.toml: no such scene file")
+    assert "'plain_plate'" in err[0]  # the bundled scenes are the choices
+
+
+def test_cli_error_at_build_is_one_line_and_leaves_no_stale_summary(tmp_path, capsys):
+    """A geometry error found when building: exit 2, and the summary.json of an earlier
+    run in the folder is gone (a summary.json is always a finished run's)."""
+    data = base(law="bonded")
+    data["interfaces"][0]["centre"] = [5.0, 5.0]
+    path, out = tmp_path / "scene.toml", tmp_path / "out"
+    path.write_text(to_toml(data))
+    out.mkdir()
+    (out / "summary.json").write_text('{"scene": "an earlier run"}')
+    assert cli.main(["run", str(path), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(f"error: {path}: ") and "never crosses" in err[0]
+    assert not (out / "summary.json").exists()
+
+
+def test_cli_newton_failure_exit_3_with_the_iterations(tmp_path, capsys):
+    path, out = tmp_path / "scene.toml", tmp_path / "out"
+    path.write_text(to_toml(pressed_inclusion("coulomb", max_iterations=1, load_steps=2)))
+    out.mkdir()
+    (out / "summary.json").write_text('{"scene": "an earlier run"}')
+    assert cli.main(["run", str(path), "--out", str(out), "--quiet"]) == 3
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith(f"error: {path}: Scene 't', load step 1/2 (load factor 0.5)")
+    assert err[0].endswith(")") and "Newton failed (SNES reason" in err[0]
+    assert err[1].startswith("  iterate  0  |F| = ") and err[2].startswith("  iterate  1")
+    assert len(err) == 3 and "Traceback" not in err
+    assert not (out / "summary.json").exists()
 
 
 def test_write_json_is_atomic(tmp_path):
