@@ -320,6 +320,18 @@ def test_validation_errors_are_one_line_naming_the_key(change, key, fragment):
     one_line_error(data, key, fragment)
 
 
+def test_names_with_spaces_are_kept_and_quoted_in_errors():
+    data = base(law="bonded", inside="soft rock")
+    data["materials"]["soft rock"] = {"E": 1e9, "nu": 0.2}
+    data["parts"] = {"left edge": {"where": "x < 1e-9"}}
+    data["loads"].append({"part": "left edge", "type": "pressure", "value": 1.0})
+    scene = load_scene(data)
+    assert scene.interfaces[0].inside == "soft rock" and "soft rock" in scene.materials
+    assert scene.parts == {"left edge": "x < 1e-9"}
+    data["materials"]["soft rock"]["nu"] = 0.7
+    one_line_error(data, "materials.'soft rock'.nu", "must be in (-1.0, 0.5), got 0.7")
+
+
 def test_large_kinematics_refused_clearly():
     one_line_error(
         base(law="frictionless", kinematics="large"),

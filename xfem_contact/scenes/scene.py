@@ -85,16 +85,16 @@ def read_toml(path: str | pathlib.Path) -> dict:
         raise SceneError("file", "TOML nested too deeply") from None
 
 
-def _tables(value, key: str, listed: bool) -> list[tuple[str, object]]:
-    """(key path, table) of the tables of ``[key.NAME]`` (a table of tables) or of
-    ``[[key]]`` (``listed``: a list of tables); each entry is checked by its caller."""
+def _tables(value, key: str, listed: bool) -> list[tuple[str, str | int, object]]:
+    """(key path, name or index, table) of the tables of ``[key.NAME]`` (a table of
+    tables) or ``[[key]]`` (``listed``: a list of tables); each checked by its caller."""
     if listed:
         if not isinstance(value, list | tuple):
             raise SceneError(key, f"expected a list of tables ([[{key}]]), got {describe(value)}")
-        return [(join(key, k), table) for k, table in enumerate(value)]
+        return [(join(key, k), k, table) for k, table in enumerate(value)]
     if not isinstance(value, dict):
         raise SceneError(key, f"expected a table of tables ([{key}.NAME]), got {describe(value)}")
-    return [(join(key, name), table) for name, table in value.items()]
+    return [(join(key, name), name, table) for name, table in value.items()]
 
 
 def load_scene(
@@ -127,22 +127,22 @@ def load_scene(
     disc = check_table(data.get("discretisation", {}), FIELDS["discretisation"], "discretisation")
 
     materials = {}
-    for where, table in _tables(data.get("materials", {}), "materials", listed=False):
+    for where, name, table in _tables(data.get("materials", {}), "materials", listed=False):
         check_table(table, FIELDS["material"], where)
-        materials[where.split(".", 1)[1]] = Material(
+        materials[name] = Material(
             float(table["E"]), float(table["nu"]), table.get("plane", "strain")
         )
     if not materials:
         raise SceneError("materials", "the scene defines no material ([materials.NAME] E, nu)")
     interfaces = [
-        _interface(table, where, materials)
-        for where, table in _tables(data.get("interfaces", []), "interfaces", listed=True)
+        _interface(table, k, materials)
+        for _, k, table in _tables(data.get("interfaces", []), "interfaces", listed=True)
     ]
     _check_shared(interfaces)
 
     parts = {}
-    for where, table in _tables(data.get("parts", {}), "parts", listed=False):
-        parts[where.split(".", 1)[1]] = check_table(table, FIELDS["part"], where)["where"]
+    for where, name, table in _tables(data.get("parts", {}), "parts", listed=False):
+        parts[name] = check_table(table, FIELDS["part"], where)["where"]
     known_parts = set(BUILTIN_PARTS[mesh["kind"]]) | set(parts)
     if mesh["file"] is not None:
         from xfem_contact.io.gmsh import physical_parts
@@ -153,7 +153,7 @@ def load_scene(
             raise SceneError("mesh.file", " ".join(str(error).split())) from None
     loads = [
         _load(table, where, known_parts)
-        for where, table in _tables(data.get("loads", []), "loads", listed=True)
+        for where, _, table in _tables(data.get("loads", []), "loads", listed=True)
     ]
 
     solver = check_table(data.get("solver", {}), FIELDS["solver"], "solver")
@@ -204,8 +204,9 @@ def _mesh(mesh, folder: pathlib.Path) -> dict:
     }
 
 
-def _interface(table, where: str, materials: dict) -> InterfaceSpec:
-    """An interface from its checked table: the parameters of its shape, its law's."""
+def _interface(table, k: int, materials: dict) -> InterfaceSpec:
+    """Interface ``k`` from its checked table: the parameters of its shape, its law's."""
+    where = f"interfaces[{k}]"
     check_table(table, FIELDS["interface"], where)
     shape = table["shape"]
     required, optional = SHAPE_KEYS[shape]
@@ -239,7 +240,7 @@ def _interface(table, where: str, materials: dict) -> InterfaceSpec:
         shape=shape,
         law=law,
         params={k: table[k] for k in required + optional if k in table},
-        name=table.get("name", f"interface{where[len('interfaces[') : -1]}"),
+        name=table.get("name", f"interface{k}"),
         inside=table.get("inside", first),
         outside=table.get("outside", first),
         friction=table.get("friction"),
