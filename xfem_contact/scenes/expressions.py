@@ -125,9 +125,10 @@ def _refusal(node: ast.AST, loads: bool) -> str | None:
             valid = " ".join(sorted(set(operators.values())))
             return f"uses {kind} {_operator(node.op)}{where}; operators: {valid}"
         if isinstance(node.op, ast.Pow) and not _small_number(node.right):
+            power = _short(ast.unparse(node.right))
             return (
-                f"raises to the power {_short(ast.unparse(node.right))}: the exponent of ** must be "
-                f"a number of size at most {MAX_EXPONENT}"
+                f"raises to the power {power}: the exponent of ** must be a number of size at "
+                f"most {MAX_EXPONENT}"
             )
         return None
     if isinstance(node, ast.Compare):
