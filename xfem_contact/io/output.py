@@ -7,12 +7,13 @@
   of its own side: the lips of the interface appear separate and discontinuous.
 - :func:`write_cut_geometry`: the cut itself (sub-triangles and interface pieces)
   as ``.vtu`` files, for ``xfem-contact show`` and ParaView.
-- :func:`write_json`: a JSON summary (numpy values converted).
+- :func:`write_json`: a JSON summary (numpy values converted), written atomically.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import pathlib
 
 import dolfinx.fem
@@ -99,8 +100,23 @@ def _jsonable(value):
 
 
 def write_json(path: str | pathlib.Path, summary: dict) -> pathlib.Path:
-    """Write ``summary`` as indented JSON (numpy arrays and scalars converted)."""
+    """Write ``summary`` as indented JSON (numpy arrays and scalars converted), atomically.
+
+    The JSON goes to a temporary file beside ``path``, flushed to disk, then renamed
+    over ``path``: a reader finds the old file or the whole new one, never a part, and
+    a failure (an unconvertible value, a full disk, the process killed) leaves ``path``
+    as it was and no temporary file behind.
+    """
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(_jsonable(summary), indent=2))
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")  # same folder: a rename
+    try:
+        with open(temporary, "w") as f:
+            json.dump(_jsonable(summary), f, indent=2)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(temporary, path)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
     return path

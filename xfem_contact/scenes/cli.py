@@ -1,6 +1,7 @@
 """The ``xfem-contact`` command: run scenes, list the bundled ones, render results.
 
-xfem-contact run SCENE.toml --out DIR [--quiet]   (also under mpiexec -n 2)
+xfem-contact run SCENE.toml --out DIR [--quiet] [--debug]   (also under mpiexec -n 2)
+    exit 0 done, 2 bad input (one line ``error: FILE: KEY: message``), 3 Newton failed
 xfem-contact scenes
 xfem-contact show DIR
 xfem-contact --version                           (xfem-contact, DOLFINx, Basix, FFCx, UFL, PETSc)
@@ -11,22 +12,45 @@ from __future__ import annotations
 import argparse
 import pathlib
 import sys
+import traceback
 
 
 def _run(args) -> int:
+    """Exit codes: 0 done, 2 bad input (one line ``error: FILE: KEY: message`` on stderr;
+    the traceback too with ``--debug``), 3 Newton failed (the step and its iterations)."""
     from mpi4py import MPI
 
-    from xfem_contact.scenes.run import run
     from xfem_contact.scenes.scene import bundled_scenes, load_scene
+    from xfem_contact.solvers.newton import NewtonFailure
 
     path = pathlib.Path(args.scene)
     if not path.exists() and args.scene in bundled_scenes():
         path = bundled_scenes()[args.scene]
-    scene = load_scene(path)
-    out = pathlib.Path(args.out or f"results/{scene.name}")
-    summary = run(scene, out, log=None if args.quiet else print)
-    if MPI.COMM_WORLD.rank == 0 and not args.quiet:
-        print(f"wrote {out}/summary.json")
+    say = print if MPI.COMM_WORLD.rank == 0 else (lambda *a, **k: None)
+
+    def failed(code: int, message: str) -> int:
+        if args.debug:
+            traceback.print_exc()
+        lines = [line.strip() for line in str(message).splitlines() if line.strip()]
+        say(f"error: {path}: {' '.join(lines) or 'failed'}", file=sys.stderr)
+        return code
+
+    if not path.is_file():
+        return failed(2, f"no such scene file or bundled scene; bundled: {list(bundled_scenes())}")
+    try:
+        scene = load_scene(path)
+        out = pathlib.Path(args.out or f"results/{scene.name}")
+        from xfem_contact.scenes.run import run
+
+        summary = run(scene, out, log=None if args.quiet else print)
+    except NewtonFailure as failure:
+        failed(3, str(failure).splitlines()[0])
+        say(failure.report.table(), file=sys.stderr)
+        return 3
+    except (ValueError, NotImplementedError, OSError) as error:
+        return failed(2, error)
+    if not args.quiet:
+        say(f"wrote {out}/summary.json")
     return 0 if summary else 1
 
 
@@ -78,6 +102,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("scene")
     p.add_argument("--out", default=None, help="output folder (default results/NAME)")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.add_argument("--debug", action="store_true", help="show the traceback of an error")
     p.set_defaults(func=_run)
     p = sub.add_parser("scenes", help="list the bundled scenes")
     p.set_defaults(func=_scenes)

@@ -267,14 +267,17 @@ def run(
     The loads are applied in ``scene.load_steps`` equal steps (a line per step and
     per Newton iterate goes to ``log``; ``None`` for silence). With ``out``, the
     fields of every step go to VTX files (``displacement.bp``, ``multiplier.bp``,
-    time = load factor), the final state to ``result.vtu`` and the summary to
-    ``summary.json``.
+    time = load factor), the final state to ``result.vtu``, last the summary to
+    ``summary.json`` (atomic; a stale one is removed first: a failed run leaves none).
 
     Returns:
         The summary: effects built, fields, dof counts, iterations per step, the
         contact status, timings (s).
     """
     say = log if (log and comm.rank == 0) else (lambda *a: None)
+    out = None if out is None else pathlib.Path(out)
+    if out is not None and comm.rank == 0:  # a summary.json is a finished run's
+        (out / "summary.json").unlink(missing_ok=True)
     compiled_before = len(forms._cache)
     start = time.perf_counter()
     problem, effects = build(scene, comm)
@@ -282,8 +285,7 @@ def run(
     say(f"scene {scene.name}: effects {effects}")
     result = Result(problem)
     series = _open_series(out, result) if (out is not None and scene.outputs["vtx"]) else []
-    steps, iterations, residuals = load_steps(scene.load_steps), [], []
-    status: dict = {}
+    steps, iterations, residuals, status = load_steps(scene.load_steps), [], [], {}
     solve_start = time.perf_counter()
     try:
         for k, t in enumerate(steps, start=1):
@@ -344,7 +346,6 @@ def run(
     }
     if out is not None:
         output_start = time.perf_counter()
-        out = pathlib.Path(out)
         _write_grid(out, problem, result.fields)
         timings["output"] = time.perf_counter() - output_start
     summary["timings"] = timings | {"total": time.perf_counter() - start}

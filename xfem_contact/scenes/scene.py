@@ -34,38 +34,67 @@ Example (TOML)::
 
 from __future__ import annotations
 
+import math
 import pathlib
+import re
 import tomllib
 
 from xfem_contact.mechanics.materials import Material
-from xfem_contact.scenes.expressions import compile_expression
 from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
     BUILTIN_PARTS,
     CELLS,
+    FIELDS,
     KINEMATICS,
     LAWS,
+    LOAD_KEYS,
     LOAD_TYPES,
+    MESH_KEYS,
     MESH_KINDS,
     SCHEMA,
+    SHAPE_KEYS,
     SHAPES,
     SHARED_INTERFACE_KEYS,
     TOP_LEVEL,
     InterfaceSpec,
     LoadSpec,
+    Number,
+    Scalar,
     Scene,
+    SceneError,
+    Vector,
+    check_table,
+    describe,
+    join,
 )
 
 
-def _check_keys(table: dict, allowed, where: str) -> None:
-    unknown = sorted(set(table) - set(allowed))
-    if unknown:
-        raise ValueError(f"Unknown key(s) {unknown} in [{where}]; valid: {sorted(allowed)}")
+def read_toml(path: str | pathlib.Path) -> dict:
+    """The parsed TOML file at ``path``; a syntax error is a :class:`SceneError` naming
+    the line and column. Raises ``OSError`` when the file cannot be read."""
+    with open(path, "rb") as f:
+        raw = f.read()
+    try:
+        return tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError as error:
+        raise SceneError("file", f"not UTF-8 text (byte {error.start}: {error.reason})") from None
+    except tomllib.TOMLDecodeError as error:
+        found = re.fullmatch(r"(.*) \((?:at )?(line \d+, column \d+|end of document)\)", str(error))
+        where, message = (found[2], found[1]) if found else ("file", str(error))
+        raise SceneError(where, f"TOML syntax error: {message}") from None
+    except RecursionError:
+        raise SceneError("file", "TOML nested too deeply") from None
 
 
-def _choice(value, choices, where: str):
-    if value not in choices:
-        raise ValueError(f"{where} = {value!r} is not valid; choose one of {list(choices)}")
-    return value
+def _tables(value, key: str, listed: bool) -> list[tuple[str, str | int, object]]:
+    """(key path, name or index, table) of the tables of ``[key.NAME]`` (a table of
+    tables) or ``[[key]]`` (``listed``: a list of tables); each checked by its caller."""
+    if listed:
+        if not isinstance(value, list | tuple):
+            raise SceneError(key, f"expected a list of tables ([[{key}]]), got {describe(value)}")
+        return [(join(key, k), k, table) for k, table in enumerate(value)]
+    if not isinstance(value, dict):
+        raise SceneError(key, f"expected a table of tables ([{key}.NAME]), got {describe(value)}")
+    return [(join(key, name), name, table) for name, table in value.items()]
 
 
 def load_scene(
@@ -75,153 +104,197 @@ def load_scene(
 
     ``folder``: where relative file names (``mesh.file``) are looked up; default
     the scene file's folder, or the working directory for a dict.
+
+    Raises:
+        SceneError: (a ``ValueError``) one line ``KEY: message`` naming the key path
+            (``interfaces[0].radius``; ``line L, column C`` for a TOML syntax error),
+            with the valid choices where there are some.
+        NotImplementedError: ``KEY: message`` for a valid choice not available yet.
     """
     if isinstance(source, dict):
         data = source
         folder = pathlib.Path(folder or ".")
     else:
-        with open(source, "rb") as f:
-            data = tomllib.load(f)
+        data = read_toml(source)
         folder = pathlib.Path(folder or pathlib.Path(source).parent)
-    _check_keys(data, TOP_LEVEL, "top level")
-    head = data.get("scene", {})
-    _check_keys(head, SCHEMA["scene"], "scene")
-    mesh = data.get("mesh", {})
-    _check_keys(mesh, SCHEMA["mesh"], "mesh")
-    disc = data.get("discretisation", {})
-    _check_keys(disc, SCHEMA["discretisation"], "discretisation")
-    degree = _choice(disc.get("degree", 2), (1, 2), "discretisation.degree")
-    ls_degree = _choice(disc.get("levelset_degree", 2), (1, 2), "discretisation.levelset_degree")
-    q_degree = int(disc.get("quadrature_degree", 6))
-    if q_degree < 1:
-        raise ValueError(f"discretisation.quadrature_degree must be >= 1, got {q_degree}")
+    if not isinstance(data, dict):
+        raise SceneError("file", f"expected a table of scene keys, got {describe(data)}")
+    unknown = [key for key in data if key not in TOP_LEVEL]
+    if unknown:
+        raise SceneError(join("", unknown[0]), f"unknown key; valid: {list(TOP_LEVEL)}")
+    head = check_table(data.get("scene", {}), FIELDS["scene"], "scene")
+    mesh = _mesh(data.get("mesh", {}), folder)
+    disc = check_table(data.get("discretisation", {}), FIELDS["discretisation"], "discretisation")
 
     materials = {}
-    for name, table in data.get("materials", {}).items():
-        _check_keys(table, SCHEMA["material"], f"materials.{name}")
-        try:
-            materials[name] = Material(
-                float(table["E"]), float(table["nu"]), table.get("plane", "strain")
-            )
-        except KeyError as missing:
-            raise ValueError(f"materials.{name} needs {missing}") from None
-    if not materials:
-        raise ValueError("The scene defines no material ([materials.NAME] with E and nu)")
-
-    interfaces = []
-    for k, table in enumerate(data.get("interfaces", [])):
-        where = f"interfaces[{k}]"
-        _check_keys(table, SCHEMA["interface"], where)
-        shape = _choice(table.get("shape"), SHAPES, f"{where}.shape")
-        law = _choice(table.get("law", "bonded"), LAWS, f"{where}.law")
-        kinematics = _choice(table.get("kinematics", "small"), KINEMATICS, f"{where}.kinematics")
-        if kinematics == "large":
-            raise NotImplementedError(
-                f"{where}.kinematics = 'large' (large sliding with slave/master pairing) is "
-                "not available yet; use 'small'"
-            )
-        for side_key in ("inside", "outside"):
-            name = table.get(side_key, next(iter(materials)))
-            if name not in materials:
-                raise ValueError(
-                    f"{where}.{side_key} = {name!r}: no such material; defined: {sorted(materials)}"
-                )
-        if shape == "expression":
-            compile_expression(table.get("expression", ""), f"{where}.expression")
-        params = {
-            k2: v
-            for k2, v in table.items()
-            if k2 in ("centre", "radius", "axes", "angle", "point", "normal", "expression")
-        }
-        interfaces.append(
-            InterfaceSpec(
-                shape=shape,
-                law=law,
-                params=params,
-                name=table.get("name", f"interface{k}"),
-                inside=table.get("inside", next(iter(materials))),
-                outside=table.get("outside", next(iter(materials))),
-                friction=table.get("friction"),
-                augmentation=float(table.get("augmentation", 1.0)),
-                lbb=table.get("lbb", "stabilized"),
-                kinematics=kinematics,
-            )
+    for where, name, table in _tables(data.get("materials", {}), "materials", listed=False):
+        check_table(table, FIELDS["material"], where)
+        materials[name] = Material(
+            float(table["E"]), float(table["nu"]), table.get("plane", "strain")
         )
+    if not materials:
+        raise SceneError("materials", "the scene defines no material ([materials.NAME] E, nu)")
+    interfaces = [
+        _interface(table, k, materials)
+        for _, k, table in _tables(data.get("interfaces", []), "interfaces", listed=True)
+    ]
     _check_shared(interfaces)
 
     parts = {}
-    for name, table in data.get("parts", {}).items():
-        _check_keys(table, SCHEMA["part"], f"parts.{name}")
-        compile_expression(table.get("where", ""), f"parts.{name}.where")
-        parts[name] = table["where"]
-
-    loads = []
-    mesh_kind = _choice(mesh.get("kind", "rectangle"), MESH_KINDS, "mesh.kind")
-    mesh_file, size = _gmsh_source(mesh, mesh_kind, folder)
-    known_parts = set(BUILTIN_PARTS[mesh_kind]) | set(parts)
-    if mesh_file is not None:
+    for where, name, table in _tables(data.get("parts", {}), "parts", listed=False):
+        parts[name] = check_table(table, FIELDS["part"], where)["where"]
+    known_parts = set(BUILTIN_PARTS[mesh["kind"]]) | set(parts)
+    if mesh["file"] is not None:
         from xfem_contact.io.gmsh import physical_parts
 
-        known_parts |= set(physical_parts(mesh_file))
-    for k, table in enumerate(data.get("loads", [])):
-        where = f"loads[{k}]"
-        _check_keys(table, SCHEMA["load"], where)
-        kind = _choice(table.get("type"), LOAD_TYPES, f"{where}.type")
-        part = table.get("part")
-        if kind not in ("point_displacement", "body_force"):
-            if part not in known_parts:
-                raise ValueError(
-                    f"{where}.part = {part!r}: no such boundary part; known: {sorted(known_parts)}"
-                )
-        side = table.get("side")
-        if side is not None:
-            _choice(side, (-1, 1), f"{where}.side")
-        if "value" not in table:
-            raise ValueError(f"{where} needs a value")
-        loads.append(
-            LoadSpec(
-                part,
-                kind,
-                table["value"],
-                side,
-                table.get("component"),
-                tuple(table["point"]) if "point" in table else None,
-            )
-        )
+        try:
+            known_parts |= set(physical_parts(mesh["file"]))
+        except (OSError, ValueError) as error:
+            raise SceneError("mesh.file", " ".join(str(error).split())) from None
+    loads = [
+        _load(table, where, known_parts)
+        for where, _, table in _tables(data.get("loads", []), "loads", listed=True)
+    ]
 
-    solver = data.get("solver", {})
-    _check_keys(solver, SCHEMA["solver"], "solver")
-    load_steps = solver.get("load_steps", 1)
-    if isinstance(load_steps, bool) or not isinstance(load_steps, int) or load_steps < 1:
-        raise ValueError(f"solver.load_steps must be an integer >= 1, got {load_steps!r}")
-    petsc = _petsc_options(solver)
-
-    outputs = data.get("outputs", {})
-    _check_keys(outputs, SCHEMA["outputs"], "outputs")
-    cells = tuple(mesh.get("cells", [20, 20]))
-    if len(cells) != 2 or min(cells) < 1:
-        raise ValueError(f"mesh.cells must be [nx, ny] with positive entries, got {cells}")
+    solver = check_table(data.get("solver", {}), FIELDS["solver"], "solver")
+    outputs = check_table(data.get("outputs", {}), FIELDS["outputs"], "outputs")
     return Scene(
         name=head.get("name", "scene"),
-        kind=mesh_kind,
-        file=mesh_file,
-        size=size,
-        radii=tuple(map(float, mesh.get("radii", [1.0, 2.0]))),
-        geometry_degree=_choice(mesh.get("geometry_degree", 1), (1, 2), "mesh.geometry_degree"),
-        corners=tuple(tuple(map(float, c)) for c in mesh.get("corners", [[0, 0], [1, 1]])),
-        cells=cells,
-        cell=_choice(mesh.get("cell", "quadrilateral"), CELLS, "mesh.cell"),
-        degree=degree,
-        levelset_degree=ls_degree,
-        quadrature_degree=q_degree,
+        **mesh,
+        degree=disc.get("degree", 2),
+        levelset_degree=disc.get("levelset_degree", 2),
+        quadrature_degree=disc.get("quadrature_degree", 6),
         materials=materials,
         interfaces=tuple(interfaces),
         parts=parts,
         loads=tuple(loads),
         outputs={"vtx": True, "png": True, **outputs},
-        load_steps=load_steps,
-        petsc_options=petsc,
+        load_steps=solver.get("load_steps", 1),
+        petsc_options=_petsc_options(solver),
     )
+
+
+def _mesh(mesh, folder: pathlib.Path) -> dict:
+    """The mesh fields of a :class:`Scene` from the checked [mesh] table."""
+    check_table(mesh, FIELDS["mesh"], "mesh")
+    kind = mesh.get("kind", "rectangle")
+    for key in mesh:
+        if key != "kind" and key not in MESH_KEYS[kind]:
+            kinds = [k for k, keys in MESH_KEYS.items() if key in keys]
+            message = f"is for mesh.kind = {' or '.join(map(repr, kinds))}, not {kind!r}"
+            raise SceneError(f"mesh.{key}", message)
+    corners = tuple(tuple(map(float, c)) for c in mesh.get("corners", [[0, 0], [1, 1]]))
+    (x0, y0), (x1, y1) = corners
+    if not (x1 > x0 and y1 > y0):
+        message = f"the second corner must lie right of and above the first, got {mesh['corners']}"
+        raise SceneError("mesh.corners", message)
+    radii = tuple(map(float, mesh.get("radii", [1.0, 2.0])))
+    if not radii[0] < radii[1]:
+        raise SceneError("mesh.radii", f"r_inner must be < r_outer, got {list(radii)}")
+    path, size = _gmsh_source(mesh, kind, folder)
+    return {
+        "kind": kind,
+        "file": path,
+        "size": size,
+        "corners": corners,
+        "radii": radii,
+        "geometry_degree": mesh.get("geometry_degree", 1),
+        "cells": tuple(mesh.get("cells", [20, 20])),
+        "cell": mesh.get("cell", "quadrilateral"),
+    }
+
+
+def _interface(table, k: int, materials: dict) -> InterfaceSpec:
+    """Interface ``k`` from its checked table: the parameters of its shape, its law's."""
+    where = f"interfaces[{k}]"
+    check_table(table, FIELDS["interface"], where)
+    shape = table["shape"]
+    required, optional = SHAPE_KEYS[shape]
+    parameters = ", ".join(required + optional)
+    for key in required:
+        if key not in table:
+            message = f"required for shape {shape!r} (its parameters: {parameters})"
+            raise SceneError(f"{where}.{key}", message)
+    for key in {k for keys in SHAPE_KEYS.values() for k in keys[0] + keys[1]}:
+        if key in table and key not in required + optional:
+            message = f"is not a parameter of shape {shape!r} (its parameters: {parameters})"
+            raise SceneError(f"{where}.{key}", message)
+    if "normal" in table and not 0.0 < math.hypot(*table["normal"]) < math.inf:
+        raise SceneError(f"{where}.normal", f"must be a non-zero vector, got {table['normal']}")
+    law = table.get("law", "bonded")
+    if law == "coulomb" and "friction" not in table:
+        raise SceneError(f"{where}.friction", "required for law 'coulomb' (coefficient >= 0)")
+    kinematics = table.get("kinematics", "small")
+    if kinematics == "large":
+        raise NotImplementedError(
+            f"{where}.kinematics: 'large' (large sliding with slave/master pairing) is "
+            "not available yet; use 'small'"
+        )
+    first = next(iter(materials))
+    for side_key in ("inside", "outside"):
+        name = table.get(side_key, first)
+        if name not in materials:
+            message = f"{name!r}: no such material; defined: {sorted(materials)}"
+            raise SceneError(f"{where}.{side_key}", message)
+    return InterfaceSpec(
+        shape=shape,
+        law=law,
+        params={k: table[k] for k in required + optional if k in table},
+        name=table.get("name", f"interface{k}"),
+        inside=table.get("inside", first),
+        outside=table.get("outside", first),
+        friction=table.get("friction"),
+        augmentation=float(table.get("augmentation", 1.0)),
+        lbb=table.get("lbb", "stabilized"),
+        kinematics=kinematics,
+    )
+
+
+def _load(table, where: str, known_parts: set) -> LoadSpec:
+    """A load from its checked table: the keys of its type, its part, the form of its value."""
+    check_table(table, FIELDS["load"], where)
+    kind = table["type"]
+    required, optional = LOAD_KEYS[kind]
+    for key in required:
+        if key not in table:
+            raise SceneError(f"{where}.{key}", f"required for a {kind!r} load")
+    for key in table:
+        if key != "type" and key not in required + optional:
+            keys = ", ".join(required + optional)
+            message = f"is not a key of a {kind!r} load (its keys: {keys})"
+            raise SceneError(f"{where}.{key}", message)
+    part = table.get("part")
+    if "part" in required and part not in known_parts:
+        message = f"{part!r}: no such boundary part; known: {sorted(known_parts)}"
+        raise SceneError(f"{where}.part", message)
+    _load_value(table["value"], kind, "component" in table, f"{where}.value")
+    return LoadSpec(
+        part,
+        kind,
+        table["value"],
+        table.get("side"),
+        table.get("component"),
+        tuple(table["point"]) if "point" in table else None,
+    )
+
+
+def _load_value(value, kind: str, component: bool, key: str) -> None:
+    """Check the value of a load: its form (scalar, [vx, vy]) by type, each entry a finite
+    number or an expression (UFL for loads on forms, numpy for interpolated data)."""
+    if kind == "point_displacement":
+        Number()(value, key)
+    elif kind == "pressure":
+        Scalar("load")(value, key)
+    elif kind in ("traction", "body_force"):
+        Vector(2, Scalar("load"))(value, key)
+    elif component:
+        Scalar("number")(value, key)
+    elif isinstance(value, list | tuple):
+        Vector(2, Scalar("number"))(value, key)
+    elif isinstance(value, str):
+        raise SceneError(key, "an expression needs component = 0 or 1; for both give [vx, vy]")
+    else:
+        Scalar("number")(value, key)
 
 
 def _check_shared(interfaces: list[InterfaceSpec]) -> None:
@@ -232,61 +305,49 @@ def _check_shared(interfaces: list[InterfaceSpec]) -> None:
             mine, first = getattr(spec, key), getattr(interfaces[0], key)
             if mine != first:
                 raise NotImplementedError(
-                    f"interfaces[{k}].{key} = {mine!r} differs from interfaces[0].{key} = "
+                    f"interfaces[{k}].{key}: {mine!r} differs from interfaces[0].{key} = "
                     f"{first!r}: the interfaces of one scene lie in one body and must share "
                     f"{list(SHARED_INTERFACE_KEYS)}"
                 )
     names = [spec.name for spec in interfaces]
-    if len(set(names)) != len(names):
-        raise ValueError(f"Interface names must be unique, got {names}")
+    for k, name in enumerate(names):
+        if name in names[:k]:
+            message = f"{name!r} names interfaces[{names.index(name)}] too; names must be unique"
+            raise SceneError(f"interfaces[{k}].name", message)
 
 
 def _gmsh_source(mesh: dict, kind: str, folder: pathlib.Path):
     """(file, size) of a gmsh mesh, checked; (None, None) for built-in meshes."""
     if kind != "gmsh":
-        for key in ("file", "size"):
-            if key in mesh:
-                raise ValueError(f"mesh.{key} is for mesh.kind = 'gmsh', not {kind!r}")
         return None, None
     if "file" not in mesh:
-        raise ValueError("mesh.kind = 'gmsh' needs mesh.file (a .geo or .msh file)")
+        raise SceneError("mesh.file", "required for mesh.kind = 'gmsh' (a .geo or .msh file)")
     path = (folder / mesh["file"]).resolve()
     if path.suffix not in (".geo", ".msh"):
-        raise ValueError(f"mesh.file = {mesh['file']!r}: expected a .geo or .msh file")
-    if not path.exists():
-        raise ValueError(f"mesh.file = {mesh['file']!r}: no such file ({path})")
+        raise SceneError("mesh.file", f"{mesh['file']!r}: expected a .geo or .msh file")
+    if not path.is_file():
+        raise SceneError("mesh.file", f"{mesh['file']!r}: no such file ({path})")
     if path.suffix == ".msh":
         given = sorted({"size", "cell", "geometry_degree"} & set(mesh))
         if given:
-            raise ValueError(
-                f"mesh.{given[0]} is read from the .msh file itself; give it only with a .geo"
-            )
+            message = "is read from the .msh file itself; give it only with a .geo"
+            raise SceneError(f"mesh.{given[0]}", message)
     size = mesh.get("size")
-    if size is not None and not float(size) > 0.0:
-        raise ValueError(f"mesh.size must be > 0 (m), got {size!r}")
     return path, None if size is None else float(size)
 
 
 def _petsc_options(solver: dict) -> dict:
-    """PETSc options of the [solver] table (Newton tolerances and the raw options)."""
-    options = {}
-    for key, option in (
-        ("max_iterations", "snes_max_it"),
-        ("rtol", "snes_rtol"),
-        ("atol", "snes_atol"),
-    ):
-        if key in solver:
-            value = solver[key]
-            if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
-                raise ValueError(f"solver.{key} must be a positive number, got {value!r}")
-            options[option] = value
-    raw = solver.get("petsc", {})
-    if not isinstance(raw, dict):
-        raise ValueError("solver.petsc must be a table of PETSc options")
-    for key, value in raw.items():
-        if not isinstance(value, str | int | float | bool):
-            raise ValueError(f"solver.petsc.{key} must be a string, number or boolean")
-    return options | raw
+    """PETSc options of the checked [solver] table (Newton tolerances and the raw options)."""
+    options = {
+        option: solver[key]
+        for key, option in (
+            ("max_iterations", "snes_max_it"),
+            ("rtol", "snes_rtol"),
+            ("atol", "snes_atol"),
+        )
+        if key in solver
+    }
+    return options | solver.get("petsc", {})
 
 
 def bundled_scenes() -> dict[str, pathlib.Path]:
