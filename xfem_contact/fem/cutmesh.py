@@ -15,7 +15,7 @@ import numpy.typing as npt
 import ufl
 from mpi4py import MPI
 
-from xfem_contact.fem.interface_cells import cell_interfaces, without_slivers
+from xfem_contact.fem.interface_cells import cell_interfaces, trace_nullity, without_slivers
 from xfem_contact.geometry import cut
 from xfem_contact.geometry.levelset import (
     CellMaps,
@@ -226,6 +226,14 @@ class CutMesh:
         return ufl.Measure(
             "dx", domain=self.mesh, subdomain_data=self, subdomain_id=_INTERFACE0 + k
         )
+
+    def trace_nullity(self, name: str | None = None) -> npt.NDArray[np.int32]:
+        """Per cut cell of interface ``name`` (rows of ``cut_cells``): the nullity of the
+        trace of its P1/Q1 vertex functions on its interface piece (see
+        :func:`xfem_contact.fem.interface_cells.trace_nullity`); 0 on other cells."""
+        rules = self.interface_rules_of(name)
+        J = self.maps.jacobian(self.cut_cells[rules.point_rows], rules.points)
+        return trace_nullity(self.mesh.topology.cell_name(), rules, np.linalg.det(J))
 
     def normal_at(self, rules: quadrature.RuleSet) -> npt.NDArray[np.float64]:
         """The unit normal :attr:`normal` (``grad phi_h / |grad phi_h|``) evaluated at

@@ -4,6 +4,7 @@ cell, and the removal of round-off slivers (both used by
 
 from __future__ import annotations
 
+import basix
 import dolfinx.mesh
 import numpy as np
 import numpy.typing as npt
@@ -59,3 +60,47 @@ def without_slivers(
     )
     h = mesh.h(mesh.topology.dim, cut_cells)
     return rules.select(length > SLIVER_TOLERANCE * h)
+
+
+#: A singular value of a cell's trace matrix below this fraction of the largest is zero
+TRACE_RANK_TOLERANCE = 1e-8
+
+
+def trace_nullity(
+    cell_name: str, rules: quadrature.RuleSet, jacobian_det: npt.NDArray[np.float64]
+) -> npt.NDArray[np.int32]:
+    """Per cut cell: how many combinations of the cell's P1/Q1 vertex functions vanish
+    on its interface piece (the nullity of the weighted trace matrix).
+
+    A straight piece in a triangle or a quadrilateral leaves 1 (a linear function on a
+    segment has 2 values, a bilinear one 3). A piece along a line of the cell's
+    reference coordinates (a circle in a polar mesh, a line along a cell row) leaves 2
+    in a quadrilateral: those combinations, joined over the cells, are multiplier
+    modes no interface term sees.
+
+    Args:
+        cell_name: ``"triangle"`` or ``"quadrilateral"``.
+        rules: The interface rules (per cut cell).
+        jacobian_det: ``|det J|`` at every rule point, shape ``(npoints,)``.
+
+    Returns:
+        Shape ``(num_rules,)``; cells without points get 0.
+    """
+    element = basix.create_element(
+        basix.ElementFamily.P, basix.CellType[cell_name], 1, basix.LagrangeVariant.gll_warped
+    )
+    nv = element.dim
+    counts = np.diff(rules.offsets)
+    nullity = np.zeros(rules.num_rules, dtype=np.int32)
+    if rules.weights.size == 0:
+        return nullity
+    basis = element.tabulate(0, rules.points)[0, :, :, 0]  # (npoints, nv)
+    basis *= np.sqrt(np.abs(rules.weights * jacobian_det))[:, None]
+    rank_of_point = np.arange(rules.weights.size) - rules.offsets[rules.point_rows]
+    padded = np.zeros((rules.num_rules, max(int(counts.max()), nv), nv))
+    padded[rules.point_rows, rank_of_point] = basis
+    sigma = np.linalg.svd(padded, compute_uv=False)  # (num_rules, nv), descending
+    has_points = counts > 0
+    ranks = np.sum(sigma > TRACE_RANK_TOLERANCE * sigma[:, :1], axis=1)
+    nullity[has_points] = nv - ranks[has_points]
+    return nullity

@@ -125,6 +125,7 @@ class Problem(Loads):
             indicator.x.scatter_forward()
             on_cut_cells = indicator
         return InterfaceContext(
+            aligned_cells=self._aligned_cells(name),
             cut=cut,
             name=name,
             measure=cut.interface_measure(name),
@@ -135,6 +136,18 @@ class Problem(Loads):
             field=field,
             w_old=self.w_old,
         )
+
+    def _aligned_cells(self, name: str) -> dolfinx.fem.Function | None:
+        """DG0 indicator of the cut cells of interface ``name`` whose piece follows a
+        line of the reference coordinates; None when no process has one. Collective."""
+        cut = self.cut
+        local = cut.cut_cells[cut.trace_nullity(name) >= 2]
+        if self.mesh.comm.allreduce(local.size, op=MPI.SUM) == 0:
+            return None
+        aligned = dolfinx.fem.Function(self.side_indicator.function_space, name="aligned")
+        aligned.x.array[aligned.function_space.dofmap.list[local, 0]] = 1.0
+        aligned.x.scatter_forward()
+        return aligned
 
     @property
     def ghost_penalty(self) -> float:

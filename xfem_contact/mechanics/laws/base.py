@@ -61,6 +61,10 @@ class InterfaceContext:
         cut_cells: 1 on the cut cells of this interface, 0 elsewhere (UFL, cellwise).
         field: Index of the law's multiplier field in the mixed space (None without).
         w_old: The last accepted state (origin of incremental laws' slip).
+        aligned_cells: 1 on the cut cells whose interface piece follows a line of the
+            cell's reference coordinates (trace nullity >= 2, see
+            :meth:`~xfem_contact.fem.cutmesh.CutMesh.trace_nullity`), DG0; None when
+            no process has one.
     """
 
     cut: CutMesh
@@ -72,6 +76,7 @@ class InterfaceContext:
     cut_cells: typing.Any
     field: int | None
     w_old: dolfinx.fem.Function
+    aligned_cells: dolfinx.fem.Function | None = None
 
     @property
     def normal(self) -> ufl.core.expr.Expr:
