@@ -140,6 +140,40 @@ def test_boundary_pieces_exact(cell, degree):
         cut.ds(1, tags, 8)
 
 
+@pytest.mark.mpi
+def test_boundary_measure_ids_agree_across_processes():
+    """cut.ds of parts that only rank 0 owns (empty elsewhere): the measure ids, so the
+    form signatures, agree on every process (the compile is collective: different forms
+    deadlock it), a part given again gets its id again, and the integrals are DOLFINx's
+    own over the same facets (sides -1 and +1 together: cut facets included)."""
+    mesh = unit_square(6, "triangle")
+    comm, fdim = mesh.comm, mesh.topology.dim - 1
+    cut = xfem_contact.CutMesh(mesh, lambda x: 0.3 * x[0] + x[1] - 0.61)
+    mesh.topology.create_connectivity(fdim, fdim + 1)
+    exterior = dolfinx.mesh.exterior_facet_indices(mesh.topology)
+    exterior = exterior[exterior < mesh.topology.index_map(fdim).size_local]
+    if comm.rank > 0:
+        exterior = exterior[:0]
+    first, second = exterior[::2], exterior[1::2]
+    assert comm.allreduce(second.size, op=MPI.SUM) > 0  # both parts exist (on rank 0)
+    measures = [cut.ds(1, first), cut.ds(1, second), cut.ds(1, first.copy()), cut.ds(-1, first)]
+    ids = [m.subdomain_id() for m in measures]
+    assert comm.allgather(ids) == [ids] * comm.size
+    assert len({ids[0], ids[1], ids[3]}) == 3 and ids[2] == ids[0]
+
+    x = ufl.SpatialCoordinate(mesh)
+    tagged = np.r_[first, second]
+    order = np.argsort(tagged)
+    values = np.r_[np.full(first.size, 1), np.full(second.size, 2)].astype(np.int32)[order]
+    tags = dolfinx.mesh.meshtags(mesh, fdim, tagged[order], values)
+    ds = ufl.ds(domain=mesh, subdomain_data=tags)
+    g = 1 + x[0] ** 2 + x[1]
+    for tag, facets in ((1, first), (2, second)):
+        reference = comm.allreduce(assemble_scalar(dolfinx.fem.form(g * ds(tag))), op=MPI.SUM)
+        both = integrate(g * cut.ds(-1, facets) + g * cut.ds(1, facets))
+        assert both == pytest.approx(reference, rel=1e-13)
+
+
 def test_update_reuses_compiled_forms():
     """A moved interface: new rules, same compiled kernels."""
     from xfem_contact.fem import forms

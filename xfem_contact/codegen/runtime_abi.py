@@ -18,6 +18,13 @@ Block (``int64`` array) for a kernel with ``T`` runtime tables and ``R`` rules
 
 A kernel that finds no block for its key, or a rule index out of range, writes
 NaN into its element tensor: missing data never reads as zero.
+
+Layout version
+    :data:`LAYOUT_VERSION` numbers this layout and the code that reads it. It enters
+    every kernel key and, as the form-compiler option :data:`LAYOUT_OPTION`, the
+    signature of every JIT module :func:`xfem_contact.form` compiles (FFCx and DOLFINx
+    name their on-disk cache entries by that signature): a new version compiles new
+    modules instead of loading kernels of an older layout from the cache.
 """
 
 from __future__ import annotations
@@ -37,6 +44,13 @@ LANGUAGE = "xfem_contact.codegen"
 #: not the points, with probability one; more points make accidental near-zero
 #: or near-one values (clamped by FFCx) even less likely.
 NUM_PLACEHOLDER_POINTS = 13
+
+#: Version of the memory layout above and of the generated code that reads it. Bump it
+#: with any change to either (marker, registry, block, table order, kernel prologue).
+LAYOUT_VERSION = 1
+#: The form-compiler option that carries :data:`LAYOUT_VERSION` into FFCx's module
+#: signature (FFCx keeps options it does not know, and hashes all of them)
+LAYOUT_OPTION = "xfem_contact_layout_version"
 
 _SEEDS = {"triangle": 20261122, "quadrilateral": 20261123}
 
@@ -92,6 +106,7 @@ def is_placeholder_rule(points: npt.NDArray[np.floating]) -> bool:
 
 
 def kernel_key(spec: tuple) -> int:
-    """Deterministic positive int64 key of a kernel's runtime-table specification."""
-    digest = hashlib.sha256(repr(spec).encode()).digest()
+    """Deterministic positive int64 key of a kernel's runtime-table specification
+    under the current :data:`LAYOUT_VERSION`."""
+    digest = hashlib.sha256(repr((LAYOUT_VERSION, spec)).encode()).digest()
     return int.from_bytes(digest[:8], "little") & 0x7FFF_FFFF_FFFF_FFFF

@@ -4,6 +4,7 @@ and for the interface.
 
 from __future__ import annotations
 
+import hashlib
 import itertools
 import time
 from collections.abc import Mapping
@@ -79,7 +80,7 @@ class CutMesh:
         self.degree = degree
         self.quadrature_degree = quadrature_degree
         self.id = next(_counter)
-        self._boundary_sets: list[tuple[int, np.ndarray]] = []
+        self._boundary_sets: list[tuple[tuple[int, str], np.ndarray]] = []
         self._boundary_parts: dict[int, list[IntegrationPart]] = {}
         self.update(levelset)
 
@@ -279,17 +280,21 @@ class CutMesh:
             value: The tag value when ``facets`` is a ``MeshTags``.
 
         Uncut cells' facets use FFCx's standard facet rule; pieces of facets of
-        cut cells are runtime rules with ``ufl.FacetNormal`` available.
+        cut cells are runtime rules with ``ufl.FacetNormal`` available. Collective: the
+        measure id (in the form's signature) is the same on every process, found by the
+        side and a hash of the part's global facet indices, never by local arrays.
         """
         if side not in (-1, 1):
             raise ValueError(f"side must be -1 or +1, got {side!r}")
         facets = self._facet_array(facets, value)
-        known = [s == side and np.array_equal(f, facets) for s, f in self._boundary_sets]
-        if any(known):
-            slot = known.index(True)
-        else:
-            self._boundary_sets.append((side, facets))
-            slot = len(self._boundary_sets) - 1
+        imap = self.mesh.topology.index_map(self.mesh.topology.dim - 1)
+        part = np.concatenate(self.mesh.comm.allgather(imap.local_to_global(facets)))
+        key = (side, hashlib.sha256(np.sort(part).astype(np.int64).tobytes()).hexdigest())
+        keys = [k for k, _ in self._boundary_sets]
+        if key not in keys:
+            self._boundary_sets.append((key, facets))
+            keys.append(key)
+        slot = keys.index(key)
         return ufl.Measure(
             "ds", domain=self.mesh, subdomain_data=self, subdomain_id=_BOUNDARY0 + slot
         )
@@ -319,7 +324,7 @@ class CutMesh:
         """Standard and runtime parts of boundary set ``slot`` on the current cut."""
         if slot in self._boundary_parts:
             return self._boundary_parts[slot]
-        side, facets = self._boundary_sets[slot]
+        (side, _), facets = self._boundary_sets[slot]
         mesh, tdim = self.mesh, self.mesh.topology.dim
         cell_name = mesh.topology.cell_name()
         mesh.topology.create_connectivity(tdim - 1, tdim)

@@ -20,7 +20,7 @@ import ufl
 from dolfinx.fem import IntegralType
 from dolfinx.fem.forms import CompiledForm, compile_form, create_form, get_integration_domains
 
-from xfem_contact.codegen import LANGUAGE
+from xfem_contact.codegen import LANGUAGE, runtime_abi
 from xfem_contact.codegen.compat import analyze_ufl_objects, compute_ir, get_options
 from xfem_contact.codegen.tables import RuntimeIntegral, runtime_integral
 from xfem_contact.quadrature.cell_rules import CellRules
@@ -191,7 +191,8 @@ def form(
     Args:
         ufl_form: A UFL form, or a (nested) list of them.
         form_compiler_options: FFCx options (``scalar_type`` defaults to
-            ``dolfinx.default_scalar_type``; ``language`` is set here).
+            ``dolfinx.default_scalar_type``; ``language`` and the layout version
+            :data:`~xfem_contact.codegen.runtime_abi.LAYOUT_OPTION` are set here).
         jit_options: DOLFINx JIT options.
 
     Returns:
@@ -206,6 +207,8 @@ def form(
         return ufl_form
     options = {"scalar_type": dolfinx.default_scalar_type, **(form_compiler_options or {})}
     options["language"] = LANGUAGE
+    # In the JIT module's signature: a new layout never loads a cached kernel of an old one
+    options[runtime_abi.LAYOUT_OPTION] = runtime_abi.LAYOUT_VERSION
     rewrite = _rewrite(ufl_form)
     domain = ufl_form.ufl_domain()
     mesh = dolfinx.mesh.Mesh(domain.ufl_cargo(), domain)

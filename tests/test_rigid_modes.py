@@ -1,0 +1,182 @@
+"""Free rigid modes found before solving: bodies no Dirichlet condition or interface
+law holds, by name, with their modes and the point constraints that remove them."""
+
+import dolfinx.mesh
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from xfem_contact.cases.paper import inclusion_problem
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.problem import Problem
+from xfem_contact.mechanics.rigid_modes import check_rigid_modes, free_bodies
+
+INSIDE = "side -1 (inside interface 'interface')"
+OUTSIDE = "side +1 (outside interface 'interface')"
+#: The point constraints of paper case 2 (inclusion_problem): u_x at two points, u_y at one
+PAPER_POINTS = [([0.5, 0.0], 0), ([0.5, 1.0], 0), ([0.0, 0.5], 1)]
+
+
+def on_boundary(x):
+    return np.isclose(x[0], 0) | np.isclose(x[0], 1) | np.isclose(x[1], 0) | np.isclose(x[1], 1)
+
+
+def case2(law, points=PAPER_POINTS, outer_fixed=False, **options):
+    """Paper case 2 with the given point constraints only (or the outer boundary fixed)."""
+    options = {k: v for k, v in options.items() if v is not None}
+    problem = inclusion_problem(10, 2, law, **options)
+    problem._bcs.clear()
+    for point, component in points:
+        problem.add_point_displacement(point, 0.0, component)
+    if outer_fixed:
+        problem.add_displacement(on_boundary, 0.0)
+    return problem
+
+
+def check(problem) -> list[str]:
+    """check_rigid_modes, with the same answer on every process."""
+    messages = check_rigid_modes(problem)
+    assert problem.mesh.comm.allgather(messages) == [messages] * problem.mesh.comm.size
+    return messages
+
+
+def fixed_by_the_remedies(problem) -> bool:
+    """Whether the point constraints the check proposes leave nothing free."""
+    for body in free_bodies(problem):
+        for point, component in body.remedies:
+            problem.add_point_displacement(point, 0.0, component)
+    return check(problem) == []
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("law", ["sticking", "coulomb", "bonded"])
+def test_case2_with_its_point_constraints_is_held(law):
+    options = {"friction": 1.0} if law == "coulomb" else {}
+    assert check(inclusion_problem(10, 2, law, **options)) == []
+
+
+@pytest.mark.mpi
+def test_without_point_constraints_the_plate_and_inclusion_are_free():
+    (message,) = check(case2("sticking", points=[]))
+    assert message.startswith(
+        f"{OUTSIDE}: translations x, y and rotation about (0.5, 0.5) are not constrained "
+        "(no Dirichlet condition; interface 'interface' is sticking: it ties the two sides; "
+        f"it moves together with {INSIDE}); fix them with add_point_displacement("
+    )
+    assert fixed_by_the_remedies(case2("sticking", points=[]))
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize(
+    "dropped, mode",
+    [(1, "rotation about (0, 0)"), (2, "translation y"), (0, "rotation about (0, 1)")],
+    ids=["no second u_x", "no u_y", "no first u_x"],
+)
+def test_one_point_constraint_less_frees_one_mode(dropped, mode):
+    points = [p for i, p in enumerate(PAPER_POINTS) if i != dropped]
+    (message,) = check(case2("sticking", points=points))
+    assert message.startswith(f"{OUTSIDE}: {mode} is not constrained (Dirichlet conditions")
+    assert fixed_by_the_remedies(case2("sticking", points=points))
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("points, outer_fixed", [([], True), (PAPER_POINTS, False)])
+def test_a_frictionless_circle_leaves_the_inclusion_free_to_spin(points, outer_fixed):
+    """Only the spin: the normal contact holds the inclusion's translations."""
+    (message,) = check(case2("frictionless", points, outer_fixed))
+    assert message.startswith(
+        f"{INSIDE}: rotation about (0.5, 0.5) is not constrained (no Dirichlet condition; "
+        "interface 'interface' is frictionless: it transmits no tangential traction); "
+        "fix it with add_point_displacement("
+    )
+    assert fixed_by_the_remedies(case2("frictionless", points, outer_fixed))
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("law, friction", [("sticking", None), ("coulomb", 0.3), ("bonded", None)])
+def test_laws_that_tie_the_sides_hold_the_inclusion(law, friction):
+    assert check(case2(law, [], outer_fixed=True, friction=friction)) == []
+
+
+def test_coulomb_without_friction_is_frictionless():
+    (message,) = check(case2("coulomb", [], outer_fixed=True, friction=0.0))
+    assert message.startswith(f"{INSIDE}: rotation about (0.5, 0.5) is not constrained")
+
+
+def test_a_free_interface_leaves_the_inclusion_free():
+    (message,) = check(case2("free", [], outer_fixed=True))
+    assert message.startswith(
+        f"{INSIDE}: translations x, y and rotation about (0.5, 0.5) are not constrained "
+        "(no Dirichlet condition; interface 'interface' is free: it transmits nothing)"
+    )
+    assert fixed_by_the_remedies(case2("free", [], outer_fixed=True))
+
+
+@pytest.mark.mpi
+def test_an_elliptic_frictionless_inclusion_is_locked_by_its_shape():
+    problem = Problem(
+        CutMesh(
+            dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 12, 12),
+            lambda x: np.hypot((x[0] - 0.5) / 0.3, (x[1] - 0.5) / 0.2) - 1.0,
+        ),
+        2,
+        Material(1e6, 0.3),
+        "frictionless",
+    )
+    problem.add_displacement(on_boundary, 0.0)
+    assert check(problem) == []
+
+
+def test_a_spin_left_by_a_frictionless_interface_is_told_from_a_missing_support():
+    (spin,) = free_bodies(case2("frictionless", [], outer_fixed=True))
+    (support,) = free_bodies(case2("sticking", [PAPER_POINTS[0], PAPER_POINTS[2]]))
+    (free,) = free_bodies(case2("free", [], outer_fixed=True))
+    assert spin.spin_only and spin.modes == ["rotation about (0.5, 0.5)"]
+    assert not support.spin_only and support.modes == ["rotation about (0, 0)"]
+    assert not free.spin_only
+
+
+def straight(law):
+    """Two blocks on y = 1 (not a mesh line): the lower one clamped at y = 0."""
+    mesh = dolfinx.mesh.create_rectangle(
+        MPI.COMM_WORLD, [[0.0, 0.0], [2.0, 2.0]], [8, 7], dolfinx.mesh.CellType.quadrilateral
+    )
+    cut = CutMesh(mesh, lambda x: x[1] - 1.0, degree=1)
+    problem = Problem(cut, 1, Material(1e6, 0.3), law)
+    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
+    return problem
+
+
+@pytest.mark.mpi
+def test_a_straight_frictionless_interface_lets_the_upper_block_slide():
+    """The same question on another geometry: the normal contact holds the upper block's
+    lift and rotation, not its sliding."""
+    (message,) = check(straight("frictionless"))
+    assert message.startswith(
+        "side +1 (outside interface 'interface'): translation x is not constrained "
+        "(no Dirichlet condition; interface 'interface' is frictionless"
+    )
+    assert check(straight("sticking")) == []
+    assert fixed_by_the_remedies(straight("frictionless"))
+
+
+@pytest.mark.mpi
+def test_each_inclusion_is_a_body():
+    """Two inclusions with their own laws in a clamped plate: only the frictionless one
+    spins, named by its interface, about its own centre."""
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 16, 16)
+    cut = CutMesh(
+        mesh,
+        {
+            "left": lambda x: np.hypot(x[0] - 0.28, x[1] - 0.5) - 0.12,
+            "right": lambda x: np.hypot(x[0] - 0.72, x[1] - 0.5) - 0.12,
+        },
+    )
+    problem = Problem(cut, 2, Material(1e6, 0.3), {"left": "sticking", "right": "frictionless"})
+    problem.add_displacement(on_boundary, 0.0)
+    (message,) = check(problem)
+    assert message.startswith(
+        "side -1 (inside interface 'right'): rotation about (0.72, 0.5) is not constrained "
+        "(no Dirichlet condition; interface 'right' is frictionless"
+    )

@@ -1,0 +1,339 @@
+"""Rigid modes that no Dirichlet condition or interface law removes, found before solving.
+
+A problem is singular when a body can move rigidly with nothing resisting it: the
+solve fails (Newton iterates until SNES gives up) or, worse, returns a solution
+with an arbitrary rigid motion in it.
+:func:`check_rigid_modes` finds those motions from the data that decide them,
+without assembling anything:
+
+- the *bodies*: side +1 (field 1) and, for each interface, the part of side -1
+  inside it (field 0 on that interface's region), each with its rigid modes
+  (translations x, y and the rotation about its centroid);
+- the *Dirichlet conditions* (``problem._bcs``): the values of each mode at the
+  prescribed active dofs of its body;
+- the *interface laws*, by what they transmit once the interface is closed:
+  ``free`` nothing; ``frictionless`` (and ``coulomb`` with ``mu = 0``) the normal
+  jump only; ``bonded``, ``sticking``, ``coulomb`` (``mu > 0``) and any other law
+  the whole jump: the jump of the bodies' modes at the interface rule points, with
+  the normal the laws use.
+
+A combination of modes is free when its mean-square constraint is below ``tol``:
+each prescribed dof weighs one, each interface its mean over arc length, and a
+rotation is scaled by the body's radius of gyration so that every mode moves the
+body by about one. The question is geometric and answered alike for any mesh and
+cut: a straight frictionless interface leaves the sliding along it free, an ellipse
+nothing, a frictionless circle the spin of the inner body. The discrete normal
+(that of the interpolated level set) makes that spin stiff to round-off of the
+geometry only: 1e-4 of a translation's stiffness at 4 cells per diameter, 1e-6 at
+16 (reported); at 2-3 cells per diameter 1e-3 to 1e-2 (not reported with the
+default ``tol``). The bulk adds no constraint (a rigid mode has no strain and no
+ghost-penalty jump), nor do the multiplier stabilisations (nor any traction).
+Contact laws are judged closed: an interface that opens under the load may still
+leave a body free, which only the solve can tell.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import basix
+import dolfinx.la
+import numpy as np
+from mpi4py import MPI
+
+from xfem_contact.fem.evaluation import interface_points
+from xfem_contact.mechanics.laws import Coulomb, Free, Frictionless
+
+#: What a closed interface of each kind transmits (the reason in the messages)
+_KIND_TEXT = {
+    "none": "transmits nothing",
+    "normal": "transmits no tangential traction",
+    "full": "ties the two sides",
+}
+
+
+@dataclasses.dataclass
+class _Body:
+    """A side's field on the cells of one region: its owned active dofs per component."""
+
+    name: str
+    field: int
+    dofs: list[np.ndarray]  # per component: owned local dofs of W
+    coords: list[np.ndarray]  # their coordinates, (n, 2)
+    alone: list[np.ndarray]  # per component: whether no other side's field is active there
+    centre: np.ndarray
+    radius: float  # radius of gyration of its area (m)
+
+    def modes(self, x: np.ndarray, component: int) -> np.ndarray:
+        """Component ``component`` of the 3 scaled modes at points ``x``, shape (n, 3)."""
+        d = (x - self.centre) / self.radius
+        z = np.zeros((x.shape[0], 3))
+        z[:, component] = 1.0
+        z[:, 2] = -d[:, 1] if component == 0 else d[:, 0]
+        return z
+
+
+@dataclasses.dataclass
+class FreeBody:
+    """A body with rigid modes nothing constrains.
+
+    Attributes:
+        body: e.g. ``"side -1 (inside interface 'inclusion')"``.
+        modes: e.g. ``["translation x", "rotation about (0.5, 0.5)"]``.
+        reasons: Why nothing holds them (Dirichlet data, interface laws).
+        remedies: ``(point, component)`` of point constraints that remove them
+            (``problem.add_point_displacement(point, 0.0, component)``).
+        spin_only: The only free mode is a rotation that a frictionless interface of
+            the body leaves (a spin its geometry does not lock), not a missing support.
+    """
+
+    body: str
+    modes: list[str]
+    reasons: list[str]
+    remedies: list[tuple[list[float], int]]
+    spin_only: bool = False
+
+    def message(self) -> str:
+        one = len(self.modes) == 1
+        fixes = ", ".join(
+            f"add_point_displacement([{_num(p[0], 6)}, {_num(p[1], 6)}], 0.0, {c})"
+            for p, c in self.remedies
+        )
+        return (
+            f"{self.body}: {' and '.join(self.modes)} {'is' if one else 'are'} not constrained "
+            f"({'; '.join(self.reasons)}); fix {'it' if one else 'them'} with {fixes}"
+        )
+
+
+def _num(value: float, digits: int) -> str:
+    """``value`` to ``digits`` significant digits, round-off (below 1e-9) shown as 0."""
+    return f"{(0.0 if abs(value) < 1e-9 else float(value)):.{digits}g}"
+
+
+def law_kind(law) -> str:
+    """What a closed interface of ``law`` transmits: ``none``, ``normal`` or ``full``."""
+    if isinstance(law, Free):
+        return "none"
+    if isinstance(law, Frictionless) or (isinstance(law, Coulomb) and law.friction == 0):
+        return "normal"
+    return "full"
+
+
+def check_rigid_modes(problem, tol: float = 1e-3) -> list[str]:
+    """Messages naming each body with free rigid modes, the modes, why, and the
+    point constraints that remove them; empty when every body is held. Collective
+    (the same list on every process). See the module docstring for the method."""
+    return [body.message() for body in free_bodies(problem, tol)]
+
+
+def free_bodies(problem, tol: float = 1e-3) -> list[FreeBody]:
+    """The bodies with free rigid modes (:class:`FreeBody`), collective."""
+    bodies, plus, inside = _bodies(problem)
+    nb = len(bodies)
+    Q = _dirichlet_gram(problem, bodies)
+    held = [np.trace(Q[3 * b : 3 * b + 3, 3 * b : 3 * b + 3]) >= tol for b in range(nb)]
+    kinds = {name: law_kind(law) for name, law in problem.laws.items()}
+    for name, kind in kinds.items():
+        if kind != "none" and name in inside and plus is not None:
+            Q += _interface_gram(problem, bodies, name, inside[name], plus, kind)
+    values, vectors = np.linalg.eigh(0.5 * (Q + Q.T))
+    null = vectors[:, values < tol]  # the free combinations, orthonormal columns
+    found = []
+    for b, body in enumerate(bodies):
+        motion = null[3 * b : 3 * b + 3]
+        U, s, _ = np.linalg.svd(motion, full_matrices=False)
+        S = U[:, s > 0.1]  # the body's motions in free modes, (3, r) in (ax, ay, theta)
+        if S.shape[1] == 0:
+            continue
+        names = [name for name, k in inside.items() if k == b] if b != plus else list(kinds)
+        reasons = ["Dirichlet conditions hold it in part" if held[b] else "no Dirichlet condition"]
+        reasons += [
+            f"interface {n!r} is {problem.laws[n].name}: it {_KIND_TEXT[kinds[n]]}" for n in names
+        ]
+        others = [
+            bodies[o].name
+            for o in range(b + 1, nb)
+            if np.linalg.norm(null[3 * o : 3 * o + 3] @ (motion.T @ S)) > 0.1
+        ]
+        if others:
+            reasons.append("it moves together with " + ", ".join(others))
+        free = _describe(problem, body, S, reasons)
+        free.spin_only = (
+            len(free.modes) == 1
+            and free.modes[0].startswith("rotation")
+            and any(kinds[n] == "normal" for n in names)
+        )
+        found.append(free)
+        # the remedies fix every free mode that moves this body: the later bodies are
+        # left with the modes that do not
+        null = null @ _null_space(motion)
+    return found
+
+
+def _describe(problem, body: _Body, S: np.ndarray, reasons: list[str]) -> FreeBody:
+    """Names of the free motions ``S`` of ``body`` and point constraints removing them."""
+    theta = S[2]
+    turns = np.linalg.norm(theta) > 0.1
+    # translations: the motions without rotation
+    T = S @ _null_space(theta[None, :]) if turns else S
+    modes, remedies = [], []
+    pivot = body.centre
+    if T.shape[1] == 2:
+        modes.append("translations x, y")
+        q = _node(problem, body, 0, body.centre, farthest=False)
+        remedies += [(q, 0), (q, 1)]
+        pivot = np.asarray(q)
+    elif T.shape[1] == 1:
+        d = T[:2, 0] / np.linalg.norm(T[:2, 0])
+        c = int(np.argmax(np.abs(d)))
+        modes.append(
+            ("translation x", "translation y")[c]
+            if abs(d[c]) > 0.999
+            else f"translation along ({_num(d[0], 3)}, {_num(d[1], 3)})"
+        )
+        remedies.append((_node(problem, body, c, body.centre, farthest=False), c))
+    if turns:
+        v = S @ theta / np.linalg.norm(theta)  # the free motion turning most
+        a, th = v[:2], v[2]
+        centre = body.centre
+        if T.shape[1] < 2:
+            centre = body.centre + body.radius / th * np.array([-a[1], a[0]])
+        modes.append(f"rotation about ({_num(centre[0], 3)}, {_num(centre[1], 3)})")
+        if T.shape[1] < 2:
+            pivot = centre
+        q = _node(problem, body, None, pivot, farthest=True)
+        arm = np.asarray(q) - pivot
+        remedies.append((q, int(np.argmax(np.abs([arm[1], arm[0]])))))
+    return FreeBody(body.name, modes, reasons, remedies)
+
+
+def _null_space(A: np.ndarray) -> np.ndarray:
+    _, s, Vt = np.linalg.svd(A)
+    rank = int(np.sum(s > 0.1))
+    return Vt[rank:].T
+
+
+def _node(problem, body: _Body, component, point, farthest: bool) -> list[float]:
+    """The node of ``body`` farthest from (or nearest to) ``point``, preferring nodes no
+    other side's field uses (a point constraint fixes both sides' fields). Collective."""
+    c = 0 if component is None else component
+    x = body.coords[c]
+    comm = problem.mesh.comm
+    prefer = comm.allreduce(int(body.alone[c].sum()), op=MPI.SUM) > 0
+    if prefer:
+        x = x[body.alone[c]]
+    best = None
+    if x.shape[0]:
+        dist = np.linalg.norm(x - point, axis=1)
+        i = int(np.argmax(dist) if farthest else np.argmin(dist))
+        best = (float(dist[i]) if farthest else -float(dist[i]), *x[i].tolist())
+    candidates = [b for b in comm.allgather(best) if b is not None]
+    return list(max(candidates)[1:])
+
+
+def _marked(W, field: int, cells: np.ndarray) -> np.ndarray:
+    """Flags of the local dofs of ``W`` that ``field`` has on ``cells`` (any process)."""
+    vec = dolfinx.la.vector(W.dofmap.index_map, W.dofmap.index_map_bs)
+    np.add.at(vec.array, W.sub(field).dofmap.list[cells].ravel(), 1.0)
+    vec.scatter_reverse(dolfinx.la.InsertMode.add)
+    vec.scatter_forward()
+    return vec.array > 0
+
+
+def _bodies(problem) -> tuple[list[_Body], int | None, dict[str, int]]:
+    """The bodies that have active dofs; the index of side +1 and of the side -1 body
+    inside each interface."""
+    cut, space = problem.cut, problem.space
+    W, comm = space.W, problem.mesh.comm
+    nowned = W.dofmap.index_map.size_local * W.dofmap.index_map_bs
+    sides = cut.cell_sides
+    owned = np.arange(sides.size, dtype=np.int32)
+    names = cut.interface_names
+    region = cut.cell_regions()
+    regions = np.rint(region.x.array[region.function_space.dofmap.list[owned, 0]]).astype(int)
+    where = "interface " + repr(names[0]) if len(names) == 1 else "the interfaces"
+    parts = [(f"side +1 (outside {where})", 1, owned[sides >= 0], None)]
+    parts += [
+        (f"side -1 (inside interface {name!r})", 0, owned[(sides <= 0) & (regions == k)], name)
+        for k, name in enumerate(names)
+    ]
+    # the other side's dof at the same node and component (the two fields' elements match)
+    partner = np.full(space.active.size, -1, dtype=np.int64)
+    for f in (0, 1):
+        partner[W.sub(f).dofmap.list.ravel()] = W.sub(1 - f).dofmap.list.ravel()
+    bodies, plus, inside = [], None, {}
+    for label, field, cells, name in parts:
+        mask = _marked(W, field, cells) & space.active
+        dofs, coords, alone = [], [], []
+        for c in (0, 1):
+            V, parent = W.sub(field).sub(c).collapse()
+            parent = np.asarray(parent).ravel()
+            keep = (parent < nowned) & mask[parent]
+            dofs.append(parent[keep])
+            coords.append(V.tabulate_dof_coordinates()[keep, :2])
+            alone.append(~space.active[partner[parent[keep]]])
+        if comm.allreduce(coords[0].shape[0], op=MPI.SUM) == 0:
+            continue
+        centre, radius = _centroid(cut, cells, 2 * field - 1)
+        if name is None:
+            plus = len(bodies)
+        else:
+            inside[name] = len(bodies)
+        bodies.append(_Body(label, field, dofs, coords, alone, centre, radius))
+    return bodies, plus, inside
+
+
+def _centroid(cut, cells: np.ndarray, side: int) -> tuple[np.ndarray, float]:
+    """Centroid (m) and radius of gyration (m) of the part of ``cells`` on ``side``: uncut
+    cells by a degree-2 rule, cut cells by the side's rules. Collective."""
+    maps, comm = cut.maps, cut.mesh.comm
+    whole = cells[cut.cell_sides[cells] == side]
+    X, W = basix.make_quadrature(cut.mesh.basix_cell(), 2)
+    rows = np.repeat(whole, W.size)
+    points, weights = np.tile(X, (whole.size, 1)), np.tile(W, whole.size)
+    rules = cut.side_rules(side)
+    mine = np.isin(cut.cut_cells[rules.point_rows], cells)
+    rows = np.r_[rows, cut.cut_cells[rules.point_rows[mine]]].astype(np.int32)
+    points, weights = np.r_[points, rules.points[mine]], np.r_[weights, rules.weights[mine]]
+    x = maps.push_forward(rows, points)[:, :2] if rows.size else np.zeros((0, 2))
+    if rows.size:
+        weights = weights * np.abs(np.linalg.det(maps.jacobian(rows, points)))
+    area = comm.allreduce(float(weights.sum()), op=MPI.SUM)
+    centre = comm.allreduce(weights @ x, op=MPI.SUM) / area
+    inertia = comm.allreduce(float(weights @ np.sum((x - centre) ** 2, axis=1)), op=MPI.SUM)
+    return centre, float(np.sqrt(inertia / area))
+
+
+def _dirichlet_gram(problem, bodies: list[_Body]) -> np.ndarray:
+    """Block-diagonal Gram of each body's modes at its prescribed dofs (global)."""
+    W = problem.space.W
+    imap = W.dofmap.index_map
+    prescribed = np.zeros((imap.size_local + imap.num_ghosts) * W.dofmap.index_map_bs, bool)
+    for bc in problem._bcs:
+        prescribed[bc.dof_indices()[0]] = True
+    G = np.zeros((3 * len(bodies), 3 * len(bodies)))
+    for b, body in enumerate(bodies):
+        for c in (0, 1):
+            z = body.modes(body.coords[c][prescribed[body.dofs[c]]], c)
+            G[3 * b : 3 * b + 3, 3 * b : 3 * b + 3] += z.T @ z
+    return problem.mesh.comm.allreduce(G, op=MPI.SUM)
+
+
+def _interface_gram(problem, bodies, name: str, minus: int, plus: int, kind: str) -> np.ndarray:
+    """Gram (global, per unit length) of the jump of the modes of bodies ``minus`` and
+    ``plus`` across interface ``name``: the whole jump or its normal part."""
+    cut = problem.cut
+    rules = cut.interface_rules_of(name)
+    x = interface_points(cut, rules)[:, :2]
+    n = cut.normal_at(rules)[:, :2]
+    J = cut.maps.jacobian(cut.cut_cells[rules.point_rows], rules.points)
+    w = rules.weights * np.abs(np.linalg.det(J))
+    jump = np.zeros((x.shape[0], 2, 3 * len(bodies)))  # per point, component, coefficient
+    for c in (0, 1):
+        for b, sign in ((minus, -1.0), (plus, 1.0)):
+            jump[:, c, 3 * b : 3 * b + 3] += sign * bodies[b].modes(x, c)
+    if kind == "normal":
+        jump = np.einsum("pc,pcm->pm", n, jump)[:, None, :]
+    comm = problem.mesh.comm
+    G = comm.allreduce(np.einsum("p,pcm,pcl->ml", w, jump, jump), op=MPI.SUM)
+    return G / comm.allreduce(float(w.sum()), op=MPI.SUM)
