@@ -180,3 +180,26 @@ def test_each_inclusion_is_a_body():
         "side -1 (inside interface 'right'): rotation about (0.72, 0.5) is not constrained "
         "(no Dirichlet condition; interface 'right' is frictionless"
     )
+
+
+# -- what Problem.solve does with them ------------------------------------------------------
+
+
+def test_solve_refuses_a_body_without_support():
+    """Instead of Newton iterates ending in a SNES failure: one error naming the modes."""
+    problem = case2("sticking", points=[])
+    with pytest.raises(
+        ValueError, match="Free rigid modes: .*translations x, y.*add_point_displacement"
+    ):
+        problem.solve()
+
+
+def test_solve_removes_a_free_spin_with_a_warning():
+    """A frictionless circle carries no torque: its spin is fixed by the point
+    constraints the check proposes, and the solve goes on."""
+    from xfem_contact.mechanics.problem import RigidModeWarning
+
+    problem = case2("frictionless", outer_fixed=True)
+    with pytest.warns(RigidModeWarning, match="rotation"):
+        problem.solve()
+    assert check(problem) == []

@@ -12,6 +12,7 @@ SI units (Pa, m).
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from collections.abc import Callable, Mapping
 
 import dolfinx.fem
@@ -29,12 +30,17 @@ from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw, make_law
 from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loading import Loads
 from xfem_contact.mechanics.materials import Material, MaterialField
+from xfem_contact.mechanics.rigid_modes import free_bodies
 from xfem_contact.solvers.linear import solve_restricted
 from xfem_contact.solvers.newton import NewtonFailure, NewtonReport, RestrictedNewton
 
 #: Materials: one for both sides, or ``{-1: m, 1: m}`` where side -1 may map
 #: interface names to the material inside each
 Materials = Material | Mapping[int, Material | Mapping[str, Material]]
+
+
+class RigidModeWarning(UserWarning):
+    """A free spin was removed by point constraints added automatically."""
 
 
 @dataclasses.dataclass
@@ -106,6 +112,7 @@ class Problem(Loads):
         }
         self._newton: RestrictedNewton | None = None
         self._newton_key = None
+        self._checked_loads: int | None = None
         self._cut_revision = cut.revision
         for name, law in self.laws.items():
             if law.coupling(self.contexts[name]) is not None:
@@ -239,6 +246,7 @@ class Problem(Loads):
                 f"space, rules and forms follow the old interface (cut revision "
                 f"{self._cut_revision}, now {self.cut.revision}); build a new Problem"
             )
+        self._check_support(log)
         if self.linear:
             a, L = form(self.bilinear_form()), form(self.linear_form())
             w, _ = solve_restricted(a, L, self._bcs, self.space, petsc_options)
@@ -269,6 +277,26 @@ class Problem(Loads):
                 f"{str(failure).splitlines()[0]}; w restored to the state before this solve",
                 failure.report,
             ) from None
+
+    def _check_support(self, log: Callable[[str], None] | None) -> None:
+        """Free rigid modes, found before solving (:mod:`xfem_contact.mechanics.rigid_modes`):
+        a body without support is an error naming the modes and the point constraints
+        that remove them; a spin that only a frictionless interface leaves free (no
+        torque can be carried there) is removed by those point constraints, with a
+        warning. Runs again only when the loads changed. Collective."""
+        if self._checked_loads == self.loads_revision:
+            return
+        free = free_bodies(self)
+        if errors := [body.message() for body in free if not body.spin_only]:
+            raise ValueError("Free rigid modes: " + " | ".join(errors))
+        for body in free:
+            message = f"{body.message()}: added automatically (a free spin)"
+            warnings.warn(message, RigidModeWarning, stacklevel=3)
+            if log is not None and self.mesh.comm.rank == 0:
+                log(message)
+            for point, component in body.remedies:
+                self.add_point_displacement(point, 0.0, component)
+        self._checked_loads = self.loads_revision
 
     @property
     def last_report(self) -> NewtonReport | None:
