@@ -127,6 +127,10 @@ def _blend(
     return X + weight[..., None] * (m - 0.5 * (a + b))
 
 
+#: Fans whose scores differ by less than this fraction are equally good
+_TIE = 1e-9
+
+
 def _best_fan(
     pts: np.ndarray,
     seg: np.ndarray,
@@ -165,7 +169,11 @@ def _best_fan(
         drop = np.repeat(drop, len(children), axis=1)
         options.append((nodes.reshape(len(v), -1, 6, 2), drop, score))
     scores = np.stack([o[2] for o in options], axis=1)
-    best = np.argmax(scores, axis=1)
+    # Near ties (the two diagonals of a symmetric side) go to the first fan: a bare
+    # argmax followed 1-ulp noise in the nodal level set, which depends on the cell
+    # numbering, so 1 and 2 processes split some annulus cells differently.
+    top = scores.max(axis=1, keepdims=True)
+    best = np.argmax(scores >= top - _TIE * np.abs(top), axis=1)
     pick = np.arange(len(pts))
     nodes = np.stack([o[0] for o in options], axis=1)[pick, best]
     drop = np.stack([o[1] for o in options], axis=1)[pick, best]
