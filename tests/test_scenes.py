@@ -377,6 +377,7 @@ def test_cli_run_and_summary(tmp_path_factory):
     assert summary["fields"] == ["u_minus", "u_plus"]
     assert summary["dofs"]["enriched"] == 2 * 3 * 41
     assert summary["ranks"] == MPI.COMM_WORLD.size
+    assert summary["versions"] == xfem_contact.versions()  # xfem-contact, DOLFINx, FFCx, ...
 
 
 def circle_without_radius() -> str:

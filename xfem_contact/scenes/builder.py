@@ -1,0 +1,197 @@
+"""Build a :class:`~xfem_contact.scenes.scene.Scene`: its mesh, level sets, laws and
+problem, creating only the effects it names (see :func:`build`)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import NamedTuple
+
+import dolfinx.io
+import dolfinx.mesh
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.io.gmsh import GmshMesh, facets, read_gmsh
+from xfem_contact.io.meshes import annulus
+from xfem_contact.mechanics.laws import ContactLaw, make_law
+from xfem_contact.mechanics.plain import PlainElasticityProblem
+from xfem_contact.mechanics.problem import Problem
+from xfem_contact.scenes.expressions import compile_expression
+from xfem_contact.scenes.scene import InterfaceSpec, Scene
+
+
+def levelset(spec: InterfaceSpec) -> Callable[[np.ndarray], np.ndarray]:
+    """The level set of an interface, negative on its side -1 (``inside``)."""
+    p = spec.params
+    if spec.shape == "circle":
+        (cx, cy), r = p["centre"], float(p["radius"])
+        return lambda x: np.hypot(x[0] - cx, x[1] - cy) - r
+    if spec.shape == "ellipse":
+        (cx, cy), (a, b), t = p["centre"], p["axes"], float(p.get("angle", 0.0))
+
+        def phi(x):
+            dx, dy = x[0] - cx, x[1] - cy
+            u, v = np.cos(t) * dx + np.sin(t) * dy, -np.sin(t) * dx + np.cos(t) * dy
+            return min(a, b) * (np.hypot(u / a, v / b) - 1.0)
+
+        return phi
+    if spec.shape in ("line", "half-plane"):
+        (px, py), (nx, ny) = p["point"], p["normal"]
+        norm = np.hypot(nx, ny)
+        return lambda x: ((x[0] - px) * nx + (x[1] - py) * ny) / norm
+    f = compile_expression(p["expression"], "interface expression")
+    return lambda x: np.broadcast_to(np.asarray(f(x), dtype=float), x[0].shape).copy()
+
+
+def _part(scene: Scene, name: str, meshed: MeshedDomain) -> Callable | np.ndarray:
+    """A boundary part: a locator of ``x`` for built-in and expression parts, local
+    facet indices for the named physical groups of a gmsh file."""
+    if name in scene.parts:
+        f = compile_expression(scene.parts[name], f"parts.{name}.where")
+        return lambda x: np.broadcast_to(np.asarray(f(x), dtype=bool), x[0].shape).copy()
+    if meshed.gmsh is not None and name in meshed.gmsh.parts:
+        return facets(meshed.gmsh, name)
+    (x0, y0), (x1, y1) = scene.corners
+    r0, r1 = scene.radii
+    tol = 1e-6 * r1
+    builtin = {
+        "inner": lambda x: np.abs(np.hypot(x[0], x[1]) - r0) < tol,
+        "outer": lambda x: np.abs(np.hypot(x[0], x[1]) - r1) < tol,
+        "left": lambda x: np.isclose(x[0], x0),
+        "right": lambda x: np.isclose(x[0], x1),
+        "bottom": lambda x: np.isclose(x[1], y0),
+        "top": lambda x: np.isclose(x[1], y1),
+        "boundary": lambda x: np.ones(x.shape[1], dtype=bool),
+    }
+    return builtin[name]
+
+
+def _value(value, vector: bool):
+    """A load value: number, [a, b], or expression string(s) -> number/callable."""
+    if isinstance(value, list | tuple):
+        comps = [_value(v, False) for v in value]
+
+        def vector_value(x):
+            if isinstance(x, ufl.core.expr.Expr):
+                return ufl.as_vector([c(x) if callable(c) else c for c in comps])
+            return np.stack(
+                [np.broadcast_to(c(x) if callable(c) else c, x[0].shape) for c in comps]
+            )
+
+        if vector and not any(callable(c) for c in comps):
+            return ufl.as_vector(comps)
+        return vector_value
+    if isinstance(value, str):
+        f = compile_expression(value, "load value")
+        return lambda x: (
+            f(x)
+            if isinstance(x, ufl.core.expr.Expr)
+            else np.broadcast_to(np.asarray(f(x), dtype=float), x[0].shape).copy()
+        )
+    return float(value)
+
+
+class MeshedDomain(NamedTuple):
+    """The mesh of a scene and, for a gmsh file, what was read with it (named parts)."""
+
+    mesh: dolfinx.mesh.Mesh
+    gmsh: GmshMesh | None = None
+
+
+def create_mesh(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> MeshedDomain:
+    """The mesh a scene names: rectangle, annulus (curved cells) or a gmsh file. Collective."""
+    if scene.kind == "gmsh":
+        meshed = read_gmsh(scene.file, comm, scene.geometry_degree, scene.cell, scene.size)
+        return MeshedDomain(meshed.mesh, meshed)
+    if scene.kind == "annulus":
+        return MeshedDomain(annulus(comm, *scene.radii, *scene.cells, scene.geometry_degree))
+    mesh = dolfinx.mesh.create_rectangle(
+        comm,
+        [list(scene.corners[0]), list(scene.corners[1])],
+        list(scene.cells),
+        dolfinx.mesh.CellType[scene.cell],
+    )
+    return MeshedDomain(mesh)
+
+
+def interface_levelsets(scene: Scene) -> dict[str, Callable]:
+    """The level sets of the scene's interfaces by name (a :class:`CutMesh` cuts
+    several as one, checked apart: see :func:`xfem_contact.geometry.levelset.union`)."""
+    return {spec.name: levelset(spec) for spec in scene.interfaces}
+
+
+def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
+    """Create the mesh and the problem of a scene (collective). Returns (problem, effects)."""
+    meshed = create_mesh(scene, comm)
+    mesh = meshed.mesh
+    material = next(iter(scene.materials.values()))
+    if not scene.interfaces:
+        problem = PlainElasticityProblem(mesh, scene.degree, material)
+        effects = {
+            "interface": None,
+            "interfaces": [],
+            "cut": False,
+            "enrichment": False,
+            "multipliers": 0,
+            "tangential_multiplier": False,
+            "solver": "KSP (one linear solve per load step)",
+            "pairing": False,
+        }
+    else:
+        cut = CutMesh(
+            mesh,
+            interface_levelsets(scene),
+            degree=scene.levelset_degree,
+            quadrature_degree=scene.quadrature_degree,
+        )
+        laws = {
+            spec.name: make_law(
+                spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb
+            )
+            for spec in scene.interfaces
+        }
+        materials = {
+            -1: {spec.name: scene.materials[spec.inside] for spec in scene.interfaces},
+            1: scene.materials[scene.interfaces[0].outside],  # shared (see the schema)
+        }
+        problem = Problem(cut, scene.degree, materials, laws)
+        gdim = mesh.geometry.dim
+        effects = {
+            "interface": scene.interfaces[0].law if len(laws) == 1 else None,
+            "interfaces": [s.name for s in scene.interfaces],
+            "laws": {name: law.describe() for name, law in laws.items()},
+            "cut": True,
+            "enrichment": True,
+            "multipliers": sum(c for _, c, _ in problem.space.multiplier_fields),
+            "tangential_multiplier": any(
+                isinstance(law, ContactLaw) and law.multiplier_components(gdim) > 1
+                for law in laws.values()
+            ),
+            "solver": "KSP (one linear solve per load step)"
+            if problem.linear
+            else "SNES (generalized Newton)",
+            "pairing": False,
+        }
+    for load in scene.loads:
+        _apply(problem, scene, load, meshed)
+    return problem, effects
+
+
+def _apply(problem, scene: Scene, load, meshed: MeshedDomain) -> None:
+    side = {} if isinstance(problem, PlainElasticityProblem) else {"side": load.side}
+    if load.type == "point_displacement":
+        problem.add_point_displacement(load.point, float(load.value), int(load.component))
+        return
+    where = _part(scene, load.part, meshed) if load.part else None
+    if load.type == "displacement":
+        problem.add_displacement(where, _value(load.value, False), load.component)
+    elif load.type == "pressure":
+        problem.add_pressure(where, _value(load.value, False), **side)
+    elif load.type == "traction":
+        problem.add_traction(where, _value(load.value, True), **side)
+    elif load.type == "body_force":
+        problem.add_body_force(_value(load.value, True), **side)
+    else:  # the scene schema admits no other type
+        raise AssertionError(f"unhandled load type {load.type!r}")
