@@ -139,6 +139,7 @@ class RestrictedNewton:
         self.snes.setJacobian(lambda snes, y, J, P: this()._jacobian(snes, y, J, P), self.J_r)
         self.snes.setMonitor(lambda snes, it, norm: this()._monitor(snes, it, norm))
         self.report = NewtonReport()
+        self._projection: PETSc.KSP | None = None
 
     def _update(self, y: PETSc.Vec) -> None:
         x = self.w.x.petsc_vec
@@ -183,17 +184,18 @@ class RestrictedNewton:
     def _start_from_w(self) -> None:
         """``y`` from the current ``w``: the least-squares ``(R^T R)^-1 R^T w`` (exact
         when ``w`` lies in the range of ``R``, e.g. after a previous solve)."""
-        RtR = self.R.transposeMatMult(self.R)
+        if self._projection is None:  # R is fixed: R^T R and its solver are made once
+            RtR = self.R.transposeMatMult(self.R)
+            self._projection = PETSc.KSP().create(self.R.getComm())
+            self._projection.setOperators(RtR)
+            self._projection.setType("cg")
+            self._projection.getPC().setType("jacobi")
+            self._projection.setTolerances(rtol=1e-14, atol=0.0, max_it=1000)
+            RtR.destroy()  # the KSP keeps its reference
         rhs = self.R.createVecRight()
         self.R.multTranspose(self.w.x.petsc_vec, rhs)
-        ksp = PETSc.KSP().create(self.R.getComm())
-        ksp.setOperators(RtR)
-        ksp.setType("cg")
-        ksp.getPC().setType("jacobi")
-        ksp.setTolerances(rtol=1e-14, atol=0.0, max_it=1000)
-        ksp.solve(rhs, self.y)
-        for obj in (ksp, RtR, rhs):
-            obj.destroy()
+        self._projection.solve(rhs, self.y)
+        rhs.destroy()
 
     def final_residual(self) -> float:
         """``|D R^T F(w)|`` at the current iterate (collective)."""
@@ -235,6 +237,9 @@ class RestrictedNewton:
         return self.report
 
     def destroy(self):
-        """Destroy the PETSc objects made here (not ``R``). Collective."""
+        """Destroy the PETSc objects made here (the scaled copy of ``R`` included, not
+        the ``R`` given). Collective."""
         for obj in (self.snes, self.A, self.J_r, self.b, self.y, self.F_r, self.R):
             obj.destroy()
+        if self._projection is not None:
+            self._projection.destroy()
