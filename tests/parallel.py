@@ -21,7 +21,7 @@ def gathered_fields(problem) -> dict[str, np.ndarray]:
     order = _by_position(np.c_[samples["x"], samples["y"]])
     fields = {k: np.asarray(samples[k])[order] for k in ("lambda_n", "lambda_t")}
     for field, name in ((0, "u_minus"), (1, "u_plus")):
-        V, dofs = problem.space.W.sub(field).collapse()
+        V, dofs = problem.space.field_space(field)
         owned = V.dofmap.index_map.size_local
         x = V.tabulate_dof_coordinates()[:owned, :2]
         values = problem.w.x.array[np.asarray(dofs)].reshape(-1, 2)[:owned]

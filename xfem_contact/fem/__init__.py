@@ -4,7 +4,8 @@ Owns :class:`~xfem_contact.fem.cutmesh.CutMesh` (a mesh cut by a level set, with
 the UFL measures of each side and of the interface), :func:`~xfem_contact.fem.forms.form`
 (UFL forms with cut measures to DOLFINx forms compiled through the runtime back end),
 the Heaviside-enriched spaces and their active dofs (:mod:`~xfem_contact.fem.enrichment`),
-point values of functions at rule points (:mod:`~xfem_contact.fem.evaluation`) and the
+sub-spaces as spaces of their own (:mod:`~xfem_contact.fem.subspaces`), point values of
+functions at rule points (:mod:`~xfem_contact.fem.evaluation`) and the
 restriction operator ``R`` from the reduced to the full space
 (:mod:`~xfem_contact.fem.restriction`). Physics does not live here. Fourth step of the
 layout: it may import :mod:`xfem_contact.codegen`, :mod:`xfem_contact.geometry` and

@@ -23,6 +23,7 @@ import ufl
 from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.subspaces import collapse
 
 
 class DofCounts(typing.NamedTuple):
@@ -90,6 +91,7 @@ class EnrichedSpace:
         self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
         self.min_support_fraction = min_support_fraction
         self._active = self._active_dofs()
+        self._collapsed: dict[int, tuple[dolfinx.fem.FunctionSpace, npt.NDArray]] = {}
 
     # -- fields -------------------------------------------------------------
     def trial(self) -> tuple:
@@ -103,6 +105,22 @@ class EnrichedSpace:
     def subspace(self, field: int) -> dolfinx.fem.FunctionSpace:
         """Sub-space of field 0 (side -1), 1 (side +1) or 2 (multiplier)."""
         return self.W.sub(field)
+
+    def field_space(self, field: int) -> tuple[dolfinx.fem.FunctionSpace, npt.NDArray]:
+        """Field ``field`` as a space of its own and the dof of ``W`` behind each of its
+        local dofs (:func:`~xfem_contact.fem.subspaces.collapse`), made once per field.
+        Collective the first time for a field."""
+        if field not in self._collapsed:
+            self._collapsed[field] = collapse(self.W.sub(field))
+        return self._collapsed[field]
+
+    def field(self, w: dolfinx.fem.Function, field: int, name: str | None = None):
+        """A copy of field ``field`` of ``w`` (a Function on ``W``) on its own space
+        (owned and ghost values copied; no communication after the first call)."""
+        V, parent = self.field_space(field)
+        u = dolfinx.fem.Function(V, name=name or f"field_{field}")
+        u.x.array[:] = w.x.array[parent]
+        return u
 
     # -- active dofs ----------------------------------------------------------
     def _mark(self, field: int, cells: np.ndarray, weights: np.ndarray | None = None):

@@ -17,15 +17,14 @@ def evaluate_reference(
     """Values of a Lagrange function at reference points, one point per cell entry (local).
 
     Args:
-        u: A Lagrange function, or a sub-function ``w.sub(i)`` of a mixed one.
+        u: A Lagrange function, or a sub-function ``w.sub(i)`` of a mixed one (read in
+            place, not collapsed).
         cells: Local cell of each point, shape ``(m,)``.
         X: Reference coordinates, shape ``(m, tdim)``.
 
     Returns:
         Values of shape ``(m, value_size)``.
     """
-    if u.function_space.component():  # a view into a mixed function
-        u = u.collapse()
     V = u.function_space
     element = basix.create_element(
         basix.ElementFamily.P,
@@ -33,11 +32,55 @@ def evaluate_reference(
         V.ufl_element().embedded_superdegree,
         basix.LagrangeVariant.gll_warped,
     )
-    basis = element.tabulate(0, X)[0, :, :, 0]  # (m, ndofs)
-    bs = V.dofmap.bs
-    dofs = V.dofmap.list[cells]  # (m, ndofs)
-    values = u.x.array[dofs[:, :, None] * bs + np.arange(bs)]  # (m, ndofs, bs)
+    basis = element.tabulate(0, X)[0, :, :, 0]  # (m, nnodes)
+    m, nnodes = basis.shape
+    if V.component():  # a view into a mixed function: unblocked dofs of W, node by node
+        dofs = V.dofmap.list[cells].reshape(m, nnodes, -1)
+    else:
+        bs = V.dofmap.bs
+        dofs = V.dofmap.list[cells][:, :, None] * bs + np.arange(bs)
+    values = u.x.array[dofs]  # (m, nnodes, value_size)
     return np.einsum("pi,pic->pc", basis, values)
+
+
+class FieldSampler:
+    """Values of the fields of functions on one mixed space at fixed points.
+
+    For a Newton status line or a state evaluated at every iterate: the basis of
+    each field at the points and the dofs of ``W`` it reads are computed once (per
+    field, on first use), after which a sample is one gather and one contraction.
+    Not collective; local to a process.
+
+    Args:
+        W: The mixed function space.
+        cells: Local cell of each point, shape ``(m,)``.
+        X: Reference coordinates, shape ``(m, tdim)``.
+    """
+
+    def __init__(
+        self,
+        W: dolfinx.fem.FunctionSpace,
+        cells: npt.NDArray[np.int32],
+        X: npt.NDArray[np.float64],
+    ):
+        self.W, self.cells, self.X = W, cells, X
+        self._fields: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    def __call__(self, w: dolfinx.fem.Function, field: int) -> npt.NDArray[np.float64]:
+        """Values of field ``field`` of ``w`` (a Function on ``W``), ``(m, value_size)``."""
+        if field not in self._fields:
+            V = self.W.sub(field)
+            element = basix.create_element(
+                basix.ElementFamily.P,
+                V.mesh.basix_cell(),
+                V.ufl_element().embedded_superdegree,
+                basix.LagrangeVariant.gll_warped,
+            )
+            basis = element.tabulate(0, self.X)[0, :, :, 0]
+            dofs = V.dofmap.list[self.cells].reshape(basis.shape[0], basis.shape[1], -1)
+            self._fields[field] = (basis, dofs)
+        basis, dofs = self._fields[field]
+        return np.einsum("pi,pic->pc", basis, w.x.array[dofs])
 
 
 def rule_cells(cut: CutMesh, rules: RuleSet) -> npt.NDArray[np.int32]:

@@ -156,15 +156,11 @@ def deformed_lips_grid(cut: CutMesh, u_minus, u_plus) -> pyvista.UnstructuredGri
 
     Args:
         cut: The cut mesh.
-        u_minus: Displacement Function of side -1 (Lagrange, vector; a
-            sub-function of a mixed Function is collapsed).
+        u_minus: Displacement Function of side -1 (Lagrange, vector; or a
+            sub-function of a mixed Function, read in place).
         u_plus: Displacement Function of side +1.
     """
-    fields = {-1: u_minus, 1: u_plus}
-    for side, u in fields.items():
-        if u.function_space.component():  # a view into a mixed Function: collapse once
-            fields[side] = u.collapse()
-    return _grid(cut, _blocks(cut), fields)
+    return _grid(cut, _blocks(cut), {-1: u_minus, 1: u_plus})
 
 
 def merge_grids(grids: Sequence[pyvista.DataSet]) -> pyvista.UnstructuredGrid:

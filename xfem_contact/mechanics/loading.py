@@ -16,6 +16,8 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from xfem_contact.fem.subspaces import collapse
+
 #: A boundary part: local facet indices, or a locator ``x -> bool`` of shape (3, n) -> (n,)
 Facets = np.ndarray | Callable[[np.ndarray], np.ndarray]
 
@@ -128,7 +130,7 @@ class Loads:
             sub = self.space.W.sub(field)
             if component is not None:
                 sub = sub.sub(component)
-            V, _ = sub.collapse()
+            V, _ = collapse(sub)
             g = dolfinx.fem.Function(V)
             if callable(value):
                 g.interpolate(value)

@@ -52,7 +52,7 @@ class Solution:
 
     def field(self, i: int) -> dolfinx.fem.Function:
         """Collapsed copy of field ``i``: 0 side -1, 1 side +1, 2.. multipliers."""
-        return self.w.sub(i).collapse()
+        return self.space.field(self.w, i)
 
 
 class Problem(Loads):
@@ -297,6 +297,12 @@ class Problem(Loads):
             if log is not None and self.mesh.comm.rank == 0:
                 log(f"warning: {message}")
         self._checked_loads = self.loads_revision
+
+    @property
+    def solver_timings(self) -> dict[str, float]:
+        """Wall times (s) of the Newton solver's set-up (forms, sparsity, first
+        Jacobian, scaling; empty before the first contact solve)."""
+        return {} if self._newton is None else dict(self._newton.timings)
 
     @property
     def last_report(self) -> NewtonReport | None:

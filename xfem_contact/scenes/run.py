@@ -43,7 +43,6 @@ class Result:
             self.fields = [dolfinx.fem.Function(problem.V, name="u")]
             self._maps = [None]
         else:
-            W = problem.space.W
             fields = problem.space.multiplier_fields
             self.names = ["u_minus", "u_plus"]
             self.names += [
@@ -51,9 +50,9 @@ class Result:
             ]
             self.fields, self._maps = [], []
             for i, name in enumerate(self.names):
-                V, dofs = W.sub(i).collapse()
+                V, dofs = problem.space.field_space(i)
                 self.fields.append(dolfinx.fem.Function(V, name=name))
-                self._maps.append(np.asarray(dofs))
+                self._maps.append(dofs)
 
     def update(self, solution: dolfinx.fem.Function) -> None:
         """Copy a solution (plain ``u`` or mixed ``w``) into the fields."""

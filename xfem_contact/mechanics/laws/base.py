@@ -28,7 +28,7 @@ import numpy.typing as npt
 import ufl
 
 from xfem_contact.fem.cutmesh import CutMesh
-from xfem_contact.fem.evaluation import evaluate_at_rules
+from xfem_contact.fem.evaluation import FieldSampler, rule_cells
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.quadrature.rules import RuleSet
 
@@ -77,6 +77,8 @@ class InterfaceContext:
     field: int | None
     w_old: dolfinx.fem.Function
     aligned_cells: dolfinx.fem.Function | None = None
+    #: Point values cached for the fixed rules (basis tables, dofs, the normal)
+    _cache: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
 
     @property
     def normal(self) -> ufl.core.expr.Expr:
@@ -96,12 +98,22 @@ class InterfaceContext:
     def frame_at(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """``n`` and ``t`` at the rule points, each ``(npoints, gdim)``: the UFL normal
         evaluated there (not the curve's own normal)."""
-        n = self.cut.normal_at(self.rules)
-        return n, np.c_[-n[:, 1], n[:, 0]]
+        if "frame" not in self._cache:
+            n = self.cut.normal_at(self.rules)
+            self._cache["frame"] = (n, np.c_[-n[:, 1], n[:, 0]])
+        return self._cache["frame"]
 
     def values_at(self, w: dolfinx.fem.Function, field: int) -> npt.NDArray[np.float64]:
-        """Values of field ``field`` of ``w`` at the rule points, ``(npoints, value_size)``."""
-        return evaluate_at_rules(w.sub(field), self.cut, self.rules)
+        """Values of field ``field`` of ``w`` (a Function on the problem's mixed space)
+        at the rule points, ``(npoints, value_size)``."""
+        key = ("sampler", id(w.function_space))
+        if key not in self._cache:
+            cells = rule_cells(self.cut, self.rules)
+            self._cache[key] = (
+                w.function_space,
+                FieldSampler(w.function_space, cells, self.rules.points),
+            )
+        return self._cache[key][1](w, field)
 
     def jump_at(self, w: dolfinx.fem.Function) -> npt.NDArray[np.float64]:
         """``[u]`` of ``w`` at the rule points, ``(npoints, gdim)`` (m)."""
