@@ -21,7 +21,12 @@ def test_table_is_consistent():
 
 def test_defaults_per_solver():
     linear, newton = defaults("linear"), defaults("newton")
-    assert linear == {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+    assert linear == {
+        "ksp_type": "preonly",
+        "pc_type": "lu",
+        "pc_factor_mat_solver_type": "mumps",
+        "mat_mumps_icntl_7": 4,  # PORD
+    }
     assert linear.items() <= newton.items()  # Newton's linear solves are the linear solver's
     assert all(key.startswith("snes_") for key in newton.keys() - linear.keys())
     with pytest.raises(ValueError, match="Unknown solver"):

@@ -1,9 +1,10 @@
 """Linear solves on the reduced space ``y`` with ``x = R y`` (PETSc KSP).
 
 The same restriction as :class:`~xfem_contact.solvers.newton.RestrictedNewton`:
-``a`` and ``L`` are assembled on the full mixed space with Dirichlet conditions
-and reduced with the operator ``R`` of :mod:`xfem_contact.fem.restriction`,
-``A_r = R^T A R`` (PETSc PtAP) and ``b_r = R^T b``; the solution is ``x = R y``.
+``a`` and ``L`` are assembled with Dirichlet conditions and reduced with the operator
+``R`` of :mod:`xfem_contact.fem.restriction`, ``A_r = R^T A R`` (straight into the
+reduced numbering, :mod:`xfem_contact.solvers.assembly`) and ``b_r = R^T b``; the
+solution is ``x = R y``.
 The solver factors the symmetrically scaled ``D A_r D`` (:mod:`xfem_contact.solvers.scaling`).
 """
 
@@ -15,6 +16,7 @@ from petsc4py import PETSc
 
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.restriction import restriction_matrix
+from xfem_contact.solvers.assembly import ReducedMatrix
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.scaling import saddle_point_scaling
 
@@ -43,16 +45,15 @@ def assemble_restricted(
         and right-hand side ``R^T b``, global size ``n_reduced``, both laid out
         as the columns of ``R``. The caller destroys both.
     """
-    A = dolfinx.fem.petsc.assemble_matrix(a, bcs=bcs)
-    A.assemble()
+    reduced = ReducedMatrix(a, bcs, R)
+    reduced.assemble()
+    A_r = reduced.release()
     b = dolfinx.fem.petsc.assemble_vector(L)
     dolfinx.fem.petsc.apply_lifting(b, [a], bcs=[bcs])
     b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     dolfinx.fem.petsc.set_bc(b, bcs)
-    A_r = A.PtAP(R)
     b_r = R.createVecRight()
     R.multTranspose(b, b_r)
-    A.destroy()
     b.destroy()
     return A_r, b_r
 

@@ -1,9 +1,10 @@
 """Generalized Newton (PETSc SNES) on the reduced space ``y`` with ``x = R y``.
 
-Residual and Jacobian are assembled on the full mixed space with Dirichlet
-conditions (as :class:`dolfinx.fem.petsc.NonlinearProblem` does) and reduced:
-``F_r = R^T F(R y)``, ``J_r = R^T J R`` (PETSc PtAP), the same restriction as the
-linear solves of :mod:`xfem_contact.solvers.linear`. Every iterate is logged
+Residual and Jacobian are assembled with Dirichlet conditions (as
+:class:`dolfinx.fem.petsc.NonlinearProblem` does) and reduced: ``F_r = R^T F(R y)``,
+``J_r = R^T J R`` (straight into the reduced numbering,
+:mod:`xfem_contact.solvers.assembly`), the same restriction as the linear solves of
+:mod:`xfem_contact.solvers.linear`. Every iterate is logged
 (residual norm and, through a callback, e.g. the contact status); failure raises
 with the whole history. Default options: :mod:`xfem_contact.solvers.options`.
 """
@@ -17,12 +18,15 @@ from collections.abc import Callable
 
 import dolfinx.fem
 import dolfinx.fem.petsc
+import numpy as np
 import ufl
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from xfem_contact.fem.forms import form
+from xfem_contact.solvers.assembly import ReducedMatrix
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
-from xfem_contact.solvers.scaling import scaled_restriction
+from xfem_contact.solvers.scaling import saddle_point_scaling
 
 
 @dataclasses.dataclass
@@ -42,9 +46,16 @@ class NewtonReport:
     status: list[dict] = dataclasses.field(default_factory=list)
     reason: int = 0
     final_residual: float = float("nan")
-    #: Wall time (s) of residual/Jacobian assembly and of the whole solve
+    #: Wall time (s) of residual/Jacobian assembly, of the status callback and of
+    #: the whole solve
     assembly_time: float = 0.0
+    status_time: float = 0.0
     total_time: float = 0.0
+
+    @property
+    def linear_solve_time(self) -> float:
+        """Wall time (s) of the rest: the factorisations and triangular solves."""
+        return self.total_time - self.assembly_time - self.status_time
 
     @property
     def iterations(self) -> int:
@@ -110,20 +121,32 @@ class RestrictedNewton:
         log: Callable[[str], None] | None = None,
     ):
         self.w, self.bcs, self.R = w, bcs, R
+        start = time.perf_counter()
         self.F = form(residual)
         self.J = form(ufl.derivative(residual, w, ufl.TrialFunction(w.function_space)))
+        #: Wall time (s) of the set-up steps: forms (JIT included on a cold cache),
+        #: sparsity, first Jacobian, scaling
+        self.timings = {"forms": time.perf_counter() - start}
         self.b = dolfinx.fem.petsc.create_vector(self.F.function_spaces[0])
-        self.A = dolfinx.fem.petsc.create_matrix(self.J)
         self.y = R.createVecRight()
         self.F_r = R.createVecRight()
         self.status, self.log = status, log
-        self._assemble_jacobian()
+        start = time.perf_counter()
+        self.jacobian = ReducedMatrix(self.J, bcs, R)
+        self.timings["sparsity"] = time.perf_counter() - start
         # Solve for y_s with x = R D y_s, D the scaling of the first Jacobian (well
-        # scaled saddle points: see xfem_contact.solvers.scaling)
-        first = self.A.PtAP(R)
-        self.R = scaled_restriction(R, first)
-        first.destroy()
-        self.J_r = self.A.PtAP(self.R)
+        # scaled saddle points: see xfem_contact.solvers.scaling); J_r = D R^T J R D
+        start = time.perf_counter()
+        self.J_r = self.jacobian.assemble()
+        self.timings["jacobian"] = time.perf_counter() - start
+        start = time.perf_counter()
+        self.D = saddle_point_scaling(self.J_r)
+        self.J_r.diagonalScale(self.D, self.D)
+        self.timings["scaling"] = time.perf_counter() - start
+        self.R = R.copy()
+        self.R.diagonalScale(None, self.D)
+        # The first Newton iterate usually sits where this Jacobian was assembled
+        self._assembled_at: np.ndarray | None = w.x.array.copy()
         self.snes = PETSc.SNES().create(R.getComm())
         # Options live in the PETSc database only while PETSc may read them (here and
         # during each solve, when the factorisation reads e.g. mat_mumps_* options)
@@ -159,22 +182,21 @@ class RestrictedNewton:
         self.R.multTranspose(self.b, F_r)
         self.report.assembly_time += time.perf_counter() - start
 
-    def _assemble_jacobian(self):
-        self.A.zeroEntries()
-        dolfinx.fem.petsc.assemble_matrix(self.A, self.J, bcs=self.bcs)
-        self.A.assemble()
-
     def _jacobian(self, snes, y, J_r, P_r):
         start = time.perf_counter()
         self._update(y)
-        self._assemble_jacobian()
-        self.A.PtAP(self.R, result=J_r)
+        x, at, self._assembled_at = self.w.x.array, self._assembled_at, None
+        if at is None or not _same_state(x, at, self.R.getComm().tompi4py()):
+            self.jacobian.assemble()  # into J_r, the same matrix
+            J_r.diagonalScale(self.D, self.D)
         self.report.assembly_time += time.perf_counter() - start
 
     def _monitor(self, snes, it, norm):
+        start = time.perf_counter()
         self.report.residuals.append(float(norm))
         status = self.status(self.w) if self.status else {}
         self.report.status.append(status)
+        self.report.status_time += time.perf_counter() - start
         if self.log:
             self.log(
                 f"  Newton {it:2d}: |F| = {norm:.3e}  "
@@ -225,7 +247,10 @@ class RestrictedNewton:
             )
         # Success is what the tolerances say, whatever SNES reports (e.g. ksponly)
         rtol, atol, _, _ = self.snes.getTolerances()
-        final = self.final_residual()
+        if self.snes.getType() in _EVALUATES_LAST and self.report.iterations == self.snes.its:
+            final = self.report.residuals[-1]  # SNES evaluated F at the last iterate
+        else:  # e.g. ksponly: the norm after the step was never computed
+            final = self.final_residual()
         bound = max(atol, rtol * self.report.residuals[0]) if self.report.residuals else atol
         self.report.final_residual = final
         if not final <= bound * (1.0 + 1e-8):
@@ -239,7 +264,21 @@ class RestrictedNewton:
     def destroy(self):
         """Destroy the PETSc objects made here (the scaled copy of ``R`` included, not
         the ``R`` given). Collective."""
-        for obj in (self.snes, self.A, self.J_r, self.b, self.y, self.F_r, self.R):
+        self.jacobian.destroy()  # J_r included
+        for obj in (self.snes, self.b, self.y, self.F_r, self.R, self.D):
             obj.destroy()
         if self._projection is not None:
             self._projection.destroy()
+
+
+#: SNES types that evaluate the residual at the iterate they stop at (and monitor it)
+_EVALUATES_LAST = ("newtonls", "newtontr")
+
+
+def _same_state(x: np.ndarray, x0: np.ndarray, comm: MPI.Comm) -> bool:
+    """Whether two dof arrays agree to round-off on every process (the start of a
+    solve, projected on the range of ``R D``, and the state it was taken from).
+    Collective."""
+    bound = 1e-14 * comm.allreduce(np.abs(x0).max(initial=0.0), op=MPI.MAX)
+    close = x.shape == x0.shape and bool(np.all(np.abs(x - x0) <= bound))
+    return comm.allreduce(close, op=MPI.LAND)

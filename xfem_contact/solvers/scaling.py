@@ -36,8 +36,8 @@ def saddle_point_scaling(J: PETSc.Mat) -> PETSc.Vec:
     inverse = J.createVecRight()
     inverse.setArray(np.divide(1.0, d, out=np.zeros_like(d), where=d > 0))
     indptr, indices, values = J.getValuesCSR()
-    squared = PETSc.Mat().createAIJ(J.getSizes(), comm=J.getComm())
-    squared.setPreallocationCSR((indptr, indices, values**2))
+    squared = J.duplicate(copy=False)  # J's layout and sparsity, not its values
+    squared.setValuesCSR(indptr, indices, values**2)
     squared.assemble()
     coupled = J.createVecLeft()
     squared.mult(inverse, coupled)  # sum_j J_ij^2 / |J_jj| over j with J_jj != 0
@@ -48,13 +48,3 @@ def saddle_point_scaling(J: PETSc.Mat) -> PETSc.Vec:
     for obj in (diagonal, inverse, squared, coupled):
         obj.destroy()
     return D
-
-
-def scaled_restriction(R: PETSc.Mat, J: PETSc.Mat) -> PETSc.Mat:
-    """``R D`` with ``D`` the :func:`saddle_point_scaling` of ``J = R^T A R``. Collective;
-    the caller destroys the result (``R`` is not modified)."""
-    D = saddle_point_scaling(J)
-    R_s = R.copy()
-    R_s.diagonalScale(None, D)
-    D.destroy()
-    return R_s
