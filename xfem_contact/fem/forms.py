@@ -20,7 +20,7 @@ import ufl
 from dolfinx.fem import IntegralType
 from dolfinx.fem.forms import CompiledForm, compile_form, create_form, get_integration_domains
 
-from xfem_contact.codegen import LANGUAGE, runtime_abi
+from xfem_contact.codegen import LANGUAGE, kernel_store, runtime_abi
 from xfem_contact.codegen.compat import analyze_ufl_objects, compute_ir, get_options
 from xfem_contact.codegen.tables import RuntimeIntegral, runtime_integral
 from xfem_contact.quadrature.cell_rules import CellRules
@@ -153,8 +153,12 @@ def _compile(
         compiled = compile_form(
             comm, ufl_form, form_compiler_options=options, jit_options=jit_options
         )
-        cell = ufl_form.ufl_domain().ufl_coordinate_element().cell_type
-        kernels = _runtime_kernels(ufl_form, get_options(options), cell)
+        store = kernel_store.store_path(compiled.module)
+        kernels = kernel_store.load(store, ufl_form)
+        if kernels is None:  # first use of this JIT module: ask FFCx for the layouts
+            cell = ufl_form.ufl_domain().ufl_coordinate_element().cell_type
+            kernels = _runtime_kernels(ufl_form, get_options(options), cell)
+            kernel_store.save(store, kernels)
         _cache[key] = _Compiled(
             compiled.ufcx_form, compiled.module, compiled.code, compiled.dtype, kernels
         )
