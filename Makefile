@@ -38,6 +38,7 @@ test-notebooks: $(VENV)/.installed
 bench: $(VENV)/.installed
 	$(PY) bench/quadrature.py
 	$(PY) bench/contact_convergence.py
+	$(PY) bench/scaling.py --ranks 2
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check xfem_contact tests demos bench

@@ -173,7 +173,8 @@ def _best_fan(
     # argmax followed 1-ulp noise in the nodal level set, which depends on the cell
     # numbering, so 1 and 2 processes split some annulus cells differently.
     top = scores.max(axis=1, keepdims=True)
-    best = np.argmax(scores >= top - _TIE * np.abs(top), axis=1)
+    margin = np.where(np.isfinite(top), _TIE * np.abs(top), 0.0)  # inf: every child dropped
+    best = np.argmax(scores >= top - margin, axis=1)
     pick = np.arange(len(pts))
     nodes = np.stack([o[0] for o in options], axis=1)[pick, best]
     drop = np.stack([o[1] for o in options], axis=1)[pick, best]

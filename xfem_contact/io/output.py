@@ -22,6 +22,10 @@ import numpy as np
 
 from xfem_contact.fem.cutmesh import CutMesh
 
+#: Compression of the ``.vtu`` files: LZ4 (ParaView >= 5.6 reads it) wrote the
+#: 160 x 160 case-2 lips grid in 0.03 s against zlib's 0.13 s (and 0.11 s raw)
+VTU_COMPRESSION = "lz4"
+
 
 def write_fields(directory: str | pathlib.Path, name: str, functions: list) -> list[pathlib.Path]:
     """Write Lagrange ``functions`` (same space) to ``directory/name.bp`` (VTX). Collective."""
@@ -65,7 +69,7 @@ def write_lips(path: str | pathlib.Path, cut: CutMesh, u_minus, u_plus) -> pathl
     from xfem_contact.io.vtk_grids import deformed_lips_grid
 
     path = _rank_path(pathlib.Path(path), cut.mesh.comm)
-    deformed_lips_grid(cut, u_minus, u_plus).save(path)
+    deformed_lips_grid(cut, u_minus, u_plus).save(path, compression=VTU_COMPRESSION)
     return path
 
 
@@ -82,7 +86,7 @@ def write_cut_geometry(directory: str | pathlib.Path, cut: CutMesh) -> list[path
     paths = []
     for name, grid in (("subcells", subcell_grid(cut)), ("interface", interface_grid(cut))):
         path = _rank_path(directory / f"{name}.vtu", comm)
-        grid.save(path)
+        grid.save(path, compression=VTU_COMPRESSION)
         paths.append(path)
     return paths
 

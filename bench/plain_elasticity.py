@@ -1,0 +1,125 @@
+"""The floor of this stack: plain DOLFINx elasticity on the mesh of paper case 2.
+
+No cut, no enrichment, no xfem_contact import: unit square, ``--n`` x ``--n`` cells,
+Lagrange ``--degree`` displacement, E = 100 MPa, nu = 0, the case-2 tractions (-1 Pa
+lateral, -2 Pa top and bottom) and the same three point constraints, one direct solve
+(MUMPS LU; ``--ordering`` sets its ICNTL(7), as xfem-contact's solver options do) and
+the displacement written as VTX, as the demo does. Prints one JSON line
+of dofs and wall times per phase (s); ``bench/scaling.py`` runs it as a process of its
+own next to the demo. Run: ``python bench/plain_elasticity.py --n 160 [--degree 2]``,
+also under ``mpiexec``.
+"""
+
+import argparse
+import json
+import pathlib
+import time
+
+# isort: split
+import dolfinx_solver  # noqa: F401  (before dolfinx: loads the wheel's PETSc and MPI)
+
+# isort: split
+import basix.ufl
+import dolfinx.fem
+import dolfinx.fem.petsc
+import dolfinx.io
+import dolfinx.mesh
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+E, NU = 100e6, 0.0
+OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+
+
+def solve(n: int, degree: int, cell: str, out: pathlib.Path, ordering: int | None) -> dict:
+    """Solve and write; returns the dofs and the wall time of each phase (s). Collective."""
+    comm = MPI.COMM_WORLD
+    times = {}
+    start = time.perf_counter()
+    mesh = dolfinx.mesh.create_unit_square(comm, n, n, dolfinx.mesh.CellType[cell])
+    V = dolfinx.fem.functionspace(
+        mesh, basix.ufl.element("Lagrange", mesh.basix_cell(), degree, shape=(2,))
+    )
+    mu, lmbda = E / (2 * (1 + NU)), E * NU / ((1 + NU) * (1 - 2 * NU))
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+
+    def sigma(w):
+        return 2 * mu * ufl.sym(ufl.grad(w)) + lmbda * ufl.tr(ufl.grad(w)) * ufl.Identity(2)
+
+    fdim = mesh.topology.dim - 1
+    sides = [
+        (1, lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0)),
+        (2, lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0)),
+    ]
+    facets = [dolfinx.mesh.locate_entities_boundary(mesh, fdim, where) for _, where in sides]
+    values = np.concatenate(
+        [np.full(f.size, tag, dtype=np.int32) for (tag, _), f in zip(sides, facets, strict=True)]
+    )
+    order = np.argsort(np.concatenate(facets))
+    tags = dolfinx.mesh.meshtags(mesh, fdim, np.concatenate(facets)[order], values[order])
+    ds = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
+    normal = ufl.FacetNormal(mesh)
+    a = ufl.inner(sigma(u), ufl.sym(ufl.grad(v))) * ufl.dx
+    L = -1.0 * ufl.dot(normal, v) * ds(1) - 2.0 * ufl.dot(normal, v) * ds(2)
+    bcs = []
+    for point, component in (((0.5, 0.0), 0), ((0.5, 1.0), 0), ((0.0, 0.5), 1)):
+        sub = V.sub(component)
+        Vc, _ = sub.collapse()
+        dofs = dolfinx.fem.locate_dofs_geometrical(
+            (sub, Vc), lambda x, p=point: np.isclose(x[0], p[0]) & np.isclose(x[1], p[1])
+        )
+        bcs.append(dolfinx.fem.dirichletbc(dolfinx.fem.Function(Vc), dofs, sub))
+    times["mesh_and_spaces"] = time.perf_counter() - start
+    t = time.perf_counter()
+    a_form, L_form = dolfinx.fem.form(a), dolfinx.fem.form(L)
+    times["forms"] = time.perf_counter() - t
+    t = time.perf_counter()
+    A = dolfinx.fem.petsc.assemble_matrix(a_form, bcs=bcs)
+    A.assemble()
+    b = dolfinx.fem.petsc.assemble_vector(L_form)
+    dolfinx.fem.petsc.apply_lifting(b, [a_form], bcs=[bcs])
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    dolfinx.fem.petsc.set_bc(b, bcs)
+    times["assembly"] = time.perf_counter() - t
+    t = time.perf_counter()
+    ksp = PETSc.KSP().create(comm)
+    ksp.setOperators(A)
+    ksp.setOptionsPrefix("plain_")
+    opts = PETSc.Options()
+    options = OPTIONS | ({} if ordering is None else {"mat_mumps_icntl_7": ordering})
+    for key, value in options.items():
+        opts[f"plain_{key}"] = value
+    ksp.setFromOptions()
+    uh = dolfinx.fem.Function(V, name="u")
+    ksp.solve(b, uh.x.petsc_vec)
+    uh.x.scatter_forward()
+    times["solve"] = time.perf_counter() - t
+    t = time.perf_counter()
+    with dolfinx.io.VTXWriter(comm, out / "displacement.bp", [uh]) as writer:
+        writer.write(0.0)
+    times["output"] = time.perf_counter() - t
+    for obj in (ksp, A, b):
+        obj.destroy()
+    dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+    return {"dofs": dofs, "timings": times}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--n", type=int, default=160)
+    parser.add_argument("--degree", type=int, default=2, choices=[1, 2])
+    parser.add_argument("--cell", default="quadrilateral", choices=["quadrilateral", "triangle"])
+    parser.add_argument("--out", default="results/plain_elasticity")
+    parser.add_argument(
+        "--ordering", type=int, default=None, help="MUMPS ICNTL(7) (default: MUMPS's choice)"
+    )
+    args = parser.parse_args()
+    result = solve(args.n, args.degree, args.cell, pathlib.Path(args.out), args.ordering)
+    if MPI.COMM_WORLD.rank == 0:
+        print(json.dumps(result))
+
+
+if __name__ == "__main__":
+    main()

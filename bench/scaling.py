@@ -1,0 +1,232 @@
+"""What a cut contact solve costs against plain DOLFINx elasticity on the same mesh.
+
+Paper case 2 (the main demo: circular inclusion, sticking, quadrilaterals) for P1 and
+P2 at N = 20 ... 320 cells per side, each run as a process of its own, next to
+``bench/plain_elasticity.py`` (no cut, the same mesh, loads and LU solver options) in
+the same session: dofs, whole-process wall time, peak resident memory, and the demo's
+own split into phases (its ``summary.json``). The ratio cut / plain is printed per N;
+the JIT (cold FFCx cache) is measured apart, once per degree at the smallest N, in an
+empty cache directory. ``--ranks 2`` adds the largest P2 case on 2 MPI ranks (speed-up
+per phase). Writes ``bench/results/scaling.{json,md,png}``.
+
+Run: ``python bench/scaling.py [--sizes 20 40 80 160 320] [--degrees 1 2] [--ranks 2]``
+(``make bench``).
+"""
+
+import argparse
+import json
+import os
+import pathlib
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "bench" / "results"
+#: The demo's phases (keys of its summary's ``timings``), in the order they run
+PHASES = [
+    ("cut", "level set + cut"),
+    ("quadrature", "rules"),
+    ("spaces", "spaces + problem"),
+    ("forms", "forms"),
+    ("sparsity", "sparsity"),
+    ("assembly", "assembly"),
+    ("scaling", "scaling"),
+    ("linear_solve", "factorisation + solve"),
+    ("status", "Newton status"),
+    ("post_processing", "post-processing"),
+    ("output", "output"),
+]
+
+
+def run(command: list[str], env: dict | None = None) -> tuple[float, float, str]:
+    """Run a process to its end: (wall time s, peak RSS MB of that process, stdout)."""
+    start = time.perf_counter()
+    with tempfile.TemporaryFile("w+") as out:
+        proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT, env=env)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - start
+        out.seek(0)
+        text = out.read()
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise RuntimeError(f"{' '.join(command)} failed:\n{text}")
+    return wall, usage.ru_maxrss / 1024.0, text
+
+
+def mumps_ordering() -> int:
+    """The MUMPS ordering of xfem-contact's solvers (so the plain solve uses it too)."""
+    code = (
+        "from xfem_contact.solvers.options import SOLVER_OPTIONS;"
+        "print(SOLVER_OPTIONS['mat_mumps_icntl_7'].default)"
+    )
+    return int(subprocess.check_output([sys.executable, "-c", code], text=True).strip())
+
+
+def demo(n, degree, work, env=None, ranks=1) -> dict:
+    summary = work / f"demo_{n}_{degree}_{ranks}.json"
+    command = [sys.executable, str(ROOT / "demos" / "inclusion_contact.py")]
+    command += ["--n", str(n), "--degree", str(degree), "--quiet"]
+    command += ["--out", str(work / "demo"), "--json", str(summary)]
+    if ranks > 1:
+        command = [str(pathlib.Path(sys.executable).parent / "mpiexec"), "-n", str(ranks)] + command
+    wall, rss, _ = run(command, env)
+    data = json.loads(summary.read_text())
+    return {
+        "wall": wall,
+        "rss_mb": rss,
+        "dofs": data["dofs"]["total"],
+        "timings": data["timings"],
+        "error": data["contact_pressure_rel_L2_error"],
+        "newton_iterations": data["newton_iterations"],
+    }
+
+
+def plain(n, degree, work, ordering, env=None) -> dict:
+    command = [sys.executable, str(ROOT / "bench" / "plain_elasticity.py")]
+    command += ["--n", str(n), "--degree", str(degree), "--out", str(work / "plain")]
+    command += ["--ordering", str(ordering)]
+    wall, rss, text = run(command, env)
+    data = json.loads(text.strip().splitlines()[-1])
+    return {"wall": wall, "rss_mb": rss, "dofs": data["dofs"], "timings": data["timings"]}
+
+
+def cold_jit(degree, n, work, ordering) -> dict:
+    """Process time with an empty FFCx cache minus the warm time (the JIT's cost)."""
+    cache = work / f"cold_cache_{degree}"
+    env = os.environ | {"XDG_CACHE_HOME": str(cache)}
+    cold = demo(n, degree, work, env)["wall"]
+    warm = demo(n, degree, work, env)["wall"]
+    plain_cold = plain(n, degree, work, ordering, env | {"XDG_CACHE_HOME": str(cache) + "p"})
+    plain_warm = plain(n, degree, work, ordering, env | {"XDG_CACHE_HOME": str(cache) + "p"})
+    shutil.rmtree(cache, ignore_errors=True)
+    shutil.rmtree(str(cache) + "p", ignore_errors=True)
+    return {"cut": cold - warm, "plain": plain_cold["wall"] - plain_warm["wall"]}
+
+
+def line(row: dict) -> str:
+    """One printed line per case: the ratios the goals are stated in."""
+    c, p = row["cut"], row["plain"]
+    solve = max(c["timings"]["linear_solve"], 1e-9)
+    after = c["timings"]["post_processing"] + c["timings"]["output"]
+    return (
+        f"P{row['degree']} N={row['n']:4d} dofs {c['dofs']:9,d}: cut {c['wall']:7.2f} s, "
+        f"plain {p['wall']:6.2f} s, ratio {c['wall'] / p['wall']:.2f}; peak RSS "
+        f"{c['rss_mb']:.0f} / {p['rss_mb']:.0f} MB ({c['rss_mb'] / p['rss_mb']:.2f}x); "
+        f"post-processing + output {100 * after / solve:.0f} % of the solve; Newton status "
+        f"{100 * c['timings']['status'] / solve:.1f} %"
+    )
+
+
+def table(rows: list[dict]) -> str:
+    head = (
+        "| P | N | dofs | cut process (s) | plain process (s) | ratio | peak RSS cut / plain (MB) |"
+    )
+    head += " " + " | ".join(label for _, label in PHASES) + " |"
+    lines = [head, "|" + "---|" * (7 + len(PHASES))]
+    for r in rows:
+        c, p = r["cut"], r["plain"]
+        cells = [
+            f"{r['degree']}",
+            f"{r['n']}",
+            f"{c['dofs']:,}",
+            f"{c['wall']:.2f}",
+            f"{p['wall']:.2f}",
+            f"**{c['wall'] / p['wall']:.2f}**",
+            f"{c['rss_mb']:.0f} / {p['rss_mb']:.0f} ({c['rss_mb'] / p['rss_mb']:.2f}x)",
+        ]
+        cells += [f"{c['timings'].get(key, 0.0):.3f}" for key, _ in PHASES]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def plot(rows: list[dict], path: pathlib.Path) -> None:
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharey=True)
+    for ax, degree in zip(axes, (1, 2), strict=True):
+        chosen = [r for r in rows if r["degree"] == degree]
+        if not chosen:
+            continue
+        dofs = [r["cut"]["dofs"] for r in chosen]
+        for key, label in PHASES:
+            times = [max(r["cut"]["timings"].get(key, 0.0), 1e-4) for r in chosen]
+            ax.loglog(dofs, times, ".-", label=label)
+        ax.loglog(dofs, [r["cut"]["wall"] for r in chosen], "k-", lw=2, label="cut: process")
+        ax.loglog(dofs, [r["plain"]["wall"] for r in chosen], "k--", lw=2, label="plain: process")
+        ref = [dofs[-1] and t for t in (chosen[-1]["cut"]["wall"],)][0]
+        ax.loglog(dofs, [ref * d / dofs[-1] for d in dofs], ":", color="grey", label="O(dofs)")
+        ax.set_title(f"Case 2, P{degree}, quadrilaterals")
+        ax.set_xlabel("dofs")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].set_ylabel("wall time (s)")
+    axes[1].legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[20, 40, 80, 160, 320])
+    parser.add_argument("--degrees", type=int, nargs="+", default=[1, 2])
+    parser.add_argument(
+        "--ranks", type=int, default=0, help="also run the largest P2 case on R ranks"
+    )
+    parser.add_argument("--no-jit", action="store_true", help="skip the cold-cache runs")
+    args = parser.parse_args()
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    ordering = mumps_ordering()
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        work = pathlib.Path(tmp)
+        for degree in args.degrees:
+            demo(args.sizes[0], degree, work)  # warm the caches of this degree
+            plain(args.sizes[0], degree, work, ordering)
+            for n in args.sizes:
+                row = {"degree": degree, "n": n}
+                row["cut"] = demo(n, degree, work)
+                row["plain"] = plain(n, degree, work, ordering)
+                rows.append(row)
+                print(line(row), flush=True)
+        jit = (
+            {}
+            if args.no_jit
+            else {d: cold_jit(d, args.sizes[0], work, ordering) for d in args.degrees}
+        )
+        for degree, cost in jit.items():
+            print(
+                f"P{degree} JIT (cold cache, N={args.sizes[0]}): cut {cost['cut']:.1f} s, "
+                f"plain {cost['plain']:.1f} s"
+            )
+        parallel = None
+        if args.ranks > 1:
+            n = args.sizes[-1]
+            serial = next(r["cut"] for r in rows if r["degree"] == 2 and r["n"] == n)
+            distributed = demo(n, 2, work, ranks=args.ranks)
+            parallel = {"n": n, "ranks": args.ranks, "serial": serial, "parallel": distributed}
+            print(
+                f"P2 N={n}: {args.ranks} ranks {distributed['wall']:.2f} s, 1 rank "
+                f"{serial['wall']:.2f} s, speed-up {serial['wall'] / distributed['wall']:.2f}"
+            )
+            for key, label in PHASES:
+                s, p = serial["timings"].get(key, 0.0), distributed["timings"].get(key, 0.0)
+                print(f"    {label:24s} {s:8.3f} s -> {p:8.3f} s  ({s / max(p, 1e-9):.2f}x)")
+    (RESULTS / "scaling.json").write_text(
+        json.dumps(
+            {"rows": rows, "jit": jit, "parallel": parallel, "mumps_ordering": ordering}, indent=1
+        )
+    )
+    text = table(rows)
+    (RESULTS / "scaling.md").write_text(text + "\n")
+    plot(rows, RESULTS / "scaling.png")
+    print(text)
+    print(f"wrote {RESULTS / 'scaling.md'}, scaling.json and scaling.png")
+
+
+if __name__ == "__main__":
+    main()

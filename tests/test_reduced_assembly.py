@@ -1,0 +1,141 @@
+"""The fast paths of the solvers give what the slow ones gave.
+
+- :func:`xfem_contact.fem.subspaces.collapse` equals DOLFINx's ``collapse``;
+- a form assembled straight into the reduced numbering equals ``R^T A R`` by PtAP,
+  bit for bit, and a prolongation in ``R`` takes the PtAP path;
+- the runtime-table layouts read back from disk equal the ones FFCx's IR gives;
+- the first Newton iterate reuses the Jacobian assembled for the scaling only when
+  it sits at that state.
+"""
+
+import dolfinx.fem
+import dolfinx.fem.petsc
+import numpy as np
+import pytest
+import ufl
+from petsc4py import PETSc
+
+from xfem_contact.cases.paper import inclusion_problem
+from xfem_contact.codegen import kernel_store
+from xfem_contact.fem import forms
+from xfem_contact.fem.forms import form
+from xfem_contact.fem.subspaces import collapse
+from xfem_contact.solvers.assembly import ReducedMatrix, selection
+
+
+@pytest.fixture(scope="module", params=["quadrilateral", "triangle"])
+def problem(request):
+    return inclusion_problem(8, 2, "coulomb", request.param, friction=0.3)
+
+
+def _jacobian(problem):
+    F = problem.residual()
+    return form(ufl.derivative(F, problem.w, ufl.TrialFunction(problem.space.W)))
+
+
+@pytest.mark.parametrize("field", [0, 1, 2])
+def test_collapse_matches_dolfinx(problem, field):
+    """Same values at the same dof coordinates as DOLFINx's collapse of the sub-space."""
+    w = problem.w.copy()
+    w.x.array[:] = np.random.default_rng(field).standard_normal(w.x.array.size)
+    sub = problem.space.W.sub(field)
+    ours, parent = collapse(sub)
+    theirs, theirs_parent = sub.collapse()
+    bs = ours.dofmap.bs
+    assert ours.dofmap.index_map.size_local == theirs.dofmap.index_map.size_local
+
+    def by_position(V, dofs):
+        x = V.tabulate_dof_coordinates()[:, :2]
+        values = w.x.array[np.asarray(dofs)].reshape(-1, bs)
+        order = np.lexsort((x[:, 1].round(12), x[:, 0].round(12)))
+        return x[order], values[order]
+
+    x_ours, v_ours = by_position(ours, parent)
+    x_theirs, v_theirs = by_position(theirs, theirs_parent)
+    assert np.array_equal(x_ours, x_theirs)
+    assert np.array_equal(v_ours, v_theirs)
+
+
+def test_direct_assembly_equals_ptap(problem):
+    """R^T J R straight into the reduced numbering: the same matrix as PtAP."""
+    J, R = _jacobian(problem), problem.restriction()
+    reduced = ReducedMatrix(J, problem._bcs, R)
+    assert reduced.direct
+    A = reduced.assemble()
+    full = dolfinx.fem.petsc.assemble_matrix(J, bcs=problem._bcs)
+    full.assemble()
+    reference = full.PtAP(R)
+    assert A.getInfo()["nz_used"] <= reference.getInfo()["nz_used"] < full.getInfo()["nz_used"]
+    reference.axpy(-1.0, A, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    assert reference.norm() == 0.0
+    for mat in (full, reference, R):
+        mat.destroy()
+    reduced.destroy()
+
+
+def test_prolongation_takes_the_ptap_path():
+    """lbb = restriction combines multiplier dofs: R is no selection."""
+    problem = inclusion_problem(8, 2, "sticking", lbb="restriction")
+    R = problem.restriction()
+    assert selection(R, problem.space.W) is None
+    J = _jacobian(problem)
+    reduced = ReducedMatrix(J, problem._bcs, R)
+    assert not reduced.direct
+    A = reduced.assemble()
+    assert A.getSize() == (R.getSize()[1],) * 2
+    reduced.destroy()
+    R.destroy()
+
+
+def test_stored_layouts_equal_computed(problem, tmp_path):
+    """The JSON beside a JIT module gives back the layouts FFCx's IR gave."""
+    form(problem.residual())  # compiles (or loads) and fills the in-memory cache
+    checked = 0
+    for compiled in forms._cache.values():
+        if not compiled.kernels:
+            continue
+        path = tmp_path / f"{checked}{kernel_store.SUFFIX}"
+        kernel_store.save(path, compiled.kernels)
+        assert path.is_file()
+        # the elements are found again in a form of the same signature
+        loaded = kernel_store.load(path, forms._rewrite(problem.residual()).form)
+        if loaded is None:  # a cached form of another problem: its elements differ
+            continue
+        assert loaded.keys() == compiled.kernels.keys()
+        for sid, kernel in compiled.kernels.items():
+            assert loaded[sid].key == kernel.key
+            assert [repr(s) for s in loaded[sid].tables] == [repr(s) for s in kernel.tables]
+        checked += 1
+    assert checked > 0
+    (tmp_path / "bad.json").write_text("{not json")
+    assert kernel_store.load(tmp_path / "bad.json", problem.residual()) is None
+
+
+def test_first_jacobian_reused_only_at_its_state(monkeypatch):
+    """Assembled once for the scaling: the first iterate at that state reuses it; a
+    solver started from another state assembles again, and both give one answer."""
+    from xfem_contact.solvers import assembly
+    from xfem_contact.solvers.newton import RestrictedNewton
+
+    calls = []
+    original = assembly.ReducedMatrix.assemble
+
+    def counting(self):
+        calls.append(1)
+        return original(self)
+
+    monkeypatch.setattr(assembly.ReducedMatrix, "assemble", counting)
+    problem = inclusion_problem(8, 2, "sticking")
+    report = problem.solve()
+    assert report.iterations == 1
+    assert len(calls) == 1  # the set-up assembly served the only Newton step
+    solution = problem.w.x.array.copy()
+
+    problem.w.x.array[:] = 0.0
+    newton = RestrictedNewton(problem.residual(), problem.w, problem._bcs, problem.restriction())
+    problem.w.x.array[:] = 0.5 * solution  # moved after the set-up assembly
+    calls.clear()
+    newton.solve()
+    assert len(calls) == newton.report.iterations  # no stale Jacobian reused
+    assert np.allclose(problem.w.x.array, solution, rtol=0.0, atol=1e-10 * np.abs(solution).max())
+    newton.destroy()
