@@ -32,6 +32,7 @@ from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart
 _SIDE_MINUS, _SIDE_PLUS, _INTERFACE = 1, 2, 3
 _INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + index
 _BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
+_CUT_CELLS0 = 50  # measure ids of cut.dx_cut(name): _CUT_CELLS0 + index, _CUT_CELLS0 - 1 all
 _counter = itertools.count()
 
 
@@ -228,6 +229,14 @@ class CutMesh:
             "dx", domain=self.mesh, subdomain_data=self, subdomain_id=_INTERFACE0 + k
         )
 
+    def dx_cut(self, name: str | None = None) -> ufl.Measure:
+        """Measure of the whole cut cells of interface ``name`` (of all interfaces for
+        ``None``) with the standard rule: for terms that act on the cut cells only, so
+        that the other cells are not assembled with a zero integrand."""
+        k = self._interface_index(name)
+        sid = _CUT_CELLS0 - 1 if k is None else _CUT_CELLS0 + k
+        return ufl.Measure("dx", domain=self.mesh, subdomain_data=self, subdomain_id=sid)
+
     def trace_nullity(self, name: str | None = None) -> npt.NDArray[np.int32]:
         """Per cut cell of interface ``name`` (rows of ``cut_cells``): the nullity of the
         trace of its P1/Q1 vertex functions on its interface piece (see
@@ -367,6 +376,10 @@ class CutMesh:
         """Standard and runtime parts of a measure id (for :func:`xfem_contact.form`)."""
         if subdomain_id >= _BOUNDARY0:
             return self._boundary(subdomain_id - _BOUNDARY0)
+        if subdomain_id >= _CUT_CELLS0 - 1:
+            k = subdomain_id - _CUT_CELLS0
+            name = None if k < 0 else self.interface_names[k]
+            return [IntegrationPart("cell", entities=self.interface_cells(name))]
         if subdomain_id >= _INTERFACE0:
             k = subdomain_id - _INTERFACE0
             if subdomain_id not in self._cell_rules:

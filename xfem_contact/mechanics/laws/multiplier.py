@@ -128,8 +128,7 @@ class MultiplierLaw(InterfaceLaw):
             weight = weight + ALIGNED_EXTENSION * ctx.aligned_cells
         scale = weight * ctx.cell_size**2 / (2.0 * shear)
         grad_lam, grad_mu = ufl.dot(ufl.grad(lam), n), ufl.dot(ufl.grad(mu), n)
-        mesh = ctx.cut.mesh
-        return scale * ufl.inner(grad_lam, grad_mu) * ufl.dx(domain=mesh)
+        return scale * ufl.inner(grad_lam, grad_mu) * ctx.cut.dx_cut(ctx.name)
 
     def lbb_terms(self, ctx: InterfaceContext, lam, mu, u: Fields, v: Fields):
         """The LBB terms to subtract from the residual: extension and stabilisation
