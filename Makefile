@@ -39,6 +39,7 @@ bench: $(VENV)/.installed
 	$(PY) bench/quadrature.py
 	$(PY) bench/contact_convergence.py
 	$(PY) bench/scaling.py --ranks 2
+	$(PY) bench/iterative.py --tiny
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check xfem_contact tests demos bench

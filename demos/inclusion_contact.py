@@ -28,6 +28,7 @@ from mpi4py import MPI
 from xfem_contact.cases.paper import INCLUSION_CENTRE, inclusion_errors, inclusion_problem
 from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
 from xfem_contact.io.plots import Series, line_plot
+from xfem_contact.solvers.options import LINEAR_PRESETS, preset
 
 
 def main():
@@ -40,6 +41,12 @@ def main():
     )
     parser.add_argument("--friction", type=float, default=1.0, help="Coulomb coefficient")
     parser.add_argument("--lbb", default="stabilized", choices=["stabilized", "restriction"])
+    parser.add_argument(
+        "--solver",
+        default="direct",
+        choices=sorted(LINEAR_PRESETS),
+        help="linear solver of the Newton steps: MUMPS LU, or FGMRES + Schur field split",
+    )
     parser.add_argument("--out", default="results/inclusion_contact")
     parser.add_argument("--json", default=None)
     parser.add_argument("--quiet", action="store_true", help="no progress lines")
@@ -62,7 +69,7 @@ def main():
     dofs = problem.space.dof_counts()  # collective
     say(f"  {cut.num_cut_cells_global} cut cells; dofs {dofs._asdict()}")
 
-    report = problem.solve(log=say)
+    report = problem.solve(preset(args.solver), log=say)
     setup = problem.solver_timings
     timings["forms"] = setup["forms"]
     timings["sparsity"] = setup["sparsity"]
@@ -105,6 +112,8 @@ def main():
             "contact_pressure_rel_L2_error": errors.pressure,
             "tangential_traction_rel_L2_error": errors.tangential,
             "newton_iterations": report.iterations,
+            "solver": args.solver,
+            "krylov_iterations": report.linear_iterations,
             "newton_residuals": report.residuals,
             "contact_status": report.status[-1],
             "dofs": dofs._asdict() | {"total": dofs.total},

@@ -31,6 +31,7 @@ from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loading import Loads
 from xfem_contact.mechanics.materials import Material, MaterialField
 from xfem_contact.mechanics.rigid_modes import free_bodies
+from xfem_contact.mechanics.splits import field_splits, rigid_modes
 from xfem_contact.solvers.linear import solve_restricted
 from xfem_contact.solvers.newton import NewtonFailure, NewtonReport, RestrictedNewton
 
@@ -257,6 +258,7 @@ class Problem(Loads):
             self._newton.destroy()  # loads or solver options changed since it was built
             self._newton = None
         if self._newton is None:
+            split = (petsc_options or {}).get("pc_type") == "fieldsplit"
             self._newton = RestrictedNewton(
                 self.residual(),
                 self.w,
@@ -265,6 +267,8 @@ class Problem(Loads):
                 petsc_options,
                 status=self.interface_status,
                 log=log,
+                splits=field_splits(self.space) if split else None,
+                near_nullspace=rigid_modes(self.space) if split else None,
             )
             self._newton_key = key
         self._newton.log = log

@@ -66,6 +66,7 @@ from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
     describe,
     join,
 )
+from xfem_contact.solvers.options import preset
 
 
 def read_toml(path: str | pathlib.Path) -> dict:
@@ -337,8 +338,9 @@ def _gmsh_source(mesh: dict, kind: str, folder: pathlib.Path):
 
 
 def _petsc_options(solver: dict) -> dict:
-    """PETSc options of the checked [solver] table (Newton tolerances and the raw options)."""
-    options = {
+    """PETSc options of the checked [solver] table: the linear-solver preset, the Newton
+    tolerances and the raw options, later ones winning."""
+    options = preset(solver.get("linear", "direct")) | {
         option: solver[key]
         for key, option in (
             ("max_iterations", "snes_max_it"),

@@ -19,7 +19,7 @@ from collections.abc import Callable
 from xfem_contact.mechanics.laws import CONTACT_LAWS, LBB_OPTIONS, LINEAR_LAWS
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.scenes.expressions import check_expression
-from xfem_contact.solvers.options import defaults
+from xfem_contact.solvers.options import LINEAR_PRESETS, defaults
 
 _NEWTON = defaults("newton")  # the [solver] defaults are the Newton solver's
 
@@ -279,6 +279,10 @@ FIELDS = {
         ),
         "rtol": Field(_POSITIVE, f"relative Newton tolerance (default {_NEWTON['snes_rtol']})"),
         "atol": Field(_POSITIVE, f"absolute Newton tolerance (default {_NEWTON['snes_atol']})"),
+        "linear": Field(
+            Choice(tuple(LINEAR_PRESETS)),
+            f"linear solver of the Newton steps: one of {tuple(LINEAR_PRESETS)} (default direct)",
+        ),
         "petsc": Field(petsc_table, "table of extra PETSc options (without prefix)"),
     },
     "part": {

@@ -44,6 +44,8 @@ class NewtonReport:
 
     residuals: list[float] = dataclasses.field(default_factory=list)
     status: list[dict] = dataclasses.field(default_factory=list)
+    #: Krylov iterations of the linear solve of each Newton step (1 per step for LU)
+    linear_iterations: list[int] = dataclasses.field(default_factory=list)
     reason: int = 0
     final_residual: float = float("nan")
     #: Wall time (s) of residual/Jacobian assembly, of the status callback and of
@@ -107,6 +109,14 @@ class RestrictedNewton:
         status: Called with ``w`` at every iterate, on every process; returns a
             dict shown in the log.
         log: Called with each log line (e.g. ``print``); ``None`` for silence.
+        splits: For a ``fieldsplit`` preconditioner (e.g. the ``"iterative"`` preset of
+            :data:`~xfem_contact.solvers.options.LINEAR_PRESETS`): split name to the
+            local dofs of ``W`` it holds: shape ``(n,)``, the reduced unknowns touching
+            them; or ``(n, bs)``, blocks of dofs that are reduced unknowns themselves
+            (a node's components), kept together as blocks of size ``bs`` (what
+            algebraic multigrid needs for elasticity). Ignored by other preconditioners.
+        near_nullspace: Functions on ``W`` (e.g. rigid modes) given, reduced and
+            orthonormalised, as the near null space of the split named ``"u"``.
     """
 
     def __init__(
@@ -119,6 +129,8 @@ class RestrictedNewton:
         petsc_options_prefix: str = "xfem_newton_",
         status: Callable[[dolfinx.fem.Function], dict] | None = None,
         log: Callable[[str], None] | None = None,
+        splits: dict[str, np.ndarray] | None = None,
+        near_nullspace: list[dolfinx.fem.Function] | None = None,
     ):
         self.w, self.bcs, self.R = w, bcs, R
         start = time.perf_counter()
@@ -155,6 +167,7 @@ class RestrictedNewton:
         self.snes.setOptionsPrefix(self._prefix)
         with applied_options(self._prefix, self._options):
             self.snes.setFromOptions()
+        self._split_objects = self._field_splits(splits or {}, near_nullspace or [])
         # PETSc keeps its callbacks alive, and the garbage collector cannot see through
         # PETSc objects: callbacks hold this object weakly, or it would never be freed.
         this = weakref.ref(self)
@@ -163,6 +176,56 @@ class RestrictedNewton:
         self.snes.setMonitor(lambda snes, it, norm: this()._monitor(snes, it, norm))
         self.report = NewtonReport()
         self._projection: PETSc.KSP | None = None
+
+    def _field_splits(self, splits: dict, near_nullspace: list) -> list:
+        """Give a fieldsplit preconditioner its index sets (and ``"u"`` its near null
+        space); returns the PETSc objects to destroy. Collective."""
+        pc = self.snes.getKSP().getPC()
+        if pc.getType() != PETSc.PC.Type.FIELDSPLIT or not splits:
+            return []
+        comm = self.R.getComm()
+        first = self.R.getOwnershipRangeColumn()[0]
+        n_owned = self.w.x.index_map.size_local * self.w.x.block_size
+        marker, reduced = self.R.createVecLeft(), self.R.createVecRight()
+        indptr, columns, _ = self.R.getValuesCSR()
+        single = np.diff(indptr) == 1  # a dof that is one reduced unknown (scaled)
+        column = np.full(n_owned, -1, dtype=np.int64)
+        column[single] = columns[indptr[:-1][single]]
+        objects, sets = [], []
+        for name, dofs in splits.items():
+            dofs = np.asarray(dofs)
+            if dofs.ndim == 2:  # blocks (a node's components), kept in order and together
+                blocks = dofs[np.all(dofs < n_owned, axis=1)]
+                blocks = column[blocks][np.all(column[blocks] >= 0, axis=1)]
+                index = PETSc.IS().createGeneral(blocks.ravel().astype(PETSc.IntType), comm=comm)
+                index.setBlockSize(dofs.shape[1])
+            else:  # any reduced unknown touching the dofs
+                marker.set(0.0)
+                marker.getArray()[dofs[dofs < n_owned]] = 1.0
+                self.R.multTranspose(marker, reduced)
+                local = np.flatnonzero(reduced.getArray(readonly=True) > 0.0)
+                index = PETSc.IS().createGeneral((first + local).astype(PETSc.IntType), comm=comm)
+            sets.append((name, index))
+            objects.append(index)
+        pc.setFieldSplitIS(*sets)
+        index = dict(sets).get("u")
+        if index is not None and near_nullspace:
+            squared = self.D.copy()
+            squared.pointwiseMult(self.D, self.D)
+            vectors = []
+            for mode in near_nullspace:  # z = D^-1 R^T x, x = R D z on the active dofs
+                self.R.multTranspose(mode.x.petsc_vec, reduced)
+                reduced.pointwiseDivide(reduced, squared)
+                part = reduced.getSubVector(index)
+                vectors.append(part.copy())
+                reduced.restoreSubVector(index, part)
+            _orthonormalise(vectors)
+            space = PETSc.NullSpace().create(vectors=vectors, comm=comm)
+            index.compose("nearnullspace", space)
+            objects += [space, squared, *vectors]
+        marker.destroy()
+        reduced.destroy()
+        return objects
 
     def _update(self, y: PETSc.Vec) -> None:
         x = self.w.x.petsc_vec
@@ -193,14 +256,20 @@ class RestrictedNewton:
 
     def _monitor(self, snes, it, norm):
         start = time.perf_counter()
+        if it > 0:
+            self.report.linear_iterations.append(snes.getKSP().getIterationNumber())
         self.report.residuals.append(float(norm))
         status = self.status(self.w) if self.status else {}
         self.report.status.append(status)
         self.report.status_time += time.perf_counter() - start
         if self.log:
+            krylov = ""
+            if it > 0 and snes.getKSP().getType() != PETSc.KSP.Type.PREONLY:
+                krylov = f"  ({self.report.linear_iterations[-1]} Krylov iterations)"
             self.log(
                 f"  Newton {it:2d}: |F| = {norm:.3e}  "
                 + "  ".join(f"{k} {v}" for k, v in status.items())
+                + krylov
             )
 
     def _start_from_w(self) -> None:
@@ -265,7 +334,7 @@ class RestrictedNewton:
         """Destroy the PETSc objects made here (the scaled copy of ``R`` included, not
         the ``R`` given). Collective."""
         self.jacobian.destroy()  # J_r included
-        for obj in (self.snes, self.b, self.y, self.F_r, self.R, self.D):
+        for obj in (self.snes, self.b, self.y, self.F_r, self.R, self.D, *self._split_objects):
             obj.destroy()
         if self._projection is not None:
             self._projection.destroy()
@@ -282,3 +351,12 @@ def _same_state(x: np.ndarray, x0: np.ndarray, comm: MPI.Comm) -> bool:
     bound = 1e-14 * comm.allreduce(np.abs(x0).max(initial=0.0), op=MPI.MAX)
     close = x.shape == x0.shape and bool(np.all(np.abs(x - x0) <= bound))
     return comm.allreduce(close, op=MPI.LAND)
+
+
+def _orthonormalise(vectors: list[PETSc.Vec]) -> None:
+    """Modified Gram-Schmidt in place (a near null space must be orthonormal);
+    collective."""
+    for i, v in enumerate(vectors):
+        for u in vectors[:i]:
+            v.axpy(-v.dot(u), u)
+        v.scale(1.0 / v.norm())

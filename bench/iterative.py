@@ -1,0 +1,104 @@
+"""Krylov iterations and memory of the iterative Newton solve against the direct one.
+
+Paper case 2 (P2-P1, sticking, quadrilaterals) for N = 40, 80, 160 cells per side, and
+with a radius that leaves cut cells with tiny parts (``--tiny``: r = 0.2 + 1e-7 h,
+so the circle passes a hair's breadth from mesh nodes), each case a process of its
+own solved with ``LINEAR_PRESETS["direct"]`` (MUMPS LU) and ``["iterative"]`` (FGMRES +
+Schur field split, GAMG on the displacements): Newton steps, Krylov iterations per
+step, wall time of the solve, peak resident memory and the contact-pressure error.
+Writes ``bench/results/iterative.{json,md}``.
+
+Run: ``python bench/iterative.py [--sizes 40 80 160] [--tiny]`` (``make bench``).
+"""
+
+import argparse
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "bench" / "results"
+
+
+def case(n: int, solver: str, tiny: bool) -> dict:
+    """Solve one case in this process; returns its numbers. Collective."""
+    from xfem_contact.cases.paper import INCLUSION_RADIUS, inclusion_errors, inclusion_problem
+    from xfem_contact.solvers.options import preset
+
+    radius = INCLUSION_RADIUS + (1e-7 / n if tiny else 0.0)
+    problem = inclusion_problem(n, 2, "sticking", radius=radius)
+    start = time.perf_counter()
+    report = problem.solve(preset(solver))
+    wall = time.perf_counter() - start
+    return {
+        "n": n,
+        "solver": solver,
+        "tiny": tiny,
+        "dofs": problem.space.dof_counts().total,
+        "newton": report.iterations,
+        "krylov": report.linear_iterations,
+        "solve_s": wall,
+        "error": inclusion_errors(problem, problem.w).pressure,
+    }
+
+
+def run(n: int, solver: str, tiny: bool) -> dict:
+    """:func:`case` in a process of its own, with that process's peak RSS (MB)."""
+    command = [sys.executable, __file__, "--case", str(n), solver, str(int(tiny))]
+    with tempfile.TemporaryFile("w+") as out:
+        proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT)
+        _, status, usage = os.wait4(proc.pid, 0)
+        out.seek(0)
+        text = out.read()
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise RuntimeError(f"{' '.join(command)} failed:\n{text}")
+    result = json.loads(text.strip().splitlines()[-1])
+    result["rss_mb"] = usage.ru_maxrss / 1024.0
+    return result
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[40, 80, 160])
+    parser.add_argument("--tiny", action="store_true", help="also the tiny-cut radius")
+    parser.add_argument("--case", nargs=3, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.case:
+        n, solver, tiny = args.case
+        print(json.dumps(case(int(n), solver, bool(int(tiny)))))
+        return
+    rows = []
+    for tiny in (False, True) if args.tiny else (False,):
+        for n in args.sizes:
+            for solver in ("direct", "iterative"):
+                r = run(n, solver, tiny)
+                rows.append(r)
+                print(
+                    f"N={n:4d}{' tiny cut' if tiny else ''} {solver:9s} dofs {r['dofs']:9,d}: "
+                    f"Newton {r['newton']}, Krylov per step {r['krylov']}, solve "
+                    f"{r['solve_s']:7.2f} s, peak RSS {r['rss_mb']:6.0f} MB, "
+                    f"error {r['error']:.4e}",
+                    flush=True,
+                )
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    (RESULTS / "iterative.json").write_text(json.dumps(rows, indent=1))
+    lines = [
+        "| N | cut | solver | dofs | Newton | Krylov per step | solve (s) | peak RSS (MB) | error |"
+    ]
+    lines.append("|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        lines.append(
+            f"| {r['n']} | {'tiny' if r['tiny'] else 'generic'} | {r['solver']} | {r['dofs']:,} | "
+            f"{r['newton']} | {r['krylov']} | {r['solve_s']:.2f} | {r['rss_mb']:.0f} | "
+            f"{r['error']:.4e} |"
+        )
+    (RESULTS / "iterative.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
