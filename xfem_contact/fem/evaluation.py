@@ -43,6 +43,29 @@ def evaluate_reference(
     return np.einsum("pi,pic->pc", basis, values)
 
 
+def evaluate_lattice(
+    u: dolfinx.fem.Function, cells: npt.NDArray[np.int32], X: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]:
+    """Values of a Lagrange function at the same reference points ``X`` (k, tdim) in
+    every one of ``cells`` (the basis tabulated once), shape ``(len(cells) * k,
+    value_size)``, cell by cell. ``u`` as for :func:`evaluate_reference`. Local."""
+    V = u.function_space
+    element = basix.create_element(
+        basix.ElementFamily.P,
+        V.mesh.basix_cell(),
+        V.ufl_element().embedded_superdegree,
+        basix.LagrangeVariant.gll_warped,
+    )
+    basis = element.tabulate(0, X)[0, :, :, 0]  # (k, nnodes)
+    if V.component():
+        dofs = V.dofmap.list[cells].reshape(len(cells), basis.shape[1], -1)
+    else:
+        bs = V.dofmap.bs
+        dofs = V.dofmap.list[cells][:, :, None] * bs + np.arange(bs)
+    values = np.einsum("ki,cis->cks", basis, u.x.array[dofs])
+    return values.reshape(-1, values.shape[-1])
+
+
 class FieldSampler:
     """Values of the fields of functions on one mixed space at fixed points.
 

@@ -127,6 +127,12 @@ class CellMaps:
         basis = self._cmap.tabulate(0, X)[0, :, :, 0]
         return np.einsum("pi,pid->pd", basis, self._geom[cells])
 
+    def push_forward_lattice(self, cells, X) -> npt.NDArray[np.float64]:
+        """``x = F_cell(X_k)`` for the same reference points ``X`` (k, tdim) in every
+        cell (the map tabulated once), shape ``(len(cells) * k, gdim)``, cell by cell."""
+        basis = self._cmap.tabulate(0, X)[0, :, :, 0]  # (k, ndofs)
+        return np.einsum("ki,cid->ckd", basis, self._geom[cells]).reshape(-1, self._gdim)
+
     def jacobian(self, cells, X) -> npt.NDArray[np.float64]:
         """Jacobians ``dx/dX`` of the cell maps, shape ``(m, gdim, tdim)``."""
         tab = self._cmap.tabulate(1, X)[1:, :, :, 0]  # (tdim, m, ndofs)

@@ -28,7 +28,7 @@ import numpy.typing as npt
 import pyvista
 
 from xfem_contact.fem.cutmesh import CutMesh
-from xfem_contact.fem.evaluation import evaluate_reference
+from xfem_contact.fem.evaluation import evaluate_lattice, evaluate_reference
 
 # Reference nodes of the uncut cells' quadratic lattice, in VTK node order
 _LATTICE = {
@@ -97,11 +97,17 @@ def _grid(
         n, k = b.X.shape[:2]
         if n == 0:
             continue
-        cells = np.repeat(b.cells, k)
-        X = np.ascontiguousarray(b.X.reshape(-1, tdim))
-        points.append(_pad3(cut.maps.push_forward(cells, X)))
-        if fields is not None:
-            values.append(_pad3(evaluate_reference(fields[b.side], cells, X)))
+        if b.X.strides[0] == 0:  # the same lattice in every cell: tabulate it once
+            lattice = np.ascontiguousarray(b.X[0])
+            points.append(_pad3(cut.maps.push_forward_lattice(b.cells, lattice)))
+            if fields is not None:
+                values.append(_pad3(evaluate_lattice(fields[b.side], b.cells, lattice)))
+        else:
+            cells = np.repeat(b.cells, k)
+            X = np.ascontiguousarray(b.X.reshape(-1, tdim))
+            points.append(_pad3(cut.maps.push_forward(cells, X)))
+            if fields is not None:
+                values.append(_pad3(evaluate_reference(fields[b.side], cells, X)))
         ids = start + np.arange(n * k).reshape(n, k)
         connectivity.append(np.c_[np.full(n, k), ids].ravel())
         types.append(np.full(n, b.vtk_type, dtype=np.uint8))
