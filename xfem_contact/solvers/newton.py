@@ -87,10 +87,12 @@ class NewtonFailure(RuntimeError):
 class RestrictedNewton:
     """Solve ``F(w; v) = 0`` for ``w = R y`` on the reduced space of ``R``.
 
-    Construction is collective (it compiles the forms, assembles the Jacobian
-    once, for the sparsity of ``R^T J R`` and the scaling ``D`` of
-    :mod:`xfem_contact.solvers.scaling`, and creates the SNES under a unique options
-    prefix, removing its options from the PETSc database afterwards). SNES iterates on
+    Construction is collective (it compiles the forms, builds the sparsity of
+    ``R^T J R`` (:class:`~xfem_contact.solvers.assembly.ReducedMatrix`), assembles the
+    Jacobian once for the scaling ``D`` of :mod:`xfem_contact.solvers.scaling` (the
+    first iterate reuses it when it sits at the same state), and creates the SNES
+    under a unique options prefix, removing its options from the PETSc database
+    afterwards). SNES iterates on
     the scaled unknowns ``y`` with ``w = R D y``, so the residual norms it reports are
     those of ``D R^T F``. Each :meth:`solve` starts from the current ``w`` (projected
     on the range of ``R D``) and checks the final residual against the tolerances.
