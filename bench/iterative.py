@@ -20,6 +20,8 @@ import sys
 import tempfile
 import time
 
+from xfem_contact.io.progress import note, progress
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "results"
 
@@ -65,6 +67,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[40, 80, 160])
     parser.add_argument("--tiny", action="store_true", help="also the tiny-cut radius")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--case", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.case:
@@ -73,16 +76,15 @@ def main():
         return
     rows = []
     for tiny in (False, True) if args.tiny else (False,):
-        for n in args.sizes:
+        for n in progress(args.sizes, "sizes", not args.no_progress):
             for solver in ("direct", "iterative"):
                 r = run(n, solver, tiny)
                 rows.append(r)
-                print(
+                note(
                     f"N={n:4d}{' tiny cut' if tiny else ''} {solver:9s} dofs {r['dofs']:9,d}: "
                     f"Newton {r['newton']}, Krylov per step {r['krylov']}, solve "
                     f"{r['solve_s']:7.2f} s, peak RSS {r['rss_mb']:6.0f} MB, "
-                    f"error {r['error']:.4e}",
-                    flush=True,
+                    f"error {r['error']:.4e}"
                 )
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "iterative.json").write_text(json.dumps(rows, indent=1))

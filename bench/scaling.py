@@ -25,6 +25,8 @@ import time
 
 import matplotlib
 
+from xfem_contact.io.progress import note, progress
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
@@ -182,6 +184,7 @@ def main():
         "--ranks", type=int, default=0, help="also run the largest P2 case on R ranks"
     )
     parser.add_argument("--no-jit", action="store_true", help="skip the cold-cache runs")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args()
     RESULTS.mkdir(parents=True, exist_ok=True)
     ordering = mumps_ordering()
@@ -191,12 +194,12 @@ def main():
         for degree in args.degrees:
             demo(args.sizes[0], degree, work)  # warm the caches of this degree
             plain(args.sizes[0], degree, work, ordering)
-            for n in args.sizes:
+            for n in progress(args.sizes, f"P{degree} sizes", not args.no_progress):
                 row = {"degree": degree, "n": n}
                 row["cut"] = demo(n, degree, work)
                 row["plain"] = plain(n, degree, work, ordering)
                 rows.append(row)
-                print(line(row), flush=True)
+                note(line(row))
         jit = (
             {}
             if args.no_jit

@@ -42,7 +42,12 @@ def _run(args) -> int:
         out = pathlib.Path(args.out or f"results/{scene.name}")
         from xfem_contact.scenes.run import run
 
-        summary = run(scene, out, log=None if args.quiet else print)
+        summary = run(
+            scene,
+            out,
+            log=None if args.quiet else print,
+            progress_bar=not (args.quiet or args.no_progress),
+        )
     except NewtonFailure as failure:
         failed(3, str(failure).splitlines()[0])
         say(failure.report.table(), file=sys.stderr)
@@ -101,7 +106,8 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("run", help="run a scene (a TOML file or a bundled scene name)")
     p.add_argument("scene")
     p.add_argument("--out", default=None, help="output folder (default results/NAME)")
-    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.add_argument("--quiet", action="store_true", help="no progress lines, no progress bar")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar over load steps")
     p.add_argument("--debug", action="store_true", help="show the traceback of an error")
     p.set_defaults(func=_run)
     p = sub.add_parser("scenes", help="list the bundled scenes")

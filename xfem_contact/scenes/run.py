@@ -15,6 +15,7 @@ from mpi4py import MPI
 from xfem_contact._version import versions
 from xfem_contact.fem import forms
 from xfem_contact.io.output import write_json
+from xfem_contact.io.progress import note, progress
 from xfem_contact.mechanics.loading import load_steps
 from xfem_contact.mechanics.plain import PlainElasticityProblem
 from xfem_contact.scenes.builder import (  # noqa: F401  (re-exported)
@@ -86,11 +87,14 @@ def run(
     out: str | pathlib.Path | None = None,
     log: Callable[[str], None] | None = print,
     comm: MPI.Comm = MPI.COMM_WORLD,
+    progress_bar: bool = True,
 ) -> dict:
     """Build, solve and summarise a scene. Collective.
 
     The loads are applied in ``scene.load_steps`` equal steps (a line per step and
-    per Newton iterate goes to ``log``; ``None`` for silence). With ``out``, the
+    per Newton iterate goes to ``log``; ``None`` for silence), with a progress bar over
+    the steps when there are several and ``progress_bar`` is true
+    (:func:`xfem_contact.io.progress.progress`). With ``out``, the
     fields of every step go to VTX files (``displacement.bp``, ``multiplier.bp``,
     time = load factor), the final state to ``result.vtu``, last the summary to
     ``summary.json`` (atomic; a stale one is removed first: a failed run leaves none).
@@ -99,6 +103,8 @@ def run(
         The summary: effects built, fields, dof counts, iterations per step, the
         contact status, timings (s).
     """
+    if log is print:  # printed lines go above the progress bar, not through it
+        log = note
     say = log if (log and comm.rank == 0) else (lambda *a: None)
     out = None if out is None else pathlib.Path(out)
     if out is not None and comm.rank == 0:  # a summary.json is a finished run's
@@ -113,7 +119,8 @@ def run(
     steps, iterations, residuals, status = load_steps(scene.load_steps), [], [], {}
     solve_start = time.perf_counter()
     try:
-        for k, t in enumerate(steps, start=1):
+        bar = progress(steps, f"{scene.name}: load steps", progress_bar and len(steps) > 1, comm)
+        for k, t in enumerate(bar, start=1):
             problem.load_factor.set(t)
             try:
                 solution, its, status = solve_step(

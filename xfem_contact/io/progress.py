@@ -1,0 +1,45 @@
+"""Progress bars for long loops (load steps, benchmark sweeps), switchable off.
+
+:func:`progress` wraps an iterable in a tqdm bar on the first process: a notebook
+widget in Jupyter when ``ipywidgets`` is there, a text bar on stderr otherwise, none
+when disabled (or on the other processes). :func:`note` prints a line without
+breaking the bar.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from collections.abc import Iterable
+
+from mpi4py import MPI
+from tqdm import std
+
+
+def _in_notebook() -> bool:
+    try:
+        shell = get_ipython().__class__.__name__  # type: ignore[name-defined]  # noqa: F821
+    except NameError:
+        return False
+    return shell == "ZMQInteractiveShell" and importlib.util.find_spec("ipywidgets") is not None
+
+
+def progress(
+    iterable: Iterable,
+    description: str,
+    enabled: bool = True,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    total: int | None = None,
+):
+    """``iterable`` with a progress bar (tqdm) on rank 0 of ``comm``; a plain pass-through
+    when ``enabled`` is false. Not collective (each process iterates its own copy)."""
+    disable = not enabled or comm.rank != 0
+    if not disable and _in_notebook():
+        from tqdm import notebook
+
+        return notebook.tqdm(iterable, desc=description, total=total)
+    return std.tqdm(iterable, desc=description, total=total, disable=disable, leave=False)
+
+
+def note(message: str) -> None:
+    """Print ``message`` on stdout above a running text bar (tqdm's ``write``)."""
+    std.tqdm.write(message)
