@@ -24,6 +24,7 @@ import tempfile
 import time
 
 import matplotlib
+import numpy as np
 
 from xfem_contact.io.progress import note, progress
 
@@ -71,7 +72,7 @@ def mumps_ordering() -> int:
     return int(subprocess.check_output([sys.executable, "-c", code], text=True).strip())
 
 
-def demo(n, degree, work, env=None, ranks=1) -> dict:
+def demo(n, degree, work, env=None, ranks=1, samples=False) -> dict:
     summary = work / f"demo_{n}_{degree}_{ranks}.json"
     command = [sys.executable, str(ROOT / "demos" / "inclusion_contact.py")]
     command += ["--n", str(n), "--degree", str(degree), "--quiet"]
@@ -87,7 +88,22 @@ def demo(n, degree, work, env=None, ranks=1) -> dict:
         "timings": data["timings"],
         "error": data["contact_pressure_rel_L2_error"],
         "newton_iterations": data["newton_iterations"],
-    }
+    } | ({"_samples": data["interface_samples"]} if samples else {})
+
+
+def max_difference(a: dict, b: dict) -> float:
+    """Largest difference of ``lambda_n`` at the same interface points of two runs
+    (points matched by sorted position), relative to the largest ``|lambda_n|``."""
+
+    def by_position(s):
+        x, y, lam = (np.asarray(s[k]) for k in ("x", "y", "lambda_n"))
+        order = np.lexsort((np.round(y, 10), np.round(x, 10)))
+        return np.c_[x, y][order], lam[order]
+
+    (xa, la), (xb, lb) = by_position(a), by_position(b)
+    if xa.shape != xb.shape or not np.allclose(xa, xb, rtol=0.0, atol=1e-12):
+        return float("inf")
+    return float(np.abs(la - lb).max() / np.abs(la).max())
 
 
 def plain(n, degree, work, ordering, env=None) -> dict:
@@ -196,7 +212,8 @@ def main():
             plain(args.sizes[0], degree, work, ordering)
             for n in progress(args.sizes, f"P{degree} sizes", not args.no_progress):
                 row = {"degree": degree, "n": n}
-                row["cut"] = demo(n, degree, work)
+                last = degree == 2 and n == args.sizes[-1]
+                row["cut"] = demo(n, degree, work, samples=last and args.ranks > 1)
                 row["plain"] = plain(n, degree, work, ordering)
                 rows.append(row)
                 note(line(row))
@@ -214,11 +231,14 @@ def main():
         if args.ranks > 1:
             n = args.sizes[-1]
             serial = next(r["cut"] for r in rows if r["degree"] == 2 and r["n"] == n)
-            distributed = demo(n, 2, work, ranks=args.ranks)
+            distributed = demo(n, 2, work, ranks=args.ranks, samples=True)
+            difference = max_difference(serial.pop("_samples"), distributed.pop("_samples"))
             parallel = {"n": n, "ranks": args.ranks, "serial": serial, "parallel": distributed}
+            parallel["lambda_n_max_relative_difference"] = difference
             print(
                 f"P2 N={n}: {args.ranks} ranks {distributed['wall']:.2f} s, 1 rank "
-                f"{serial['wall']:.2f} s, speed-up {serial['wall'] / distributed['wall']:.2f}"
+                f"{serial['wall']:.2f} s, speed-up {serial['wall'] / distributed['wall']:.2f}; "
+                f"lambda_n at the same points differs by {difference:.1e} (relative)"
             )
             for key, label in PHASES:
                 s, p = serial["timings"].get(key, 0.0), distributed["timings"].get(key, 0.0)
