@@ -15,6 +15,7 @@ from xfem_contact.scenes.scene import SceneError, load_scene
 from xfem_contact.solvers.options import LINEAR_PRESETS, preset
 
 
+@pytest.mark.mpi
 @pytest.mark.filterwarnings("ignore::xfem_contact.mechanics.problem.RigidModeWarning")
 @pytest.mark.parametrize("law", ["sticking", "frictionless"])
 def test_iterative_equals_direct(law):
