@@ -74,15 +74,6 @@ class SmallStrain:
             a += self._ghost_penalty(u, v)
         return a
 
-    def layer_cells(self) -> np.ndarray:
-        """Local cells that the interface terms and the ghost penalty touch: the cut
-        cells and both cells of every ghost-penalty facet. Collective (a DG0 scatter)."""
-        cells = [self.cut.cut_cells]
-        if self.ghost_penalty > 0:
-            for _, entities in ghost_penalty_facets(self.cut):  # (cell, facet) x 2
-                cells.append(np.asarray(entities).reshape(-1, 4)[:, [0, 2]].ravel())
-        return np.unique(np.concatenate(cells)).astype(np.int32)
-
     def _ghost_penalty(self, trial, test) -> ufl.Form:
         dS = ufl.Measure("dS", domain=self.cut.mesh, subdomain_data=ghost_penalty_facets(self.cut))
         h = ufl.avg(self.h)

@@ -267,7 +267,7 @@ class Problem(Loads):
                 petsc_options,
                 status=self.interface_status,
                 log=log,
-                splits=field_splits(self.space, self.bulk.layer_cells()) if split else None,
+                splits=field_splits(self.space) if split else None,
                 near_nullspace=rigid_modes(self.space) if split else None,
             )
             self._newton_key = key

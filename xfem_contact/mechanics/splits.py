@@ -1,8 +1,7 @@
 """What a field-split preconditioner needs to know of a problem's mixed space.
 
-:func:`field_splits` names the dofs of the displacements away from the interface
-(``"u"``: both sides) and the rest (``"lambda"``: every multiplier field and the
-displacements of the interface layer); :func:`rigid_modes` gives the
+:func:`field_splits` names the dofs of the displacements (``"u"``: both sides) and of
+the multipliers (``"lambda"``: every multiplier field); :func:`rigid_modes` gives the
 translations and the rotation of each side, the near null space of the displacement
 block for algebraic multigrid (GAMG). Used by
 :class:`~xfem_contact.mechanics.problem.Problem` for the ``"iterative"`` preset of
@@ -19,18 +18,10 @@ from xfem_contact.fem.enrichment import EnrichedSpace
 SIDE_FIELDS = (0, 1)
 
 
-def field_splits(
-    space: EnrichedSpace, layer_cells: np.ndarray | None = None
-) -> dict[str, np.ndarray]:
-    """``{"u": nodes, "lambda": dofs}``: local dofs of ``space.W`` (owned and ghost).
-
-    ``"u"``: the displacement dofs away from the interface, one row ``(x, y)`` per
-    node and side. ``"lambda"``: the multiplier dofs and the displacement dofs of the
-    ``layer_cells`` (the cut cells and the cells of the ghost-penalty facets: the rows
-    that algebraic multigrid finds hard, case 2 at 40 x 40: CG + GAMG on the
-    displacements takes 151 iterations with them, 23 without, as plain elasticity),
-    for the small block solved directly. Not collective.
-    """
+def field_splits(space: EnrichedSpace) -> dict[str, np.ndarray]:
+    """``{"u": nodes, "lambda": dofs}``: local dofs of ``space.W`` (owned and ghost) of
+    the displacement fields, one row ``(x, y)`` per node and side, and of the multiplier
+    fields (no ``"lambda"`` without a multiplier). Not collective."""
     W = space.W
 
     def dofs(fields):
@@ -40,18 +31,10 @@ def field_splits(
     for field in SIDE_FIELDS:
         parts = [W.sub(field).sub(c).dofmap.list.ravel() for c in range(W.mesh.geometry.dim)]
         nodes.append(np.unique(np.stack(parts, axis=1), axis=0))
-    nodes = np.concatenate(nodes)
+    splits = {"u": np.concatenate(nodes)}
     multipliers = [field for field, _, _ in space.multiplier_fields]
-    small = [dofs(multipliers)] if multipliers else []
-    if layer_cells is not None and layer_cells.size:
-        layer = np.zeros(W.dofmap.index_map.size_local + W.dofmap.index_map.num_ghosts, bool)
-        layer[W.dofmap.list[layer_cells].ravel()] = True
-        near = layer[nodes].any(axis=1)
-        small.append(nodes[near].ravel())
-        nodes = nodes[~near]
-    splits = {"u": nodes}
-    if small:
-        splits["lambda"] = np.unique(np.concatenate(small))
+    if multipliers:
+        splits["lambda"] = dofs(multipliers)
     return splits
 
 

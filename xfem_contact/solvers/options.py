@@ -79,13 +79,12 @@ SOLVER_OPTIONS: dict[str, Option] = {
 #: of a scene): option name (without prefix) to value, merged over the defaults. The
 #: iterative one is FGMRES preconditioned by a lower-triangular Schur-complement field
 #: split (as many iterations as the full factorisation, at half the cost): the
-#: displacements away from the interface ("u": nodes as blocks of 2, the rigid modes
-#: of each side as GAMG's near null space) by one GAMG V-cycle with 4 Chebyshev/SOR
-#: smoothing steps, the multipliers and the displacements of the interface layer
-#: ("lambda": the cut cells and the ghost-penalty cells, see
-#: :func:`xfem_contact.mechanics.splits.field_splits`) by LU of the Schur
-#: approximation ``A_ll - A_lu diag(A_uu)^-1 A_ul``. It needs little memory but many
-#: iterations (case 2 at 40 x 40: 120), see ``bench/iterative.py``.
+#: displacements ("u": nodes as blocks of 2, the rigid modes of each side as GAMG's
+#: near null space) by one GAMG V-cycle with 4 Chebyshev/SOR smoothing steps, the
+#: multipliers ("lambda") by LU of the Schur approximation
+#: ``A_ll - A_lu diag(A_uu)^-1 A_ul`` (small: the vertices of the cut cells). It needs
+#: little memory but many iterations (case 2 at 40 x 40: 151; the ghost penalty
+#: rows make the displacement block hard for GAMG), see ``bench/iterative.py``.
 LINEAR_PRESETS: dict[str, dict[str, OptionValue]] = {
     "direct": {},
     "iterative": {
