@@ -221,7 +221,7 @@ class RestrictedNewton:
                 part = reduced.getSubVector(index)
                 vectors.append(part.copy())
                 reduced.restoreSubVector(index, part)
-            _orthonormalise(vectors)
+            vectors = _orthonormalise(vectors)
             space = PETSc.NullSpace().create(vectors=vectors, comm=comm)
             index.compose("nearnullspace", space)
             objects += [space, squared, *vectors]
@@ -355,10 +355,19 @@ def _same_state(x: np.ndarray, x0: np.ndarray, comm: MPI.Comm) -> bool:
     return comm.allreduce(close, op=MPI.LAND)
 
 
-def _orthonormalise(vectors: list[PETSc.Vec]) -> None:
-    """Modified Gram-Schmidt in place (a near null space must be orthonormal);
-    collective."""
-    for i, v in enumerate(vectors):
-        for u in vectors[:i]:
+def _orthonormalise(vectors: list[PETSc.Vec]) -> list[PETSc.Vec]:
+    """Modified Gram-Schmidt (a near null space must be orthonormal): the orthonormal
+    vectors kept, the ones that vanish on the split (e.g. the rigid modes of a body
+    that lies in the interface layer) destroyed. Collective."""
+    kept = []
+    for v in vectors:
+        size = v.norm()
+        for u in kept:
             v.axpy(-v.dot(u), u)
-        v.scale(1.0 / v.norm())
+        norm = v.norm()
+        if norm > 1e-10 * size:
+            v.scale(1.0 / norm)
+            kept.append(v)
+        else:
+            v.destroy()
+    return kept
