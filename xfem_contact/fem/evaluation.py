@@ -11,6 +11,28 @@ from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.quadrature.rules import RuleSet
 
 
+def _basis(V: dolfinx.fem.FunctionSpace, X: npt.NDArray[np.float64]) -> np.ndarray:
+    """The Lagrange basis of ``V``'s element at reference points ``X``, ``(n, nnodes)``."""
+    element = basix.create_element(
+        basix.ElementFamily.P,
+        V.mesh.basix_cell(),
+        V.ufl_element().embedded_superdegree,
+        basix.LagrangeVariant.gll_warped,
+    )
+    return element.tabulate(0, X)[0, :, :, 0]
+
+
+def _cell_dofs(V: dolfinx.fem.FunctionSpace, cells: npt.NDArray[np.int32]) -> np.ndarray:
+    """Indices into the array of a Function on ``V`` (or on its parent, for a view
+    ``W.sub(i)``: unblocked dofs of ``W``, node by node) of the dofs of each cell,
+    shape ``(len(cells), nnodes, value_size)``."""
+    if V.component():
+        bs = V.ufl_element().reference_value_size
+        return V.dofmap.list[cells].reshape(len(cells), -1, bs)
+    bs = V.dofmap.bs
+    return V.dofmap.list[cells][:, :, None] * bs + np.arange(bs)
+
+
 def evaluate_reference(
     u: dolfinx.fem.Function, cells: npt.NDArray[np.int32], X: npt.NDArray[np.float64]
 ) -> npt.NDArray[np.float64]:
@@ -26,20 +48,8 @@ def evaluate_reference(
         Values of shape ``(m, value_size)``.
     """
     V = u.function_space
-    element = basix.create_element(
-        basix.ElementFamily.P,
-        V.mesh.basix_cell(),
-        V.ufl_element().embedded_superdegree,
-        basix.LagrangeVariant.gll_warped,
-    )
-    basis = element.tabulate(0, X)[0, :, :, 0]  # (m, nnodes)
-    m, nnodes = basis.shape
-    if V.component():  # a view into a mixed function: unblocked dofs of W, node by node
-        dofs = V.dofmap.list[cells].reshape(m, nnodes, -1)
-    else:
-        bs = V.dofmap.bs
-        dofs = V.dofmap.list[cells][:, :, None] * bs + np.arange(bs)
-    values = u.x.array[dofs]  # (m, nnodes, value_size)
+    values = u.x.array[_cell_dofs(V, cells)]  # (m, nnodes, value_size)
+    basis = _basis(V, X)  # (m, nnodes)
     return np.einsum("pi,pic->pc", basis, values)
 
 
@@ -50,18 +60,7 @@ def evaluate_lattice(
     every one of ``cells`` (the basis tabulated once), shape ``(len(cells) * k,
     value_size)``, cell by cell. ``u`` as for :func:`evaluate_reference`. Local."""
     V = u.function_space
-    element = basix.create_element(
-        basix.ElementFamily.P,
-        V.mesh.basix_cell(),
-        V.ufl_element().embedded_superdegree,
-        basix.LagrangeVariant.gll_warped,
-    )
-    basis = element.tabulate(0, X)[0, :, :, 0]  # (k, nnodes)
-    if V.component():
-        dofs = V.dofmap.list[cells].reshape(len(cells), basis.shape[1], -1)
-    else:
-        bs = V.dofmap.bs
-        dofs = V.dofmap.list[cells][:, :, None] * bs + np.arange(bs)
+    basis, dofs = _basis(V, X), _cell_dofs(V, cells)  # (k, nnodes), (n, nnodes, bs)
     values = np.einsum("ki,cis->cks", basis, u.x.array[dofs])
     return values.reshape(-1, values.shape[-1])
 
@@ -93,14 +92,7 @@ class FieldSampler:
         """Values of field ``field`` of ``w`` (a Function on ``W``), ``(m, value_size)``."""
         if field not in self._fields:
             V = self.W.sub(field)
-            element = basix.create_element(
-                basix.ElementFamily.P,
-                V.mesh.basix_cell(),
-                V.ufl_element().embedded_superdegree,
-                basix.LagrangeVariant.gll_warped,
-            )
-            basis = element.tabulate(0, self.X)[0, :, :, 0]
-            dofs = V.dofmap.list[self.cells].reshape(basis.shape[0], basis.shape[1], -1)
+            basis, dofs = _basis(V, self.X), _cell_dofs(V, self.cells)
             self._fields[field] = (basis, dofs)
         basis, dofs = self._fields[field]
         return np.einsum("pi,pic->pc", basis, w.x.array[dofs])
