@@ -6,8 +6,9 @@ with one law built by :func:`~xfem_contact.mechanics.laws.make_law`."""
 from __future__ import annotations
 
 from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.mechanics.composition import Materials
 from xfem_contact.mechanics.laws import CONTACT_LAWS, LINEAR_LAWS, make_law
-from xfem_contact.mechanics.problem import Materials, Problem
+from xfem_contact.mechanics.problem import Problem
 
 #: Interface laws of :class:`ElasticityProblem`
 INTERFACE_LAWS = LINEAR_LAWS

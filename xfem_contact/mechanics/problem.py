@@ -25,19 +25,15 @@ from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.evaluation import interface_points
 from xfem_contact.fem.forms import form
 from xfem_contact.fem.restriction import restriction_matrix
-from xfem_contact.mechanics.bulk import SIDES, SmallStrain, cell_size, check_ghosts
-from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw, make_law
+from xfem_contact.mechanics.bulk import SmallStrain, cell_size, check_ghosts
+from xfem_contact.mechanics.composition import Materials, interface_laws, side_and_law_materials
+from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw
 from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loading import Loads
-from xfem_contact.mechanics.materials import Material, MaterialField
 from xfem_contact.mechanics.rigid_modes import free_bodies
 from xfem_contact.mechanics.splits import field_splits, rigid_modes
 from xfem_contact.solvers.linear import solve_restricted
 from xfem_contact.solvers.newton import NewtonFailure, NewtonReport, RestrictedNewton
-
-#: Materials: one for both sides, or ``{-1: m, 1: m}`` where side -1 may map
-#: interface names to the material inside each
-Materials = Material | Mapping[int, Material | Mapping[str, Material]]
 
 
 class RigidModeWarning(UserWarning):
@@ -86,8 +82,8 @@ class Problem(Loads):
         min_support_fraction: float | None = None,
     ):
         self.cut, self.mesh = cut, cut.mesh
-        self.laws = _laws(cut, interfaces)
-        side_materials, law_materials = _materials(cut, materials)
+        self.laws = interface_laws(cut, interfaces)
+        side_materials, law_materials = side_and_law_materials(cut, materials)
         if min_support_fraction is None:
             min_support_fraction = 0.0 if ghost_penalty > 0 else 1e-12
         gdim = self.mesh.geometry.dim
@@ -353,48 +349,3 @@ class Problem(Loads):
         local |= {k: state[k] for k in keys if k in state}
         comm = self.mesh.comm
         return {k: np.concatenate(comm.allgather(v)).tolist() for k, v in local.items()}
-
-
-def _laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
-    """One law object per interface name of ``cut``."""
-    names = cut.interface_names
-    if not isinstance(interfaces, Mapping):
-        interfaces = {name: interfaces for name in names}
-    if set(interfaces) != set(names):
-        raise ValueError(f"Give a law for each interface {list(names)}; got {sorted(interfaces)}")
-    laws = {}
-    for name in names:
-        law = interfaces[name]
-        laws[name] = make_law(law) if isinstance(law, str) else law
-        if not isinstance(laws[name], InterfaceLaw):
-            raise ValueError(f"Interface {name!r}: {law!r} is not an interface law")
-    return laws
-
-
-def _materials(cut: CutMesh, materials: Materials):
-    """Per side (Material or MaterialField) and per interface ({-1, 1}: Material)."""
-    if isinstance(materials, Material):
-        materials = {-1: materials, 1: materials}
-    missing = [s for s in SIDES if s not in materials]
-    if missing:
-        raise ValueError(f"Give a Material for sides -1 and +1 (missing: {missing})")
-    names = cut.interface_names
-    inside = materials[-1]
-    if isinstance(inside, Mapping):
-        if set(inside) != set(names):
-            raise ValueError(
-                f"Side -1 materials must name the interfaces {list(names)}; got {sorted(inside)}"
-            )
-        per_interface = dict(inside)
-    else:
-        per_interface = {name: inside for name in names}
-    if not all(isinstance(m, Material) for m in [*per_interface.values(), materials[1]]):
-        raise ValueError("Give a Material for sides -1 and +1")
-    distinct = len({per_interface[n] for n in names}) > 1
-    side_minus = (
-        MaterialField(cut.cell_regions(), [per_interface[n] for n in names])
-        if distinct
-        else per_interface[names[0]]
-    )
-    law_materials = {name: {-1: per_interface[name], 1: materials[1]} for name in names}
-    return {-1: side_minus, 1: materials[1]}, law_materials
