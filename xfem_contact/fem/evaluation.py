@@ -11,18 +11,24 @@ from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.quadrature.rules import RuleSet
 
 
-def _basis(V: dolfinx.fem.FunctionSpace, X: npt.NDArray[np.float64]) -> np.ndarray:
-    """The Lagrange basis of ``V``'s element at reference points ``X``, ``(n, nnodes)``."""
-    element = basix.create_element(
+def lagrange_element(V: dolfinx.fem.FunctionSpace) -> basix.finite_element.FiniteElement:
+    """The scalar Lagrange element of ``V`` (or of a sub-space ``W.sub(i)``), whose
+    ``tabulate(k, X)`` gives the basis and its reference derivatives up to order ``k``
+    at reference points ``X`` in the node order of :func:`cell_dofs`."""
+    return basix.create_element(
         basix.ElementFamily.P,
         V.mesh.basix_cell(),
         V.ufl_element().embedded_superdegree,
         basix.LagrangeVariant.gll_warped,
     )
-    return element.tabulate(0, X)[0, :, :, 0]
 
 
-def _cell_dofs(V: dolfinx.fem.FunctionSpace, cells: npt.NDArray[np.int32]) -> np.ndarray:
+def _basis(V: dolfinx.fem.FunctionSpace, X: npt.NDArray[np.float64]) -> np.ndarray:
+    """The Lagrange basis of ``V``'s element at reference points ``X``, ``(n, nnodes)``."""
+    return lagrange_element(V).tabulate(0, X)[0, :, :, 0]
+
+
+def cell_dofs(V: dolfinx.fem.FunctionSpace, cells: npt.NDArray[np.int32]) -> np.ndarray:
     """Indices into the array of a Function on ``V`` (or on its parent, for a view
     ``W.sub(i)``: unblocked dofs of ``W``, node by node) of the dofs of each cell,
     shape ``(len(cells), nnodes, value_size)``."""
@@ -48,7 +54,7 @@ def evaluate_reference(
         Values of shape ``(m, value_size)``.
     """
     V = u.function_space
-    values = u.x.array[_cell_dofs(V, cells)]  # (m, nnodes, value_size)
+    values = u.x.array[cell_dofs(V, cells)]  # (m, nnodes, value_size)
     basis = _basis(V, X)  # (m, nnodes)
     return np.einsum("pi,pic->pc", basis, values)
 
@@ -60,7 +66,7 @@ def evaluate_lattice(
     every one of ``cells`` (the basis tabulated once), shape ``(len(cells) * k,
     value_size)``, cell by cell. ``u`` as for :func:`evaluate_reference`. Local."""
     V = u.function_space
-    basis, dofs = _basis(V, X), _cell_dofs(V, cells)  # (k, nnodes), (n, nnodes, bs)
+    basis, dofs = _basis(V, X), cell_dofs(V, cells)  # (k, nnodes), (n, nnodes, bs)
     values = np.einsum("ki,cis->cks", basis, u.x.array[dofs])
     return values.reshape(-1, values.shape[-1])
 
@@ -92,7 +98,7 @@ class FieldSampler:
         """Values of field ``field`` of ``w`` (a Function on ``W``), ``(m, value_size)``."""
         if field not in self._fields:
             V = self.W.sub(field)
-            basis, dofs = _basis(V, self.X), _cell_dofs(V, self.cells)
+            basis, dofs = _basis(V, self.X), cell_dofs(V, self.cells)
             self._fields[field] = (basis, dofs)
         basis, dofs = self._fields[field]
         return np.einsum("pi,pic->pc", basis, w.x.array[dofs])

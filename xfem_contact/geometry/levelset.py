@@ -118,6 +118,15 @@ class CellMaps:
         self._phi = levelset.function.x.array[space.dofmap.list]
         self._exact = levelset.exact
 
+    @property
+    def coordinate_element(self) -> basix.finite_element.FiniteElement:
+        """The scalar Basix element of the cell maps (the mesh's coordinate element)."""
+        return self._cmap
+
+    def cell_nodes(self, cells: npt.NDArray[np.int32]) -> npt.NDArray[np.float64]:
+        """Geometry nodes of cells, shape ``(len(cells), ndofs, gdim)`` (m)."""
+        return self._geom[cells]
+
     def nodal_values(self, cells: npt.NDArray[np.int32]) -> npt.NDArray[np.float64]:
         """Level-set nodal values in basix order, shape ``(len(cells), ndofs)``."""
         return self._phi[cells]

@@ -2,8 +2,9 @@
 
 :class:`SmallStrain`: linear elasticity per side, ``sum_s int_s sigma_s(u_s) :
 eps(v_s)``, plus the ghost penalty that keeps the operator well conditioned under
-tiny cuts. A new bulk model (e.g. large rotations) provides the same ``form``.
-SI units (Pa, m).
+tiny cuts. :class:`SaintVenantKirchhoff`: the same moduli on the Green-Lagrange
+strain, for large rotations with small strains (``kinematics="large"``); a new bulk
+model provides the same ``form``. SI units (Pa, m).
 """
 
 from __future__ import annotations
@@ -90,6 +91,31 @@ class SmallStrain:
                 )
                 du, dv = ufl.grad(du), ufl.grad(dv)
         return sum(terms[1:], terms[0])
+
+
+class SaintVenantKirchhoff(SmallStrain):
+    """Large rotations, small strains: ``sum_s int_s P_s(u_s) : grad v_s`` with the
+    Saint Venant-Kirchhoff stress
+    (:func:`~xfem_contact.mechanics.materials.saint_venant_kirchhoff`;
+    objective: a rigid rotation of any angle carries no stress), plus the ghost
+    penalty of :class:`SmallStrain` (it jumps gradients, which a rigid rotation keeps
+    continuous). Same arguments as :class:`SmallStrain`; :meth:`form` takes the
+    unknown ``u`` as a coefficient (the residual), never a trial function."""
+
+    def form(self, u: Fields, v: Fields) -> ufl.Form:
+        """The residual's bulk terms (UFL, linear in the test functions ``v``)."""
+        a = sum(
+            ufl.inner(self.materials[s].piola(u[i]), ufl.grad(v[i])) * self.cut.dx(s)
+            for i, s in enumerate(SIDES)
+        )
+        if self.ghost_penalty > 0:
+            a += self._ghost_penalty(u, v)
+        return a
+
+
+#: Bulk models by kinematics
+BULK_MODELS = {"small": SmallStrain, "large": SaintVenantKirchhoff}
+KINEMATICS = tuple(BULK_MODELS)
 
 
 def ghost_penalty_facets(cut: CutMesh) -> list[tuple[int, np.ndarray]]:

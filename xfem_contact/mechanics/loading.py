@@ -16,6 +16,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from xfem_contact.fem.evaluation import cell_dofs, lagrange_element
 from xfem_contact.fem.subspaces import collapse
 
 #: A boundary part: local facet indices, or a locator ``x -> bool`` of shape (3, n) -> (n,)
@@ -48,7 +49,7 @@ class LoadFactor:
 
     def __init__(self, mesh: dolfinx.mesh.Mesh):
         self.constant = dolfinx.fem.Constant(mesh, dolfinx.default_scalar_type(1.0))
-        self._dirichlet: list[tuple[dolfinx.fem.Function, np.ndarray]] = []
+        self._dirichlet: list[tuple[dolfinx.fem.Function, Callable[[float], np.ndarray]]] = []
 
     @property
     def value(self) -> float:
@@ -58,21 +59,29 @@ class LoadFactor:
         """``t * load`` (UFL), for loads that enter a form."""
         return self.constant * load
 
-    def track(self, g: dolfinx.fem.Function) -> None:
-        """Register the values of a Dirichlet function, taken as their full (t = 1) value.
+    def track(
+        self, g: dolfinx.fem.Function, at: Callable[[float], np.ndarray] | None = None
+    ) -> None:
+        """Register a Dirichlet function: by default its values are the full (t = 1)
+        ones and ``g`` is rescaled to ``t`` times them whenever the factor is set;
+        ``at(t)`` instead gives its whole array at factor ``t`` (a prescribed motion
+        that is not proportional to ``t``, e.g. a rotation by ``t alpha``)."""
+        if at is None:
+            full = g.x.array.copy()
 
-        ``g`` is rescaled to ``t`` times those values when the factor is set.
-        """
-        self._dirichlet.append((g, g.x.array.copy()))
-        g.x.array[:] *= self.value
+            def at(t: float, full=full) -> np.ndarray:
+                return t * full
+
+        self._dirichlet.append((g, at))
+        g.x.array[:] = at(self.value)
 
     def set(self, t: float) -> None:
         """Set the factor ``t`` (finite) for the next solve."""
         if not np.isfinite(t):
             raise ValueError(f"The load factor must be finite, got {t}")
         self.constant.value = t
-        for g, full in self._dirichlet:
-            g.x.array[:] = t * full
+        for g, at in self._dirichlet:
+            g.x.array[:] = at(t)
 
 
 def load_steps(n: int) -> np.ndarray:
@@ -80,6 +89,41 @@ def load_steps(n: int) -> np.ndarray:
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
         raise ValueError(f"The number of load steps must be an integer >= 1, got {n!r}")
     return np.arange(1, n + 1) / n
+
+
+def rotated_nodes(space, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The displacement nodes of the bodies touching boundary ``facets``: the local
+    dofs of ``W`` (one row per node, ``(k, 2)``) and the nodes' reference positions
+    (m), ``(k, 2)``, over the local cells (owned and ghost) of each side whose cells
+    hold those facets, in the same regions (the inclusion, for side -1). Collective."""
+    cut = space.cut
+    mesh, tdim = cut.mesh, cut.mesh.topology.dim
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    touching = np.unique(np.concatenate([f2c.links(f) for f in facets] or [[]])).astype(np.int32)
+    side = cut.side_indicator()
+    sides = np.rint(side.x.array[side.function_space.dofmap.list[:, 0]]).astype(np.int64)
+    regions = cut.cell_regions()
+    region = np.rint(regions.x.array[regions.function_space.dofmap.list[:, 0]]).astype(np.int64)
+    comm = mesh.comm
+    dofs, nodes = [np.zeros((0, 2), dtype=np.int32)], [np.zeros((0, 2))]
+    for field, s in ((0, -1), (1, 1)):
+        here = touching[(sides[touching] == s) | (sides[touching] == 0)]
+        held = np.unique(np.concatenate(comm.allgather(region[here] if s == -1 else here[:0])))
+        if comm.allreduce(here.size, op=MPI.SUM) == 0:
+            continue
+        body = (sides == s) | (sides == 0)
+        if s == -1:
+            body &= np.isin(region, held)
+        cells = np.flatnonzero(body).astype(np.int32)
+        V = space.W.sub(field)
+        points = lagrange_element(V).points
+        X = cut.maps.push_forward_lattice(cells, points)[:, :2]
+        d = cell_dofs(V, cells).reshape(-1, 2)
+        d, first = np.unique(d, axis=0, return_index=True)
+        dofs.append(d)
+        nodes.append(X[first])
+    return np.concatenate(dofs), np.concatenate(nodes)
 
 
 #: A load: a number, a UFL expression, or a callable of the UFL coordinate ``x``
@@ -105,6 +149,10 @@ class Loads:
         self._x = ufl.SpatialCoordinate(mesh)
         #: Scales every load and prescribed displacement
         self.load_factor = LoadFactor(mesh)
+        #: Rotation conditions: ((dofs (k, 2), reference nodes (k, 2)), angle, centre)
+        self._rotations: list = []
+        #: Tangential springs: (facets, stiffness in Pa/m)
+        self._springs: list[tuple[np.ndarray, float]] = []
         #: Incremented by every load or Dirichlet condition added (solvers built for an
         #: older revision are rebuilt)
         self.loads_revision = 0
@@ -140,6 +188,70 @@ class Loads:
             dofs = dolfinx.fem.locate_dofs_topological((sub, V), fdim, facets)
             self._bcs.append(dolfinx.fem.dirichletbc(g, dofs, sub))
             self.loads_revision += 1
+
+    def add_rotation(self, part: Facets, angle: float, centre=(0.0, 0.0)) -> None:
+        """Rotate a boundary part rigidly: ``u = (Q(t angle) - I)(X - c)`` on both sides'
+        fields, ``Q`` the rotation by ``t angle`` (rad, counter-clockwise), ``c`` the
+        centre (m), ``t`` the load factor (the angle is ramped, not the displacement:
+        each load step is an exact rotation)."""
+        if not np.isfinite(angle):
+            raise ValueError(f"The rotation angle must be finite, got {angle}")
+        fdim = self.mesh.topology.dim - 1
+        facets = self.facets(part)
+        centre = np.asarray(centre, dtype=float)[:2]
+        for field in (0, 1):
+            sub = self.space.W.sub(field)
+            V, _ = collapse(sub)
+            g = dolfinx.fem.Function(V)
+            arm = V.tabulate_dof_coordinates()[:, :2] - centre  # (nodes, 2)
+
+            def at(t: float, arm=arm) -> np.ndarray:
+                c, s = np.cos(t * angle), np.sin(t * angle)
+                return np.column_stack(
+                    [(c - 1) * arm[:, 0] - s * arm[:, 1], s * arm[:, 0] + (c - 1) * arm[:, 1]]
+                ).ravel()
+
+            self.load_factor.track(g, at)
+            dofs = dolfinx.fem.locate_dofs_topological((sub, V), fdim, facets)
+            self._bcs.append(dolfinx.fem.dirichletbc(g, dofs, sub))
+            self.loads_revision += 1
+        self._rotations.append((rotated_nodes(self.space, facets), angle, centre))
+
+    def rotate_bodies(self, w: dolfinx.fem.Function, t_from: float, t_to: float) -> None:
+        """Predictor of a load step: rotate the deformed configuration of each body a
+        rotation condition drives by its angle times ``t_to - t_from`` (exact for a
+        rigidly turning body, and objective laws keep its stresses). Collective."""
+        for (dofs, X), angle, centre in self._rotations:
+            delta = (t_to - t_from) * angle
+            if delta == 0.0:
+                continue
+            Q = np.array([[np.cos(delta), -np.sin(delta)], [np.sin(delta), np.cos(delta)]])
+            x = X + w.x.array[dofs]
+            w.x.array[dofs] = (x - centre) @ Q.T + centre - X
+        w.x.scatter_forward()
+
+    def add_tangential_spring(self, part: Facets, stiffness: float) -> None:
+        """Hold the tangential displacement of a boundary part at zero by a stiff
+        spring, ``int k (u . t)(v . t) ds`` on both sides' fields (``t`` the boundary's
+        tangent, ``k`` in Pa/m): ``u_t = 0`` along a curved boundary (e.g. to stop a
+        ring from spinning while its radial motion stays free). Not scaled by the load
+        factor (it is a support, not a load)."""
+        if not stiffness > 0.0:
+            raise ValueError(f"The spring stiffness must be > 0 Pa/m, got {stiffness}")
+        self._springs.append((self.facets(part), float(stiffness)))
+        self.loads_revision += 1
+
+    def spring_terms(self, u, v):
+        """The springs' terms of the residual (UFL, bilinear in ``u``, ``v``: split
+        unknowns and tests of both sides), or None."""
+        n = ufl.FacetNormal(self.mesh)
+        t = ufl.as_vector([-n[1], n[0]])
+        terms = [
+            k * ufl.dot(u[i], t) * ufl.dot(v[i], t) * self.space.cut.ds(side, facets)
+            for facets, k in self._springs
+            for i, side in enumerate((-1, 1))
+        ]
+        return sum(terms[1:], terms[0]) if terms else None
 
     def add_point_displacement(self, point, value: float, component: int) -> None:
         """Fix one displacement component at a mesh node (e.g. to remove rigid modes)."""

@@ -1,4 +1,5 @@
-"""Linear elastic materials (SI units: Pa, m)."""
+"""Elastic materials (SI units: Pa, m): linear elasticity, and Saint Venant-Kirchhoff
+for large rotations with small strains (the same moduli on the Green-Lagrange strain)."""
 
 from __future__ import annotations
 
@@ -50,6 +51,23 @@ class Material:
         eps = ufl.sym(ufl.grad(u))
         return 2.0 * self.mu * eps + self.lmbda * ufl.tr(eps) * ufl.Identity(len(u))
 
+    def piola(self, u) -> ufl.core.expr.Expr:
+        """First Piola-Kirchhoff stress (Pa) of ``u`` (m), Saint Venant-Kirchhoff
+        (:func:`saint_venant_kirchhoff`)."""
+        return saint_venant_kirchhoff(self.mu, self.lmbda, u)
+
+
+def saint_venant_kirchhoff(mu, lmbda, u) -> ufl.core.expr.Expr:
+    """``P = F S``, ``S = 2 mu E + lmbda tr(E) I``, ``E = (F^T F - I) / 2``,
+    ``F = I + grad u`` (Pa; ``mu``, ``lmbda`` numbers or DG0 Functions, Pa): objective,
+    so a rigid rotation gives ``P = 0``; equal to the linear law to first order in
+    ``grad u``."""
+    d = len(u)
+    identity = ufl.Identity(d)
+    F = identity + ufl.grad(u)
+    E = 0.5 * (F.T * F - identity)
+    return F * (2.0 * mu * E + lmbda * ufl.tr(E) * identity)
+
 
 class MaterialField:
     """A side whose material changes from region to region (cellwise constant).
@@ -75,3 +93,7 @@ class MaterialField:
         """Cauchy stress (Pa) of displacement ``u`` (m), small strain."""
         eps = ufl.sym(ufl.grad(u))
         return 2.0 * self.mu * eps + self.lmbda * ufl.tr(eps) * ufl.Identity(len(u))
+
+    def piola(self, u) -> ufl.core.expr.Expr:
+        """First Piola-Kirchhoff stress (Pa), Saint Venant-Kirchhoff, as :meth:`Material.piola`."""
+        return saint_venant_kirchhoff(self.mu, self.lmbda, u)

@@ -25,9 +25,9 @@ from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.evaluation import interface_points
 from xfem_contact.fem.forms import form
 from xfem_contact.fem.restriction import restriction_matrix
-from xfem_contact.mechanics.bulk import SmallStrain, cell_size, check_ghosts
+from xfem_contact.mechanics.bulk import BULK_MODELS, KINEMATICS, cell_size, check_ghosts
 from xfem_contact.mechanics.composition import Materials, interface_laws, side_and_law_materials
-from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw
+from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw, large_sliding
 from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loading import Loads
 from xfem_contact.mechanics.rigid_modes import free_bodies
@@ -67,6 +67,13 @@ class Problem(Loads):
         min_support_fraction: See :class:`EnrichedSpace`. Default: keep every dof
             when the ghost penalty is on (it defines the field's extension over empty
             supports), else drop dofs with no support on their side.
+        kinematics: ``"small"`` (linear elasticity, small sliding) or ``"large"``
+            (Saint Venant-Kirchhoff bulk, and contact laws in large sliding: the
+            slave/master hybrid element of :mod:`xfem_contact.mechanics.sliding`,
+            slave side ``slave``, paired at every Newton iterate or once per step as
+            ``pairing`` says).
+        slave, pairing: See :class:`~xfem_contact.mechanics.laws.sliding.SlidingFrictionless`
+            (``kinematics="large"`` only).
 
     Collective.
     """
@@ -80,9 +87,17 @@ class Problem(Loads):
         *,
         ghost_penalty: float = 0.01,
         min_support_fraction: float | None = None,
+        kinematics: str = "small",
+        slave: int = -1,
+        pairing: str = "iterate",
     ):
+        if kinematics not in KINEMATICS:
+            raise ValueError(f"Unknown kinematics {kinematics!r}; valid: {KINEMATICS}")
         self.cut, self.mesh = cut, cut.mesh
+        self.kinematics = kinematics
         self.laws = interface_laws(cut, interfaces)
+        if kinematics == "large":
+            self.laws = {n: large_sliding(law, slave, pairing) for n, law in self.laws.items()}
         side_materials, law_materials = side_and_law_materials(cut, materials)
         if min_support_fraction is None:
             min_support_fraction = 0.0 if ghost_penalty > 0 else 1e-12
@@ -98,7 +113,8 @@ class Problem(Loads):
         super().__init__(self.mesh, self.space)
         self.cell_size = cell_size(self.mesh)
         self.side_indicator = cut.side_indicator()
-        self.bulk = SmallStrain(cut, side_materials, degree, self.cell_size, ghost_penalty)
+        bulk = BULK_MODELS[kinematics]
+        self.bulk = bulk(cut, side_materials, degree, self.cell_size, ghost_penalty)
         self.materials = side_materials
         self.w = dolfinx.fem.Function(self.space.W, name="w")
         #: The last accepted load step (its jump is the origin of incremental slips)
@@ -111,12 +127,14 @@ class Problem(Loads):
         self._newton_key = None
         self._checked_loads: int | None = None
         self._cut_revision = cut.revision
-        for name, law in self.laws.items():
-            if law.coupling(self.contexts[name]) is not None:
-                raise NotImplementedError(
-                    f"Interface {name!r}: the {law.name!r} law couples two cells, and the "
-                    "Newton solver does not assemble such couplings yet"
-                )
+        #: Load factor of the rotations that the bodies of ``w`` have turned by
+        self._rotated_at = 0.0
+        #: Terms of laws coupling two cells (large sliding), assembled outside UFL
+        self.couplings = {
+            name: c
+            for name, law in self.laws.items()
+            if (c := law.coupling(self.contexts[name])) is not None
+        }
 
     def _context(self, name: str, materials: dict, field: int | None) -> InterfaceContext:
         cut = self.cut
@@ -160,8 +178,9 @@ class Problem(Loads):
 
     @property
     def linear(self) -> bool:
-        """Whether every law is linear (one KSP solve instead of Newton)."""
-        return all(law.linear for law in self.laws.values())
+        """Whether the problem is linear (small kinematics and linear laws: one KSP
+        solve instead of Newton)."""
+        return self.kinematics == "small" and all(law.linear for law in self.laws.values())
 
     def law(self, name: str | None = None) -> InterfaceLaw:
         """The law of interface ``name`` (of the only interface for ``None``)."""
@@ -177,8 +196,9 @@ class Problem(Loads):
         return name
 
     # -- forms -----------------------------------------------------------------------
-    def _interface_terms(self, u, v) -> list:
-        terms = []
+    def _law_and_spring_terms(self, u, v) -> list:
+        springs = self.spring_terms(u, v)
+        terms = [] if springs is None else [springs]
         for name, law in self.laws.items():
             ctx = self.contexts[name]
             term = law.residual(ctx, ctx.fields(u), ctx.fields(v))
@@ -191,12 +211,12 @@ class Problem(Loads):
         if not self.linear:
             raise ValueError("A problem with a contact law has a residual, not a bilinear form")
         u, v = self.space.trial(), self.space.test()
-        return sum(self._interface_terms(u, v), self.bulk.form(u, v))
+        return sum(self._law_and_spring_terms(u, v), self.bulk.form(u, v))
 
     def residual(self) -> ufl.Form:
         """The residual ``F(w; v)`` (UFL, linear in the test functions)."""
         u, v = ufl.split(self.w), self.space.test()
-        F = sum(self._interface_terms(u, v), self.bulk.form(u, v))
+        F = sum(self._law_and_spring_terms(u, v), self.bulk.form(u, v))
         if self._rhs:
             F -= sum(self._rhs[1:], self._rhs[0])
         return F
@@ -265,12 +285,18 @@ class Problem(Loads):
                 log=log,
                 splits=field_splits(self.space) if split else None,
                 near_nullspace=rigid_modes(self.space) if split else None,
+                couplings=list(self.couplings.values()),
             )
             self._newton_key = key
         self._newton.log = log
         accepted = self.w.x.array.copy()
+        t = self.load_factor.value
+        if self.kinematics == "large":  # turn rotated bodies rigidly first (predictor)
+            self.rotate_bodies(self.w, self._rotated_at, t)
         try:
-            return self._newton.solve()
+            report = self._newton.solve()
+            self._rotated_at = t
+            return report
         except NewtonFailure as failure:
             self.w.x.array[:] = accepted  # the state before this solve, not the diverged one
             raise NewtonFailure(
@@ -314,6 +340,14 @@ class Problem(Loads):
         (Coulomb) measure the slip of the next step from it."""
         self.w.x.scatter_forward()
         self.w_old.x.array[:] = self.w.x.array
+        for coupling in self.couplings.values():
+            coupling.accept(self.w)
+
+    def pairing_counts(self) -> dict[str, dict[str, int]]:
+        """Per large-sliding interface, the slave points paired and unpaired and the
+        pairs whose master cell changed since the last accepted step, at the last
+        evaluation (global counts; empty in small sliding)."""
+        return {name: dict(c.counts) for name, c in self.couplings.items()}
 
     # -- interface state -------------------------------------------------------------
     def interface_state(

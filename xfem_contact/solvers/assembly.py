@@ -143,6 +143,8 @@ class ReducedMatrix:
         chosen = selection(R, a.function_spaces[0])
         #: Whether the form is assembled straight into the reduced numbering
         self.direct = chosen is not None
+        #: The reduced column of every dof (:class:`Selection`; None for ``PtAP``)
+        self.selection = chosen
         self._full = None if self.direct else dolfinx.fem.petsc.create_matrix(a)
         self.mat: PETSc.Mat | None = reduced_matrix(a, chosen) if self.direct else None
 

@@ -11,7 +11,6 @@ with the whole history. Default options: :mod:`xfem_contact.solvers.options`.
 
 from __future__ import annotations
 
-import dataclasses
 import time
 import weakref
 from collections.abc import Callable
@@ -26,62 +25,8 @@ from petsc4py import PETSc
 from xfem_contact.fem.forms import form
 from xfem_contact.solvers.assembly import ReducedMatrix
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
+from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
-
-
-@dataclasses.dataclass
-class NewtonReport:
-    """History of one solve: residual norms and per-iterate status lines.
-
-    Attributes:
-        residuals: Norm of the scaled reduced residual ``D R^T F`` at each iterate,
-            the initial one first (``iterations + 1`` entries).
-        status: The status callback's dict at each iterate (same length).
-        reason: SNES converged reason (> 0 converged, < 0 diverged).
-        final_residual: The residual norm evaluated after the solve (checked
-            against the tolerances; NaN before).
-    """
-
-    residuals: list[float] = dataclasses.field(default_factory=list)
-    status: list[dict] = dataclasses.field(default_factory=list)
-    #: Krylov iterations of the linear solve of each Newton step (1 per step for LU)
-    linear_iterations: list[int] = dataclasses.field(default_factory=list)
-    reason: int = 0
-    final_residual: float = float("nan")
-    #: Wall time (s) of residual/Jacobian assembly, of the status callback and of
-    #: the whole solve
-    assembly_time: float = 0.0
-    status_time: float = 0.0
-    total_time: float = 0.0
-
-    @property
-    def linear_solve_time(self) -> float:
-        """Wall time (s) of the rest: the factorisations and triangular solves."""
-        return self.total_time - self.assembly_time - self.status_time
-
-    @property
-    def iterations(self) -> int:
-        """Number of Newton steps taken."""
-        return max(len(self.residuals) - 1, 0)
-
-    def table(self) -> str:
-        """The history, one line per iterate. Not collective."""
-        lines = []
-        for k, r in enumerate(self.residuals):
-            extra = self.status[k] if k < len(self.status) else {}
-            lines.append(
-                f"  iterate {k:2d}  |F| = {r:.3e}  "
-                + "  ".join(f"{key} {value}" for key, value in extra.items())
-            )
-        return "\n".join(lines)
-
-
-class NewtonFailure(RuntimeError):
-    """Newton did not converge; ``report`` holds the iteration history."""
-
-    def __init__(self, message: str, report: NewtonReport):
-        super().__init__(f"{message}\n{report.table()}")
-        self.report = report
 
 
 class RestrictedNewton:
@@ -119,6 +64,12 @@ class RestrictedNewton:
             algebraic multigrid needs for elasticity). Ignored by other preconditioners.
         near_nullspace: Functions on ``W`` (e.g. rigid modes) given, reduced and
             orthonormalised, as the near null space of the split named ``"u"``.
+        couplings: Terms assembled outside UFL (e.g. the large-sliding hybrid
+            elements of :class:`~xfem_contact.mechanics.sliding.coupling.SlidingCoupling`):
+            objects with ``bind(columns, bcs)``, ``begin_step(w)``,
+            ``add_residual(w, b)`` (into the residual of ``W``, global numbering) and
+            ``add_jacobian(w, J)`` (into the unscaled reduced Jacobian). They need a
+            selecting ``R`` (no multiplier prolongation).
     """
 
     def __init__(
@@ -133,8 +84,10 @@ class RestrictedNewton:
         log: Callable[[str], None] | None = None,
         splits: dict[str, np.ndarray] | None = None,
         near_nullspace: list[dolfinx.fem.Function] | None = None,
+        couplings: list | None = None,
     ):
         self.w, self.bcs, self.R = w, bcs, R
+        self.couplings = list(couplings or [])
         start = time.perf_counter()
         self.F = form(residual)
         self.J = form(ufl.derivative(residual, w, ufl.TrialFunction(w.function_space)))
@@ -148,6 +101,13 @@ class RestrictedNewton:
         start = time.perf_counter()
         self.jacobian = ReducedMatrix(self.J, bcs, R)
         self.timings["sparsity"] = time.perf_counter() - start
+        if self.couplings and not self.jacobian.direct:
+            raise ValueError(
+                "Couplings assembled outside UFL (large sliding) need a restriction that "
+                "selects dofs: no multiplier prolongation (lbb = 'restriction')"
+            )
+        for coupling in self.couplings:
+            coupling.bind(self.jacobian.selection.columns, bcs)
         # Solve for y_s with x = R D y_s, D the scaling of the first Jacobian (well
         # scaled saddle points: see xfem_contact.solvers.scaling); J_r = D R^T J R D
         start = time.perf_counter()
@@ -160,7 +120,7 @@ class RestrictedNewton:
         self.R = R.copy()
         self.R.diagonalScale(None, self.D)
         # The first Newton iterate usually sits where this Jacobian was assembled
-        self._assembled_at: np.ndarray | None = w.x.array.copy()
+        self._assembled_at = None if self.couplings else w.x.array.copy()
         self.snes = PETSc.SNES().create(R.getComm())
         # Options live in the PETSc database only while PETSc may read them (here and
         # during each solve, when the factorisation reads e.g. mat_mumps_* options)
@@ -243,6 +203,8 @@ class RestrictedNewton:
         dolfinx.fem.petsc.assemble_vector(self.b, self.F)
         dolfinx.fem.petsc.apply_lifting(self.b, [self.J], bcs=[self.bcs], x0=[x], alpha=-1.0)
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        for coupling in self.couplings:
+            coupling.add_residual(self.w, self.b)
         dolfinx.fem.petsc.set_bc(self.b, self.bcs, x, -1.0)
         self.R.multTranspose(self.b, F_r)
         self.report.assembly_time += time.perf_counter() - start
@@ -253,8 +215,20 @@ class RestrictedNewton:
         x, at, self._assembled_at = self.w.x.array, self._assembled_at, None
         if at is None or not _same_state(x, at, self.R.getComm().tompi4py()):
             self.jacobian.assemble()  # into J_r, the same matrix
+            if self.couplings:
+                self._add_couplings(J_r)
             J_r.diagonalScale(self.D, self.D)
         self.report.assembly_time += time.perf_counter() - start
+
+    def _add_couplings(self, J_r) -> None:
+        """Add the couplings' Jacobians. A coupling that grows the pattern replaces
+        the matrix's storage (PETSc's merge), which the preconditioner does not see as
+        a new pattern: its factorisation is then reset. Collective."""
+        size = J_r.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_allocated"]
+        for coupling in self.couplings:
+            coupling.add_jacobian(self.w, J_r)
+        if J_r.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_allocated"] != size:
+            self.snes.getKSP().getPC().reset()
 
     def _monitor(self, snes, it, norm):
         start = time.perf_counter()
@@ -307,6 +281,8 @@ class RestrictedNewton:
         self.report = NewtonReport()
         start = time.perf_counter()
         self._start_from_w()
+        for coupling in self.couplings:
+            coupling.begin_step(self.w)
         with applied_options(self._prefix, self._options):
             self.snes.solve(None, self.y)
         self.report.total_time = time.perf_counter() - start
@@ -336,6 +312,8 @@ class RestrictedNewton:
         """Destroy the PETSc objects made here (the scaled copy of ``R`` included, not
         the ``R`` given). Collective."""
         self.jacobian.destroy()  # J_r included
+        for coupling in self.couplings:
+            coupling.destroy()
         for obj in (self.snes, self.b, self.y, self.F_r, self.R, self.D, *self._split_objects):
             obj.destroy()
         if self._projection is not None:

@@ -4,7 +4,9 @@ Each law declares the multiplier field it needs, contributes its residual terms 
 evaluates its state at the interface rule points from the same definitions (see
 :mod:`xfem_contact.mechanics.laws.base`). Small-sliding laws: ``free`` and ``bonded``
 (linear, :mod:`~xfem_contact.mechanics.laws.bonding`), ``frictionless``, ``coulomb``
-and ``sticking`` (augmented Lagrangian, :mod:`~xfem_contact.mechanics.laws.contact`).
+and ``sticking`` (augmented Lagrangian, :mod:`~xfem_contact.mechanics.laws.contact`);
+in large sliding :func:`large_sliding` gives their hybrid-element versions
+(:mod:`~xfem_contact.mechanics.laws.sliding`).
 A new law subclasses :class:`InterfaceLaw` (or :class:`MultiplierLaw`) and is listed
 in :data:`LAWS`.
 """
@@ -13,6 +15,7 @@ from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, Interface
 from xfem_contact.mechanics.laws.bonding import Bonded, Free
 from xfem_contact.mechanics.laws.contact import ContactLaw, Coulomb, Frictionless, Sticking
 from xfem_contact.mechanics.laws.multiplier import LBB_OPTIONS, MultiplierLaw
+from xfem_contact.mechanics.laws.sliding import SLIDING_LAWS, SlidingFrictionless, large_sliding
 
 #: The laws by name
 LAWS: dict[str, type[InterfaceLaw]] = {
@@ -66,6 +69,9 @@ __all__ = [
     "InterfaceContext",
     "InterfaceLaw",
     "MultiplierLaw",
+    "SLIDING_LAWS",
+    "SlidingFrictionless",
+    "large_sliding",
     "Sticking",
     "make_law",
 ]

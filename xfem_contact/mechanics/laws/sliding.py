@@ -1,0 +1,157 @@
+"""Contact laws in large sliding: the slave/master hybrid element of the paper.
+
+In large sliding the two lips of an interface no longer face each other at the same
+reference point, so the gap is not the jump ``[u] . n``: every slave point is paired
+with its closest point on the deformed master lip and the contact terms couple the
+slave cell with the master cell (:mod:`xfem_contact.mechanics.sliding`), assembled
+outside UFL (:meth:`SlidingFrictionless.coupling`). What stays in UFL is local to the
+slave side: the multiplier's normal-gradient extension and its LBB stabilisation,
+here against the slave side's own normal traction in the deformed configuration,
+``lambda_n - (P N) . n~`` (``P`` the first Piola-Kirchhoff stress, ``N`` the slave's
+outward reference normal, ``n~`` the deformed one, ``cof(F) N / |cof(F) N|``): the
+multiplier is the contact pressure per unit reference length (Pa, compression
+negative), objective under rigid rotations. SI units.
+"""
+
+from __future__ import annotations
+
+import dolfinx.fem
+import numpy as np
+import ufl
+from ufl.algorithms import extract_arguments, extract_coefficients
+
+from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw
+from xfem_contact.mechanics.laws.contact import Frictionless
+from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES, SlidingCoupling
+
+#: The laws available in large sliding (by their small-sliding name)
+SLIDING_LAWS = ("frictionless",)
+#: LBB treatments available in large sliding (the restriction needs a prolongation
+#: the hybrid element's assembly does not apply)
+SLIDING_LBB = ("stabilized", "none")
+
+
+class SlidingFrictionless(Frictionless):
+    """Frictionless contact in large sliding (augmented Lagrangian, normal multiplier
+    on the slave side).
+
+    Args:
+        slave: The slave side (-1 or +1); the master is the other one.
+        pairing: ``"iterate"`` (pair at every Newton iterate) or ``"step"`` (pair at
+            the start of each load step).
+        radius: Search radius of the pairing (m); default the largest cut-cell size.
+        augmentation, lbb, multiplier_stabilization, multiplier_extension: As for
+            :class:`~xfem_contact.mechanics.laws.contact.Frictionless` (``lbb``:
+            ``"stabilized"`` or ``"none"``).
+    """
+
+    #: Large sliding
+    sliding = True
+
+    def __init__(self, slave: int = -1, pairing: str = "iterate", radius=None, **options):
+        super().__init__(**options)
+        if self.lbb not in SLIDING_LBB:
+            raise ValueError(
+                f"lbb {self.lbb!r} is not available in large sliding; valid: {SLIDING_LBB}"
+            )
+        if slave not in (-1, 1):
+            raise ValueError(f"slave must be the side -1 or +1, got {slave!r}")
+        if pairing not in PAIRING_UPDATES:
+            raise ValueError(f"pairing must be one of {PAIRING_UPDATES}, got {pairing!r}")
+        self.slave, self.pairing, self.radius = slave, pairing, radius
+
+    def describe(self) -> dict:
+        return super().describe() | {
+            "kinematics": "large",
+            "slave": self.slave,
+            "pairing": self.pairing,
+        }
+
+    def coupling(self, ctx: InterfaceContext) -> SlidingCoupling:
+        """The interface's :class:`~xfem_contact.mechanics.sliding.coupling.SlidingCoupling`
+        (made once per context; collective then)."""
+        if "coupling" not in ctx._cache:
+            W = ctx.w_old.function_space
+            ctx._cache["coupling"] = SlidingCoupling(
+                ctx, W, self, self.slave, self.radius, self.pairing
+            )
+        return ctx._cache["coupling"]
+
+    # -- the UFL part: slave side only -------------------------------------------------
+    def slave_normal_traction(self, ctx: InterfaceContext, u: Fields):
+        """``(P N) . n~`` of the slave side (Pa per unit reference length), UFL."""
+        u_s = u.minus if self.slave == -1 else u.plus
+        N = ctx.normal if self.slave == -1 else -ctx.normal
+        F = ufl.Identity(len(u_s)) + ufl.grad(u_s)
+        deformed = ufl.det(F) * ufl.inv(F).T * N
+        P = ctx.materials[self.slave].piola(u_s)
+        return ufl.dot(P * N, deformed) / ufl.sqrt(ufl.dot(deformed, deformed))
+
+    def residual(self, ctx: InterfaceContext, u: Fields, v: Fields):
+        terms = []
+        if self.multiplier_extension > 0:
+            terms.append(-self.extension_form(ctx, u.multiplier, v.multiplier))
+        if self.multiplier_stabilization > 0:
+            (w,) = extract_coefficients(u.multiplier)
+            (test,) = extract_arguments(v.multiplier)
+            scale = (
+                self.multiplier_stabilization * ctx.cell_size / (2.0 * ctx.materials[self.slave].mu)
+            )
+            misfit = u.multiplier - self.slave_normal_traction(ctx, u)
+            energy = 0.5 * scale * misfit**2 * ctx.measure
+            terms.append(-ufl.derivative(energy, w, test))
+        return sum(terms[1:], terms[0]) if terms else None
+
+    # -- the state at the slave points -------------------------------------------------
+    def state(self, ctx: InterfaceContext, w: dolfinx.fem.Function) -> dict[str, np.ndarray]:
+        """As :meth:`ContactLaw.state`, from the pairing at ``w``: the gap to the
+        master foot (unpaired points: the distance to the lip, beyond the search
+        radius), ``paired`` (1.0 or 0.0); tangential entries zero. Collective."""
+        pairing, terms = self.coupling(ctx).evaluate(w)
+        zero = np.zeros(pairing.piece.size)
+        gap = np.where(pairing.paired, terms.gap, pairing.distance)
+        return {
+            "gap": gap,
+            "slip": zero,
+            "slip_increment": zero,
+            "lambda_n": terms.lambda_n,
+            "lambda_t": zero,
+            "P_n": terms.P_n,
+            "P_t": zero,
+            "r": self.coupling(ctx).r,
+            "trial_t": zero,
+            "paired": pairing.paired.astype(float),
+        }
+
+    def status(self, state: dict[str, np.ndarray]) -> dict[str, int]:
+        counts = super().status(state)
+        return counts | {"unpaired": int(np.sum(state["paired"] == 0.0))}
+
+
+def large_sliding(law: InterfaceLaw, slave: int = -1, pairing: str = "iterate") -> InterfaceLaw:
+    """The large-sliding version of a law: contact laws become their hybrid-element
+    counterparts; ``free`` and ``bonded`` (no relative motion or none resisted) stay.
+
+    Raises:
+        ValueError: for a contact law without a large-sliding version, naming the
+            valid ones, or an LBB treatment large sliding does not offer.
+    """
+    if getattr(law, "sliding", False) or law.linear:
+        return law
+    if type(law) is not Frictionless:
+        raise ValueError(
+            f"The {law.name!r} law is not available in large sliding "
+            f"(kinematics = 'large'); valid: {SLIDING_LAWS}"
+        )
+    return SlidingFrictionless(
+        slave=slave,
+        pairing=pairing,
+        augmentation=law.augmentation,
+        lbb=law.lbb,
+        multiplier_extension=law.multiplier_extension,
+        **(
+            {"multiplier_stabilization": law.multiplier_stabilization}
+            if law.lbb == "stabilized"
+            else {}
+        ),
+    )

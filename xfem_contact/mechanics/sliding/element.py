@@ -1,0 +1,130 @@
+"""The hybrid slave/master contact element: residual and consistent Jacobian per point.
+
+Local unknowns of one pair, ``z = (a, l, b)``: the slave cell's displacement dofs ``a``
+(``2 nn``, node by node), its multiplier dofs ``l`` (``nl``) and the master cell's
+displacement dofs ``b`` (``2 nn``). With ``x_s = X_s + phi_s a`` (the slave point),
+the master curve ``x_m(s) = F(X(s)) + phi_m(s) b``, its tangent ``t = x_m'`` and unit
+normal ``n = o (-t_y, t_x) / |t|`` out of the master (``o`` the piece orientation), the
+foot ``s`` solves ``(x_s - x_m) . t = 0`` and the gap is ``g = (x_s - x_m) . n``.
+
+Kept linearisation terms: all of them. ``grad g = (S - B)^T n`` (the variations of the
+foot and of the normal drop out of it at a closest point), and its Hessian adds the
+variation of the foot ``ds = -F_z / F_s`` and of the normal through the master's
+tangent derivative ``c = B'^T n`` and curvature ``kappa = n . x_m''``:
+
+    H = -(ds c^T + c ds^T) (1 - g kappa / |t|^2) + (F_s kappa / |t|^2) ds ds^T
+        + (g / |t|^2) c c^T,    F_s = -|t|^2 + g kappa,  F_z = (S - B)^T t + g c.
+
+The frictionless augmented-Lagrangian law of
+:class:`~xfem_contact.mechanics.laws.contact.ContactLaw` then gives, with
+``lambda_n = L l``, ``P = min(0, lambda_n + r g)`` and the slave point's weight ``w``
+(reference arc length, m):
+
+    R = w (P grad g - (lambda_n - P) L / r)
+    K = w (grad g L^T + L grad g^T + r grad g grad g^T + P H)   (contact, P < 0)
+    K = -w L L^T / r                                             (no contact)
+
+Vectorised over the points (numpy). SI units: m, Pa.
+"""
+
+from __future__ import annotations
+
+import typing
+
+import numpy as np
+import numpy.typing as npt
+
+
+class PairTerms(typing.NamedTuple):
+    """Per-point residual ``(m, nz)`` and Jacobian ``(m, nz, nz)`` (N/m and N/m^2 per
+    unit thickness), and the state: gap (m), ``lambda_n`` and ``P_n`` (Pa)."""
+
+    residual: npt.NDArray[np.float64]
+    jacobian: npt.NDArray[np.float64]
+    gap: npt.NDArray[np.float64]
+    lambda_n: npt.NDArray[np.float64]
+    P_n: npt.NDArray[np.float64]
+
+
+def gap_derivatives(x_s, phi_s, curve, orientation):
+    """Gap, its gradient ``(m, nz_u)`` and Hessian ``(m, nz_u, nz_u)`` in the
+    displacement unknowns ``(a, b)`` of the pairs (the multiplier slots excluded).
+
+    Args:
+        x_s: Deformed slave points (m), ``(m, 2)``.
+        phi_s: Slave displacement basis at them, ``(m, nn_s)``.
+        curve: The :class:`~xfem_contact.mechanics.sliding.lips.CurvePoint` at the feet.
+        orientation: Piece orientation (+-1) of each foot, ``(m,)``.
+    """
+    m = x_s.shape[0]
+    t, t2 = curve.t, curve.t2
+    tt = np.sum(t * t, axis=1)
+    n = orientation[:, None] * np.column_stack([-t[:, 1], t[:, 0]]) / np.sqrt(tt)[:, None]
+    r = x_s - curve.x
+    g = np.sum(r * n, axis=1)
+    kappa = np.sum(n * t2, axis=1)
+
+    def slots(basis_a, basis_b, v):
+        """``[basis_a (x) v, basis_b (x) v]`` node by node, ``(m, 2 nn_a + 2 nn_b)``."""
+        a = (basis_a[:, :, None] * v[:, None, :]).reshape(m, -1)
+        b = (basis_b[:, :, None] * v[:, None, :]).reshape(m, -1)
+        return np.concatenate([a, b], axis=1)
+
+    zero_s = np.zeros_like(phi_s)
+    grad = slots(phi_s, -curve.phi, n)
+    c = slots(zero_s, curve.dphi, n)
+    F_s = -tt + g * kappa
+    F_z = slots(phi_s, -curve.phi, t) + g[:, None] * c
+    ds = -F_z / F_s[:, None]
+    sym = ds[:, :, None] * c[:, None, :]
+    sym = sym + np.transpose(sym, (0, 2, 1))
+    H = (
+        -(1.0 - g * kappa / tt)[:, None, None] * sym
+        + (F_s * kappa / tt)[:, None, None] * ds[:, :, None] * ds[:, None, :]
+        + (g / tt)[:, None, None] * c[:, :, None] * c[:, None, :]
+    )
+    return g, grad, H
+
+
+def frictionless_terms(
+    x_s, phi_s, lam_basis, lam_values, curve, orientation, weights, r, paired
+) -> PairTerms:
+    """The hybrid element's terms at ``m`` slave points, unknowns ordered ``(a, l, b)``.
+
+    Args:
+        x_s: Deformed slave points (m), ``(m, 2)``.
+        phi_s: Slave displacement basis, ``(m, nn)``.
+        lam_basis: Multiplier basis, ``(m, nl)``.
+        lam_values: Multiplier dof values, ``(m, nl)`` (Pa).
+        curve: The master curve at the feet (any values where unpaired).
+        orientation: Piece orientations, ``(m,)``.
+        weights: Reference arc-length weights (m), ``(m,)``.
+        r: Augmentation coefficients (Pa/m), ``(m,)``.
+        paired: Which points have a master foot, ``(m,)``; the others carry no contact.
+    """
+    m, nn = phi_s.shape
+    nl = lam_basis.shape[1]
+    g, grad_u, H_u = gap_derivatives(x_s, phi_s, curve, orientation)
+    g = np.where(paired, g, np.inf)
+    lam = np.sum(lam_basis * lam_values, axis=1)
+    trial = lam + r * np.where(paired, g, 0.0)
+    contact = paired & (trial < 0.0)
+    P = np.where(contact, trial, 0.0)
+    nz = 4 * nn + nl
+    grad = np.zeros((m, nz))
+    grad[:, : 2 * nn] = grad_u[:, : 2 * nn]
+    grad[:, 2 * nn + nl :] = grad_u[:, 2 * nn :]
+    L = np.zeros((m, nz))
+    L[:, 2 * nn : 2 * nn + nl] = lam_basis
+    residual = weights[:, None] * (P[:, None] * grad - ((lam - P) / r)[:, None] * L)
+    K = np.where(
+        contact[:, None, None],
+        np.einsum("mi,mj->mij", grad, L)
+        + np.einsum("mi,mj->mij", L, grad)
+        + r[:, None, None] * np.einsum("mi,mj->mij", grad, grad),
+        -np.einsum("mi,mj->mij", L, L) / r[:, None, None],
+    )
+    u = np.r_[0 : 2 * nn, 2 * nn + nl : nz]
+    K[:, u[:, None], u[None, :]] += np.where(contact[:, None, None], P[:, None, None] * H_u, 0.0)
+    K *= weights[:, None, None]
+    return PairTerms(residual, K, np.where(paired, g, np.nan), lam, P)

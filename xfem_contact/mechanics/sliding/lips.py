@@ -1,0 +1,170 @@
+"""The master lip of an interface, on every process: curved pieces mapped by a field.
+
+A piece is a SEG3 of a cut cell in that cell's reference coordinates
+(:class:`~xfem_contact.geometry.cut.CutGeometry`); its deformed position is
+``x(s) = F_c(X(s)) + u_m(X(s))``, ``s in [0, 1]``, with ``F_c`` the cell map and
+``u_m`` the master side's displacement. The pieces of all processes are gathered once
+(reference data, dof numbers) and their dof values at every :meth:`MasterLip.refresh`,
+so the closest-point search sees the whole lip whatever the partition (a master point
+may slide onto another process's cells during the solve). SI units (m).
+"""
+
+from __future__ import annotations
+
+import typing
+
+import numpy as np
+import numpy.typing as npt
+
+from xfem_contact.fem.evaluation import cell_dofs, lagrange_element
+from xfem_contact.geometry.cut_topology import seg3_basis
+
+#: Second derivatives of the SEG3 shape functions (a, b, mid), constant
+_SEG3_SECOND = np.array([4.0, 4.0, -8.0])
+
+
+class CurvePoint(typing.NamedTuple):
+    """The deformed master curve at parameters ``s`` of pieces, ``m`` points.
+
+    Attributes:
+        x: Position (m), ``(m, 2)``.
+        t: ``dx/ds`` (m), ``(m, 2)``.
+        t2: ``d^2x/ds^2`` (m), ``(m, 2)``.
+        phi: The master displacement basis at the point, ``(m, nnodes)``.
+        dphi: Its ``d/ds``, ``(m, nnodes)``.
+    """
+
+    x: npt.NDArray[np.float64]
+    t: npt.NDArray[np.float64]
+    t2: npt.NDArray[np.float64]
+    phi: npt.NDArray[np.float64]
+    dphi: npt.NDArray[np.float64]
+
+
+def along(element, seg: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A cell basis and its first two ``s``-derivatives along SEG3 pieces.
+
+    Args:
+        element: Scalar Basix element of the cell.
+        seg: Piece nodes (a, b, mid) in reference coordinates, ``(m, 3, 2)``.
+        s: Piece parameter of each point, ``(m,)``.
+
+    Returns:
+        ``(phi, dphi, ddphi)``, each ``(m, ndofs)``.
+    """
+    N, dN = seg3_basis(s)
+    X = np.einsum("mk,mkd->md", N, seg)
+    dX = np.einsum("mk,mkd->md", dN, seg)
+    ddX = np.einsum("k,mkd->md", _SEG3_SECOND, seg)
+    tab = element.tabulate(2, X)[..., 0]  # (6, m, ndofs): 1, x, y, xx, xy, yy
+    dphi = tab[1] * dX[:, :1] + tab[2] * dX[:, 1:]
+    ddphi = (
+        tab[3] * dX[:, :1] ** 2
+        + 2.0 * tab[4] * dX[:, :1] * dX[:, 1:]
+        + tab[5] * dX[:, 1:] ** 2
+        + tab[1] * ddX[:, :1]
+        + tab[2] * ddX[:, 1:]
+    )
+    return tab[0], dphi, ddphi
+
+
+def global_dofs(W, local: np.ndarray) -> np.ndarray:
+    """Global (unrolled) indices in ``W``'s PETSc vector of local dof indices."""
+    bs = W.dofmap.index_map_bs
+    blocks = W.dofmap.index_map.local_to_global(local.ravel() // bs)
+    return (blocks * bs + local.ravel() % bs).reshape(local.shape)
+
+
+class MasterLip:
+    """The pieces of one interface on the master side, gathered on every process.
+
+    Args:
+        cut: The cut mesh.
+        W: The problem's mixed space.
+        field: The master displacement's field (0: side -1, 1: side +1).
+        rows: Cut-cell rows whose pieces form the lip (this process's).
+        columns: Reduced column of every local dof of ``W`` (-1: not an unknown of
+            the Jacobian: inactive or Dirichlet), ``(num_local_dofs,)``.
+
+    Attributes (global, identical on all processes, rank by rank):
+        seg: Piece nodes in their cell's reference coordinates, ``(P, 3, 2)``.
+        nodes: The cell's geometry nodes (m), ``(P, ngeom, 2)``.
+        dofs: Global dofs of ``W`` of the master field on the cell, ``(P, 2 nnodes)``
+            (node by node, components inner).
+        columns: Their reduced columns (-1: none), same shape.
+        cells: Global cell index of each piece, ``(P,)``.
+        orientation: +1 or -1 per piece: ``orientation * (-t_y, t_x)`` points out
+            of the master side (into the slave side), ``(P,)``.
+
+    Construction is collective.
+    """
+
+    def __init__(self, cut, W, field: int, rows: np.ndarray, columns: np.ndarray):
+        comm = cut.mesh.comm
+        geometry = cut.geometry
+        keep = np.isin(geometry.seg_cell, rows)
+        keep &= ~np.all(geometry.seg[:, 0] == geometry.seg[:, 1], axis=1)
+        seg = geometry.seg[keep]
+        cells = cut.cut_cells[geometry.seg_cell[keep]]
+        self._W, self._field = W, field
+        V = W.sub(field)
+        self.element = lagrange_element(V)
+        self.coordinate_element = cut.maps.coordinate_element
+        local_dofs = cell_dofs(V, cells).reshape(cells.size, -1)
+        self._local_dofs = local_dofs
+        orientation = self._orientation(cut, cells, seg, field)
+        tdim = cut.mesh.topology.dim
+        global_cells = cut.mesh.topology.index_map(tdim).local_to_global(cells)
+
+        def gather(a: np.ndarray) -> np.ndarray:
+            return np.concatenate(comm.allgather(a))
+
+        self.seg = gather(seg)
+        self.nodes = gather(cut.maps.cell_nodes(cells)[:, :, :2])
+        self.dofs = gather(global_dofs(W, local_dofs))
+        self.columns = gather(columns[local_dofs])
+        self.cells = gather(global_cells)
+        self.orientation = gather(orientation)
+        self.values = np.zeros(self.dofs.shape)
+        self._comm = comm
+
+    @property
+    def size(self) -> int:
+        """Number of pieces (all processes)."""
+        return self.seg.shape[0]
+
+    @staticmethod
+    def _orientation(cut, cells, seg, field) -> np.ndarray:
+        """+1 where ``(-t_y, t_x)`` at a piece's middle points out of the master side."""
+        if cells.size == 0:
+            return np.zeros(0)
+        mid = seg[:, 2]
+        _, dN = seg3_basis(np.full(cells.size, 0.5))
+        dX = np.einsum("mk,mkd->md", dN, seg)
+        J = cut.maps.jacobian(cells, mid)[:, :2, :]
+        t = np.einsum("mdi,mi->md", J, dX)
+        left = np.column_stack([-t[:, 1], t[:, 0]])
+        grad_ref = cut.maps.grad_ref(cells, mid)[:, :, None]
+        grad = np.linalg.solve(np.transpose(J, (0, 2, 1)), grad_ref)[:, :, 0]
+        # the master side's outward normal points against grad phi for side +1
+        master_sign = 1.0 if field == 1 else -1.0
+        return np.where(np.sum(left * grad, axis=1) * master_sign < 0.0, 1.0, -1.0)
+
+    def refresh(self, w) -> None:
+        """Gather the master field's dof values of ``w`` (a Function on ``W``).
+        Collective."""
+        local = w.x.array[self._local_dofs]
+        self.values = np.concatenate(self._comm.allgather(local)).reshape(self.dofs.shape)
+
+    def curve(self, pieces: np.ndarray, s: np.ndarray) -> CurvePoint:
+        """The deformed curve of ``pieces`` ``(m,)`` at parameters ``s`` ``(m,)``
+        (for the values of the last :meth:`refresh`). Local."""
+        seg = self.seg[pieces]
+        psi, dpsi, ddpsi = along(self.coordinate_element, seg, s)
+        phi, dphi, ddphi = along(self.element, seg, s)
+        nodes = self.nodes[pieces]
+        u = self.values[pieces].reshape(pieces.size, -1, 2)
+        x = np.einsum("mi,mid->md", psi, nodes) + np.einsum("mi,mid->md", phi, u)
+        t = np.einsum("mi,mid->md", dpsi, nodes) + np.einsum("mi,mid->md", dphi, u)
+        t2 = np.einsum("mi,mid->md", ddpsi, nodes) + np.einsum("mi,mid->md", ddphi, u)
+        return CurvePoint(x, t, t2, phi, dphi)

@@ -1,0 +1,129 @@
+"""Closest points on the deformed master lip: bounding boxes, then Newton per piece.
+
+For a slave point ``x`` and a master piece ``x_m(s)``
+(:class:`~xfem_contact.mechanics.sliding.lips.MasterLip`),
+the closest point solves ``f(s) = (x - x_m(s)) . x_m'(s) = 0`` (Newton, ``f'(s) =
+-|x_m'|^2 + (x - x_m) . x_m''``). Candidates are the pieces whose deformed bounding
+box, grown by the search radius, holds the point, nearest first; the pair kept is the
+closest one whose foot lies on its piece, else the nearest piece end. Points farther
+than the search radius from every piece are unpaired. Vectorised over all points;
+local (each process pairs its own slave points against the whole lip). SI units (m).
+"""
+
+from __future__ import annotations
+
+import typing
+
+import numpy as np
+import numpy.typing as npt
+
+#: Parameters at which each deformed piece is sampled for its bounding box
+_SAMPLES = np.linspace(0.0, 1.0, 5)
+#: A foot at ``s`` in ``[-_ON_PIECE, 1 + _ON_PIECE]`` lies on its piece
+_ON_PIECE = 1e-9
+
+
+class Pairing(typing.NamedTuple):
+    """Master piece and parameter of each slave point (``piece`` -1: unpaired).
+
+    Attributes:
+        piece: Index into the lip's pieces, ``(m,)``, -1 where unpaired.
+        s: Piece parameter of the foot, ``(m,)`` (0 where unpaired).
+        distance: Distance to the foot (m), ``(m,)``; where unpaired, to the nearest
+            sample of the lip (a lower bound is all that is known: beyond the radius).
+    """
+
+    piece: npt.NDArray[np.int64]
+    s: npt.NDArray[np.float64]
+    distance: npt.NDArray[np.float64]
+
+    @property
+    def paired(self) -> npt.NDArray[np.bool_]:
+        return self.piece >= 0
+
+
+def _newton(lip, x: np.ndarray, pieces: np.ndarray, s: np.ndarray, iterations: int = 30):
+    """Newton on ``f(s) = 0`` for each (point, piece), started from ``s``; the
+    parameter is kept in ``[-0.5, 1.5]`` (the polynomial piece extended a little)."""
+    for _ in range(iterations):
+        c = lip.curve(pieces, s)
+        r = x - c.x
+        f = -np.sum(r * c.t, axis=1)
+        df = np.sum(c.t * c.t, axis=1) - np.sum(r * c.t2, axis=1)
+        step = np.where(df > 0.0, f / np.where(df > 0.0, df, 1.0), 0.0)
+        s = np.clip(s - step, -0.5, 1.5)
+        if np.all(np.abs(step) < 1e-14):
+            break
+    return s
+
+
+def _candidates(x, samples, radius, k, chunk: int = 512):
+    """The ``k`` pieces whose grown box holds each point, nearest sample first:
+    ``(order (m, k), tried (m, k) bool, nearest sample distance (m,))``."""
+    low, high = samples.min(axis=1), samples.max(axis=1)
+    grow = 0.25 * np.linalg.norm(high - low, axis=1)[:, None] + radius  # bulge + radius
+    low, high = low - grow, high + grow
+    orders, tried, nearest = [], [], []
+    for start in range(0, x.shape[0], chunk):
+        p = x[start : start + chunk]
+        inside = np.all((p[:, None, :] >= low) & (p[:, None, :] <= high), axis=2)
+        d2 = np.min(np.sum((p[:, None, None, :] - samples[None]) ** 2, axis=3), axis=2)
+        nearest.append(np.sqrt(d2.min(axis=1)))
+        d2 = np.where(inside, d2, np.inf)
+        order = np.argsort(d2, axis=1, kind="stable")[:, :k]
+        orders.append(order)
+        tried.append(np.isfinite(np.take_along_axis(d2, order, axis=1)))
+    return np.concatenate(orders), np.concatenate(tried), np.concatenate(nearest)
+
+
+def closest_points(
+    lip, x: npt.NDArray[np.float64], radius: float, candidates: int = 4, only=None
+) -> Pairing:
+    """Pair slave points with the deformed master lip (for its last ``refresh``).
+
+    Args:
+        lip: The :class:`~xfem_contact.mechanics.sliding.lips.MasterLip`.
+        x: Deformed slave points (m), ``(m, 2)``.
+        radius: Search radius (m): no master within it leaves a point unpaired.
+        candidates: Pieces tried per point (nearest boxes first).
+        only: A piece per point (``(m,)``, -1: unpaired) to project on instead of
+            searching (the pairing frozen over a load step).
+
+    Returns:
+        The :class:`Pairing`. Local.
+    """
+    m = x.shape[0]
+    if m == 0 or lip.size == 0:
+        return Pairing(np.full(m, -1), np.zeros(m), np.full(m, np.inf))
+    P = lip.size
+    samples = lip.curve(np.repeat(np.arange(P), _SAMPLES.size), np.tile(_SAMPLES, P)).x
+    samples = samples.reshape(P, _SAMPLES.size, 2)
+    if only is None:
+        order, tried, nearest = _candidates(x, samples, radius, min(candidates, P))
+        k = order.shape[1]
+    else:
+        order = np.where(only >= 0, only, 0)[:, None]
+        tried = (only >= 0)[:, None]
+        nearest = np.full(m, np.inf)
+        k = 1
+    rows = np.repeat(np.arange(m), k)
+    pieces = order.ravel()
+    start = _SAMPLES[np.argmin(np.sum((x[rows, None, :] - samples[pieces]) ** 2, axis=2), axis=1)]
+    s = _newton(lip, x[rows], pieces, start)
+    on_piece = (s >= -_ON_PIECE) & (s <= 1.0 + _ON_PIECE)
+    s = np.where(on_piece, s, np.clip(s, 0.0, 1.0))  # off the piece: its nearest end
+    distance = np.linalg.norm(x[rows] - lip.curve(pieces, s).x, axis=1).reshape(m, k)
+    # rank: feet on their piece first, then by distance
+    score = np.where(on_piece.reshape(m, k), distance, np.inf)
+    score = np.where(tried, score, np.inf)
+    fallback = np.where(tried, distance, np.inf)
+    best = np.where(
+        np.isfinite(score).any(axis=1), np.argmin(score, axis=1), np.argmin(fallback, axis=1)
+    )
+    pick = np.arange(m) * k + best
+    piece = np.where(tried[np.arange(m), best], pieces[pick], -1)
+    dist = distance.ravel()[pick]
+    if only is None:
+        piece = np.where(dist <= radius, piece, -1)
+    dist = np.where(piece >= 0, dist, np.where(np.isfinite(nearest), nearest, dist))
+    return Pairing(piece.astype(np.int64), np.where(piece >= 0, s[pick], 0.0), dist)

@@ -1,0 +1,61 @@
+"""What a Newton solve reports: the history of its iterates, and the failure that
+carries it (:mod:`xfem_contact.solvers.newton`)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+
+@dataclasses.dataclass
+class NewtonReport:
+    """History of one solve: residual norms and per-iterate status lines.
+
+    Attributes:
+        residuals: Norm of the scaled reduced residual ``D R^T F`` at each iterate,
+            the initial one first (``iterations + 1`` entries).
+        status: The status callback's dict at each iterate (same length).
+        reason: SNES converged reason (> 0 converged, < 0 diverged).
+        final_residual: The residual norm evaluated after the solve (checked
+            against the tolerances; NaN before).
+    """
+
+    residuals: list[float] = dataclasses.field(default_factory=list)
+    status: list[dict] = dataclasses.field(default_factory=list)
+    #: Krylov iterations of the linear solve of each Newton step (1 per step for LU)
+    linear_iterations: list[int] = dataclasses.field(default_factory=list)
+    reason: int = 0
+    final_residual: float = float("nan")
+    #: Wall time (s) of residual/Jacobian assembly, of the status callback and of
+    #: the whole solve
+    assembly_time: float = 0.0
+    status_time: float = 0.0
+    total_time: float = 0.0
+
+    @property
+    def linear_solve_time(self) -> float:
+        """Wall time (s) of the rest: the factorisations and triangular solves."""
+        return self.total_time - self.assembly_time - self.status_time
+
+    @property
+    def iterations(self) -> int:
+        """Number of Newton steps taken."""
+        return max(len(self.residuals) - 1, 0)
+
+    def table(self) -> str:
+        """The history, one line per iterate. Not collective."""
+        lines = []
+        for k, r in enumerate(self.residuals):
+            extra = self.status[k] if k < len(self.status) else {}
+            lines.append(
+                f"  iterate {k:2d}  |F| = {r:.3e}  "
+                + "  ".join(f"{key} {value}" for key, value in extra.items())
+            )
+        return "\n".join(lines)
+
+
+class NewtonFailure(RuntimeError):
+    """Newton did not converge; ``report`` holds the iteration history."""
+
+    def __init__(self, message: str, report: NewtonReport):
+        super().__init__(f"{message}\n{report.table()}")
+        self.report = report
