@@ -33,41 +33,40 @@ from xfem_contact.mechanics.problem import Problem
 OUTER_SUPPORTS = ("point", "tangential")
 
 
-def _radial_stress(a, b, mu, lmbda):
-    """Second Piola-Kirchhoff ``(S_rr, S_tt)`` of the stretches ``a = 1 + u'``,
-    ``b = 1 + u / R`` (plane strain, Saint Venant-Kirchhoff)."""
-    E_rr, E_tt = 0.5 * (a * a - 1.0), 0.5 * (b * b - 1.0)
+def _radial_stress(e_r, e_t, mu, lmbda):
+    """Second Piola-Kirchhoff ``(S_rr, S_tt)`` (Pa) of the strains ``e_r = u'`` and
+    ``e_t = u / R`` (plane strain, Saint Venant-Kirchhoff; the Green-Lagrange strains
+    ``e + e^2 / 2`` written without cancellation)."""
+    E_rr, E_tt = e_r * (1.0 + 0.5 * e_r), e_t * (1.0 + 0.5 * e_t)
     trace = E_rr + E_tt
     return lmbda * trace + 2.0 * mu * E_rr, lmbda * trace + 2.0 * mu * E_tt
 
 
 def _shoot(slope, mu, lmbda, radii, steps):
     """Integrate ``d(R P_rr)/dR = P_tt`` (RK4) from ``u(R_i) = 0``, ``u'(R_i) =
-    slope``; returns ``(P_rr at the interface, P_rr at R_e)``."""
+    slope``; returns ``(P_rr at the interface, P_rr at R_e)`` (Pa)."""
     r_in, r_gamma, r_out = radii
 
-    def stretch(R, u, T):  # a with a S_rr(a, b) = T / R (Newton from the current a)
-        b = 1.0 + u / R
-        a = 1.0
+    def radial_strain(R, e_t, T):  # e_r with (1 + e_r) S_rr(e_r, e_t) = T / R (Newton)
+        e_r = 0.0
         for _ in range(30):
-            S, _ = _radial_stress(a, b, mu, lmbda)
-            dS = (lmbda + 2.0 * mu) * a
-            f = a * S - T / R
-            step = f / (S + a * dS)
-            a -= step
-            if abs(step) < 1e-16:
+            S, _ = _radial_stress(e_r, e_t, mu, lmbda)
+            f = (1.0 + e_r) * S - T / R
+            step = f / (S + (1.0 + e_r) ** 2 * (lmbda + 2.0 * mu))
+            e_r -= step
+            if abs(step) <= 1e-15 * (abs(e_r) + 1e-300):
                 break
-        return a, b
+        return e_r
 
     def rhs(R, y):
         u, T = y
-        a, b = stretch(R, u, T)
-        _, S_tt = _radial_stress(a, b, mu, lmbda)
-        return np.array([a - 1.0, b * S_tt])
+        e_t = u / R
+        e_r = radial_strain(R, e_t, T)
+        _, S_tt = _radial_stress(e_r, e_t, mu, lmbda)
+        return np.array([e_r, (1.0 + e_t) * S_tt])
 
-    a0 = 1.0 + slope
-    S_rr, _ = _radial_stress(a0, 1.0, mu, lmbda)
-    y = np.array([0.0, r_in * a0 * S_rr])
+    S_rr, _ = _radial_stress(slope, 0.0, mu, lmbda)
+    y = np.array([0.0, r_in * (1.0 + slope) * S_rr])
     values = {}
     for start, end in ((r_in, r_gamma), (r_gamma, r_out)):
         h = (end - start) / steps
@@ -101,11 +100,12 @@ def svk_annulus_pressure(
     slopes = [0.0, -pressure / E]
     misfits = [_shoot(s, mu, lmbda, radii, steps)[1] + pressure for s in slopes]
     for _ in range(30):  # secant on the outer traction
-        s = slopes[-1] - misfits[-1] * (slopes[-1] - slopes[-2]) / (misfits[-1] - misfits[-2])
+        change = misfits[-1] - misfits[-2]
+        if abs(misfits[-1]) < 1e-13 * pressure or change == 0.0:
+            break
+        s = slopes[-1] - misfits[-1] * (slopes[-1] - slopes[-2]) / change
         slopes.append(s)
         misfits.append(_shoot(s, mu, lmbda, radii, steps)[1] + pressure)
-        if abs(misfits[-1]) < 1e-13 * pressure:
-            break
     return _shoot(slopes[-1], mu, lmbda, radii, steps)[0]
 
 

@@ -93,6 +93,7 @@ class MasterLip:
             (node by node, components inner).
         columns: Their reduced columns (-1: none), same shape.
         cells: Global cell index of each piece, ``(P,)``.
+        owners: The process that owns each piece's cell, ``(P,)``.
         orientation: +1 or -1 per piece: ``orientation * (-t_y, t_x)`` points out
             of the master side (into the slave side), ``(P,)``.
 
@@ -125,6 +126,7 @@ class MasterLip:
         self.columns = gather(columns[local_dofs])
         self.cells = gather(global_cells)
         self.orientation = gather(orientation)
+        self.owners = gather(np.full(cells.size, comm.rank, dtype=np.int32))
         self.values = np.zeros(self.dofs.shape)
         self._comm = comm
 

@@ -1,0 +1,313 @@
+"""Large sliding: closest-point pairing, the hybrid element's Jacobian, objectivity and
+paper case 3 with rotation (against the exact pressure of the same bulk model)."""
+
+import xfem_contact  # noqa: F401
+
+# isort: split
+import dolfinx.fem
+import numpy as np
+import pytest
+import ufl
+from mpi4py import MPI
+
+from xfem_contact.cases.paper import ANNULUS_CONTACT_PRESSURE, ANNULUS_RADII
+from xfem_contact.cases.rotation import (
+    pressure_errors,
+    rotating_annulus_problem,
+    svk_annulus_pressure,
+)
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.forms import form
+from xfem_contact.geometry.cut_topology import seg3_basis
+from xfem_contact.io.meshes import annulus
+from xfem_contact.mechanics.laws import make_law
+from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.problem import Problem
+from xfem_contact.mechanics.sliding import element
+from xfem_contact.mechanics.sliding.lips import CurvePoint
+from xfem_contact.mechanics.sliding.projection import closest_points
+from xfem_contact.solvers.newton import RestrictedNewton
+
+
+class ArcLip:
+    """A lip of SEG3 pieces whose nodes lie on a circle of radius R (physical nodes,
+    identity map): the projection sees the same interface as a MasterLip's."""
+
+    def __init__(self, R, angles):
+        a, b = angles[:-1], angles[1:]
+        c = 0.5 * (a + b)
+        self.nodes = R * np.stack(
+            [np.c_[np.cos(t), np.sin(t)] for t in (a, b, c)], axis=1
+        )  # (P, 3, 2): a, b, mid
+        self.size = self.nodes.shape[0]
+
+    def curve(self, pieces, s):
+        N, dN = seg3_basis(s)
+        nodes = self.nodes[pieces]
+        x = np.einsum("mk,mkd->md", N, nodes)
+        t = np.einsum("mk,mkd->md", dN, nodes)
+        t2 = np.einsum("k,mkd->md", np.array([4.0, 4.0, -8.0]), nodes)
+        return CurvePoint(x, t, t2, N, dN)
+
+
+@pytest.fixture
+def circle():
+    return ArcLip(2.0, np.linspace(0.0, 2 * np.pi, 13))
+
+
+def test_points_on_curved_pieces_are_their_own_feet(circle):
+    rng = np.random.default_rng(0)
+    pieces = rng.integers(0, circle.size, 50)
+    s = rng.uniform(0.0, 1.0, 50)
+    x = circle.curve(pieces, s).x
+    pairing = closest_points(circle, x, radius=0.5)
+    assert np.all(pairing.paired)
+    assert np.abs(pairing.distance).max() < 1e-12
+    feet = circle.curve(pairing.piece, pairing.s).x
+    assert np.abs(feet - x).max() < 1e-12
+
+
+def test_points_off_the_curve_project_along_its_normal(circle):
+    rng = np.random.default_rng(1)
+    pieces = rng.integers(0, circle.size, 40)
+    s = rng.uniform(0.05, 0.95, 40)
+    c = circle.curve(pieces, s)
+    n = np.c_[c.t[:, 1], -c.t[:, 0]] / np.linalg.norm(c.t, axis=1)[:, None]
+    offset = rng.uniform(-0.1, 0.1, 40)
+    pairing = closest_points(circle, c.x + offset[:, None] * n, radius=0.5)
+    assert np.array_equal(pairing.piece, pieces)
+    assert np.abs(pairing.s - s).max() < 1e-10
+    assert np.abs(pairing.distance - np.abs(offset)).max() < 1e-12
+
+
+def test_beyond_the_piece_ends_the_foot_is_the_end():
+    lip = ArcLip(2.0, np.linspace(0.0, np.pi / 2, 4))  # an open quarter circle
+    end = lip.curve(np.array([2]), np.array([1.0]))
+    tangent = end.t[0] / np.linalg.norm(end.t[0])
+    # nearly tangent: a point along the tangent line past the end, slightly outside
+    x = end.x + 0.05 * tangent + 1e-6 * np.array([[-tangent[1], tangent[0]]])
+    pairing = closest_points(lip, x, radius=0.5)
+    assert pairing.piece[0] == 2 and pairing.s[0] == 1.0
+    assert abs(pairing.distance[0] - np.linalg.norm(x - end.x)) < 1e-14
+    far = closest_points(lip, end.x + 0.6 * tangent, radius=0.5)
+    assert far.piece[0] == -1 and far.distance[0] > 0.5
+
+
+def test_no_master_found_is_reported_not_raised(circle):
+    x = np.array([[10.0, 0.0], [0.0, -7.5]])
+    pairing = closest_points(circle, x, radius=0.5)
+    assert np.all(pairing.piece == -1)
+    assert np.all(pairing.distance > 5.0)
+    empty = ArcLip(2.0, np.array([0.0]))
+    assert np.all(closest_points(empty, x, radius=0.5).piece == -1)
+
+
+def test_master_lip_is_the_interface_of_the_cut():
+    """With no displacement, every slave point of case 3 lies on the master lip
+    (distance at round-off, gap zero)."""
+    problem = rotating_annulus_problem(5, 2, 0.0)
+    coupling = next(iter(problem.couplings.values()))
+    coupling.bind(np.arange(problem.w.x.array.size), [])
+    pairing, terms = coupling.evaluate(problem.w)
+    assert np.all(pairing.paired)
+    assert np.abs(pairing.distance).max() < 1e-12
+    r = np.hypot(*coupling.x_ref.T)  # on the circle up to the SEG3 interpolation (h^3)
+    assert np.abs(r - ANNULUS_RADII[1]).max() < 2e-4
+
+
+def _perturbed_state(problem, alpha, rng):
+    """The inner ring turned by alpha, both rings compressed a little, random noise,
+    multipliers in compression; Dirichlet dofs at their values."""
+    for f, a in ((0, alpha), (1, 0.0)):
+        V, dofs = problem.space.field_space(f)
+        X = V.tabulate_dof_coordinates()[:, :2]
+        Q = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+        u = X @ (Q - np.eye(2)).T - 0.004 * X + 1e-3 * rng.standard_normal(X.shape)
+        problem.w.x.array[dofs] = u.ravel()
+    _, dofs = problem.space.field_space(2)
+    problem.w.x.array[dofs] = -1e6 * (1 + 0.1 * rng.standard_normal(len(dofs)))
+    for bc in problem._bcs:
+        bc.set(problem.w.x.array)
+
+
+def _jacobian_error(problem, eps, seed=0):
+    """|FD - J dy| / |J dy| of the reduced (scaled) residual along a random
+    direction relative to each unknown."""
+    rng = np.random.default_rng(seed)
+    _perturbed_state(problem, 0.3, rng)
+    newton = RestrictedNewton(
+        problem.residual(),
+        problem.w,
+        problem._bcs,
+        problem.restriction(),
+        couplings=list(problem.couplings.values()),
+    )
+    newton._start_from_w()
+    y, J = newton.y.copy(), newton.J_r
+    F = newton.F_r.duplicate()
+    newton._residual(None, y, F)
+    newton._jacobian(None, y, J, J)
+    dy = y.duplicate()
+    dy.setArray(rng.standard_normal(dy.getLocalSize()) * np.abs(y.getArray()))
+    Jdy = y.duplicate()
+    J.mult(dy, Jdy)
+
+    def at(s):
+        ys = y.copy()
+        ys.axpy(s, dy)
+        newton._residual(None, ys, F)
+        return F.getArray().copy()
+
+    fd = (at(eps) - at(-eps)) / (2 * eps)
+    comm = problem.mesh.comm
+    num = comm.allreduce(float(np.sum((fd - Jdy.getArray()) ** 2)), op=MPI.SUM)
+    den = comm.allreduce(float(np.sum(Jdy.getArray() ** 2)), op=MPI.SUM)
+    state = problem.interface_state()
+    contact = comm.allreduce(int(np.sum(state["P_n"] < 0)), op=MPI.SUM)
+    newton.destroy()
+    return np.sqrt(num / den), contact
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+@pytest.mark.parametrize("lbb", ["stabilized", "none"])
+def test_jacobian_matches_central_differences(degree, lbb):
+    """All linearisation terms kept: the foot's and the master normal's variations
+    (the inner ring turned by 0.3 rad: slave and master cells differ)."""
+    problem = rotating_annulus_problem(5, degree, 0.3, lbb=lbb)
+    error, contact = _jacobian_error(problem, 1e-5)
+    assert contact > 0
+    assert error < 1e-6, error
+
+
+def test_central_differences_catch_a_missing_curvature_term(monkeypatch):
+    """The check fails when the gap's Hessian (the foot and normal variations) is
+    dropped: what the Jacobian test guards."""
+    gap_derivatives = element.gap_derivatives
+
+    def without_hessian(*args):
+        g, grad, H = gap_derivatives(*args)
+        return g, grad, 0.0 * H
+
+    monkeypatch.setattr(element, "gap_derivatives", without_hessian)
+    problem = rotating_annulus_problem(5, 2, 0.3, lbb="none")
+    error, _ = _jacobian_error(problem, 1e-5)
+    assert error > 1e-4, error
+
+
+def test_svk_reference_tends_to_lame_for_small_strains():
+    """The radial ODE of the Saint Venant-Kirchhoff ring against the exact Lame
+    pressure when the strains vanish (E 1e6 times stiffer)."""
+    p = svk_annulus_pressure(E=1e12)
+    assert abs(p / ANNULUS_CONTACT_PRESSURE - 1.0) < 1e-6
+    # and the model error at the paper's strains (~1 %) is of the order of the strain
+    assert 1e-4 < abs(svk_annulus_pressure() / ANNULUS_CONTACT_PRESSURE - 1.0) < 2e-2
+
+
+def test_rigid_rotation_by_a_right_angle_carries_no_stress():
+    """Patch test: both boundaries of the annulus turned by pi/2, no load: the
+    solution is the rotation, with zero stress and zero multipliers."""
+    r_in, r_gamma, r_out = ANNULUS_RADII
+    mesh = annulus(MPI.COMM_WORLD, r_in, r_out, 5, 20, 2)
+    cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - r_gamma, degree=2)
+    material = Material(100e6, 0.3)
+    problem = Problem(cut, 2, material, make_law("frictionless"), kinematics="large")
+    tol = 1e-6 * r_out
+    for r in (r_in, r_out):
+        problem.add_rotation(lambda x, r=r: np.abs(np.hypot(x[0], x[1]) - r) < tol, np.pi / 2)
+    for t in (0.5, 1.0):
+        problem.load_factor.set(t)
+        # no load: the rotation's residual is round-off (4e-9), not to be reduced 1e10 times
+        problem.solve({"snes_atol": 1e-7})
+        problem.accept_step()
+    lam = problem.interface_state()["lambda_n"]
+    scale = 1e6  # the load scale of case 3 (Pa)
+    assert np.abs(lam).max(initial=0.0) < 1e-10 * scale
+    u = problem.space.field(problem.w, 0)
+    stress = sum(
+        ufl.inner(
+            material.piola(problem.space.field(problem.w, i)),
+            material.piola(problem.space.field(problem.w, i)),
+        )
+        * cut.dx(s)
+        for i, s in ((0, -1), (1, 1))
+    )
+    area = np.pi * (r_out**2 - r_in**2)
+    energy = MPI.COMM_WORLD.allreduce(dolfinx.fem.assemble_scalar(form(stress)), op=MPI.SUM)
+    assert np.sqrt(energy / area) < 1e-10 * scale
+    X = u.function_space.tabulate_dof_coordinates()[:, :2]
+    rotated = np.c_[-X[:, 1], X[:, 0]] - X
+    inside = np.hypot(*X.T) < r_gamma - 2.0  # nodes of side -1's own cells
+    assert np.abs(u.x.array.reshape(-1, 2)[inside] - rotated[inside]).max() < 1e-10 * r_gamma
+
+
+def _solve(problem, steps):
+    reports = []
+    for k in range(1, steps + 1):
+        problem.load_factor.set(k / steps)
+        reports.append(problem.solve())
+        problem.accept_step()
+    return reports
+
+
+@pytest.mark.parametrize("degree, bound", [(2, 2e-3), (1, 1e-2)])
+def test_case3_turned_by_a_quarter_of_pi(degree, bound):
+    problem = rotating_annulus_problem(10, degree, np.pi / 4)
+    reports = _solve(problem, 2)
+    assert all(r.iterations <= 10 for r in reports)
+    errors = pressure_errors(problem)
+    assert errors["error"] < bound, errors
+    counts = problem.pairing_counts()["interface"]
+    assert counts["unpaired"] == 0 and counts["changed"] > 0
+
+
+def test_objectivity_a_right_angle_gives_the_unturned_pressures():
+    still = rotating_annulus_problem(10, 2, 0.0)
+    _solve(still, 1)
+    turned = rotating_annulus_problem(10, 2, np.pi / 2)
+    _solve(turned, 4)
+    a, b = (p.interface_state()["lambda_n"] for p in (turned, still))
+    assert np.abs(a - b).max() < 1e-8 * abs(ANNULUS_CONTACT_PRESSURE)
+
+
+@pytest.mark.parametrize(
+    "build, message",
+    [
+        (lambda: rotating_annulus_problem(4, 2, 0.1, law="sticking"), "not available in large"),
+        (lambda: rotating_annulus_problem(4, 2, 0.1, lbb="restriction"), "lbb 'restriction'"),
+        (lambda: rotating_annulus_problem(4, 2, 0.1, slave=0), "slave must be"),
+        (lambda: rotating_annulus_problem(4, 2, 0.1, pairing="sometimes"), "pairing must be"),
+        (lambda: rotating_annulus_problem(4, 2, 0.1, outer="glue"), "outer support"),
+    ],
+)
+def test_bad_input_is_one_clear_error(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()
+
+
+def test_rotation_of_a_missing_part_is_an_error():
+    problem = rotating_annulus_problem(4, 2, 0.0)
+    with pytest.raises(ValueError, match="holds no boundary facet"):
+        problem.add_rotation(lambda x: np.hypot(x[0], x[1]) > 100.0, 0.5)
+
+
+def test_unknown_kinematics_names_the_valid_ones():
+    mesh = annulus(MPI.COMM_WORLD, 3.0, 20.0, 3, 12, 2)
+    cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 8.0, degree=2)
+    with pytest.raises(ValueError, match=r"valid: \('small', 'large'\)"):
+        Problem(cut, 2, Material(1e8, 0.0), "frictionless", kinematics="huge")
+
+
+@pytest.mark.mpi
+@pytest.mark.parallel
+def test_masters_on_the_other_process_are_paired():
+    """On 2 ranks some slave points pair with a master piece the other rank owns
+    (the field equality against one rank is in test_parallel)."""
+    comm = MPI.COMM_WORLD
+    if comm.size < 2:
+        pytest.skip("needs 2 processes")
+    problem = rotating_annulus_problem(6, 2, 0.3)
+    _solve(problem, 1)
+    coupling = next(iter(problem.couplings.values()))
+    pairing, _ = coupling.evaluate(problem.w)
+    remote = pairing.paired & (coupling.lip.owners[np.maximum(pairing.piece, 0)] != comm.rank)
+    assert comm.allreduce(int(remote.sum()), op=MPI.SUM) > 0
