@@ -30,12 +30,8 @@ CASES = {
     "case3 annulus P2, curved cells": lambda comm: annulus_problem(6, 24, 2, comm=comm),
     "case3 annulus P1": lambda comm: annulus_problem(6, 24, 1, comm=comm),
     # large sliding: masters on the other rank, the inner ring turned by 0.3 rad
-    "case3 turned, large sliding P2": lambda comm: rotating_annulus_problem(
-        6, 2, 0.3, comm=comm
-    ),
-    "case3 turned, large sliding P1": lambda comm: rotating_annulus_problem(
-        6, 1, 0.3, comm=comm
-    ),
+    "case3 turned, large sliding P2": lambda comm: rotating_annulus_problem(6, 2, 0.3, comm=comm),
+    "case3 turned, large sliding P1": lambda comm: rotating_annulus_problem(6, 1, 0.3, comm=comm),
 }
 
 
