@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
+from xfem_contact.cases.rotation import svk_annulus_pressure
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.scenes import cli
 from xfem_contact.scenes.run import build, levelset, run
@@ -332,13 +333,62 @@ def test_names_with_spaces_are_kept_and_quoted_in_errors():
     one_line_error(data, "materials.'soft rock'.nu", "must be in (-1.0, 0.5), got 0.7")
 
 
-def test_large_kinematics_refused_clearly():
-    one_line_error(
-        base(law="frictionless", kinematics="large"),
-        "interfaces[0].kinematics",
-        "not available yet",
-        NotImplementedError,
-    )
+LARGE_SLIDING_REFUSALS = {
+    "unsupported law": (
+        {"law": "sticking", "kinematics": "large"},
+        "interfaces[0].law",
+        "'sticking' is not available in large sliding (kinematics = 'large'); valid: "
+        "('frictionless', 'free', 'bonded')",
+    ),
+    "restriction": (
+        {"law": "frictionless", "kinematics": "large", "lbb": "restriction"},
+        "interfaces[0].lbb",
+        "valid: ('stabilized', 'none')",
+    ),
+    "slave and master on one side": (
+        {"law": "frictionless", "kinematics": "large", "slave": 1, "master": 1},
+        "interfaces[0].master",
+        "slave and master are both side 1",
+    ),
+    "slave in small sliding": (
+        {"law": "frictionless", "slave": 1},
+        "interfaces[0].slave",
+        "only with kinematics = 'large'",
+    ),
+    "pairing of a typo": (
+        {"law": "frictionless", "kinematics": "large", "pairing": "often"},
+        "interfaces[0].pairing",
+        "choose one of ['iterate', 'step']",
+    ),
+}
+
+
+@pytest.mark.parametrize(
+    "interface, key, fragment", LARGE_SLIDING_REFUSALS.values(), ids=LARGE_SLIDING_REFUSALS
+)
+def test_large_sliding_input_errors_name_the_key(interface, key, fragment):
+    one_line_error(base(**interface), key, fragment)
+
+
+def test_rotation_of_a_missing_part_names_the_parts():
+    data = base(law="frictionless", kinematics="large")
+    data["loads"].append({"part": "inner", "type": "rotation", "value": 0.1})
+    one_line_error(data, "loads[2].part", "'inner': no such boundary part")
+
+
+def test_bundled_rotating_inclusion_turns_a_right_angle():
+    """The bundled case-3 scene: 4 load steps of pi/8, every slave point paired and
+    changing master cell each step, the pressure uniform to round-off."""
+    scene = load_scene(bundled_scenes()["case3_rotating_inclusion"])
+    summary = run(scene, log=None, progress_bar=False)
+    assert summary["effects"]["kinematics"] == "large" and summary["effects"]["pairing"]
+    assert len(summary["pairing"]) == 4
+    counts = [step["interface0"] for step in summary["pairing"]]
+    assert all(c["unpaired"] == 0 and c["paired"] > 0 for c in counts)
+    assert all(c["changed"] == c["paired"] for c in counts[1:])
+    lam = np.array(summary["interface_samples"]["lambda_n"])
+    reference = svk_annulus_pressure()
+    assert np.abs(lam / reference - 1.0).max() < 1e-3
 
 
 def test_level_set_that_never_crosses_is_refused():

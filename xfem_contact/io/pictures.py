@@ -237,7 +237,13 @@ def render_folder(
     quiet_vtk()
     written = []
     grid = merge_grids([pyvista.read(p) for p in results])
-    written.append(plot_deformed(grid, folder / "result.png", title=f"{name}: deformed"))
+    # large kinematics: the true deformed configuration (a magnified rotation shrinks)
+    large = summary.get("effects", {}).get("kinematics") == "large"
+    written.append(
+        plot_deformed(
+            grid, folder / "result.png", title=f"{name}: deformed", scale=1.0 if large else None
+        )
+    )
     subcells = sorted(folder.glob("subcells*.vtu"))
     if subcells:
         pieces = [pyvista.read(p) for p in sorted(folder.glob("interface*.vtu"))]

@@ -156,12 +156,22 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             -1: {spec.name: scene.materials[spec.inside] for spec in scene.interfaces},
             1: scene.materials[scene.interfaces[0].outside],  # shared (see the schema)
         }
-        problem = Problem(cut, scene.degree, materials, laws)
+        first = scene.interfaces[0]  # kinematics, slave side and pairing are shared
+        problem = Problem(
+            cut,
+            scene.degree,
+            materials,
+            laws,
+            kinematics=first.kinematics,
+            slave=first.slave,
+            pairing=first.pairing,
+        )
         gdim = mesh.geometry.dim
         effects = {
             "interface": scene.interfaces[0].law if len(laws) == 1 else None,
             "interfaces": [s.name for s in scene.interfaces],
-            "laws": {name: law.describe() for name, law in laws.items()},
+            "laws": {name: law.describe() for name, law in problem.laws.items()},
+            "kinematics": first.kinematics,
             "cut": True,
             "enrichment": True,
             "multipliers": sum(c for _, c, _ in problem.space.multiplier_fields),
@@ -172,7 +182,7 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             "solver": "KSP (one linear solve per load step)"
             if problem.linear
             else "SNES (generalized Newton)",
-            "pairing": False,
+            "pairing": bool(problem.couplings),
         }
     for load in scene.loads:
         _apply(problem, scene, load, meshed)
@@ -193,5 +203,9 @@ def _apply(problem, scene: Scene, load, meshed: MeshedDomain) -> None:
         problem.add_traction(where, _value(load.value, True), **side)
     elif load.type == "body_force":
         problem.add_body_force(_value(load.value, True), **side)
+    elif load.type == "rotation":
+        problem.add_rotation(where, float(load.value), load.centre)
+    elif load.type == "tangential_support":
+        problem.add_tangential_spring(where, float(load.value))
     else:  # the scene schema admits no other type
         raise AssertionError(f"unhandled load type {load.type!r}")

@@ -117,6 +117,7 @@ def run(
     result = Result(problem)
     series = _open_series(out, result) if (out is not None and scene.outputs["vtx"]) else []
     steps, iterations, residuals, status = load_steps(scene.load_steps), [], [], {}
+    pairing = []
     solve_start = time.perf_counter()
     try:
         bar = progress(steps, f"{scene.name}: load steps", progress_bar and len(steps) > 1, comm)
@@ -135,6 +136,14 @@ def run(
             iterations.append(its)
             if not problem.linear:
                 residuals.append(problem.last_report.residuals)
+            if getattr(problem, "couplings", None):
+                pairing.append(problem.pairing_counts())
+                status = status | {
+                    f"{key} {name}": value
+                    for name, counts in pairing[-1].items()
+                    for key, value in counts.items()
+                    if key != "unpaired"  # in the status already
+                }
             result.update(solution)
             for writer in series:
                 writer.write(float(t))
@@ -164,6 +173,8 @@ def run(
     if not problem.linear:
         summary["contact_status"] = status
         summary["newton_residuals"] = residuals
+    if pairing:
+        summary["pairing"] = pairing
     if not isinstance(problem, PlainElasticityProblem):
         samples = {name: problem.interface_samples(name) for name in problem.laws}
         summary["interfaces"] = {

@@ -39,6 +39,8 @@ import pathlib
 import re
 import tomllib
 
+from xfem_contact.mechanics.laws import LINEAR_LAWS, SLIDING_LAWS
+from xfem_contact.mechanics.laws.sliding import SLIDING_LBB
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
     BUILTIN_PARTS,
@@ -226,11 +228,17 @@ def _interface(table, k: int, materials: dict) -> InterfaceSpec:
     if law == "coulomb" and "friction" not in table:
         raise SceneError(f"{where}.friction", "required for law 'coulomb' (coefficient >= 0)")
     kinematics = table.get("kinematics", "small")
+    slave = _sides(table, kinematics, where)
     if kinematics == "large":
-        raise NotImplementedError(
-            f"{where}.kinematics: 'large' (large sliding with slave/master pairing) is "
-            "not available yet; use 'small'"
-        )
+        if law not in SLIDING_LAWS + LINEAR_LAWS:
+            message = (
+                f"{law!r} is not available in large sliding (kinematics = 'large'); "
+                f"valid: {SLIDING_LAWS + LINEAR_LAWS}"
+            )
+            raise SceneError(f"{where}.law", message)
+        if law in SLIDING_LAWS and table.get("lbb", "stabilized") not in SLIDING_LBB:
+            message = f"{table['lbb']!r} is not available in large sliding; valid: {SLIDING_LBB}"
+            raise SceneError(f"{where}.lbb", message)
     first = next(iter(materials))
     for side_key in ("inside", "outside"):
         name = table.get(side_key, first)
@@ -248,7 +256,22 @@ def _interface(table, k: int, materials: dict) -> InterfaceSpec:
         augmentation=float(table.get("augmentation", 1.0)),
         lbb=table.get("lbb", "stabilized"),
         kinematics=kinematics,
+        slave=slave,
+        pairing=table.get("pairing", "iterate"),
     )
+
+
+def _sides(table, kinematics: str, where: str) -> int:
+    """The slave side of an interface table (large kinematics only; the master is the
+    other side)."""
+    for key in ("slave", "master", "pairing"):
+        if key in table and kinematics != "large":
+            raise SceneError(f"{where}.{key}", "only with kinematics = 'large' (large sliding)")
+    slave = table.get("slave", -table.get("master", 1))
+    if "master" in table and table["master"] == slave:
+        message = f"slave and master are both side {slave}: the master is the other side"
+        raise SceneError(f"{where}.master", message)
+    return slave
 
 
 def _load(table, where: str, known_parts: set) -> LoadSpec:
@@ -276,14 +299,17 @@ def _load(table, where: str, known_parts: set) -> LoadSpec:
         table.get("side"),
         table.get("component"),
         tuple(table["point"]) if "point" in table else None,
+        tuple(table.get("centre", (0.0, 0.0))),
     )
 
 
 def _load_value(value, kind: str, component: bool, key: str) -> None:
     """Check the value of a load: its form (scalar, [vx, vy]) by type, each entry a finite
     number or an expression (UFL for loads on forms, numpy for interpolated data)."""
-    if kind == "point_displacement":
+    if kind in ("point_displacement", "rotation"):
         Number()(value, key)
+    elif kind == "tangential_support":
+        Number(0.0, open=True)(value, key)
     elif kind == "pressure":
         Scalar("load")(value, key)
     elif kind in ("traction", "body_force"):

@@ -18,6 +18,7 @@ from collections.abc import Callable
 
 from xfem_contact.mechanics.laws import CONTACT_LAWS, LBB_OPTIONS, LINEAR_LAWS
 from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
 from xfem_contact.scenes.expressions import check_expression
 from xfem_contact.solvers.options import LINEAR_PRESETS, defaults
 
@@ -25,7 +26,15 @@ _NEWTON = defaults("newton")  # the [solver] defaults are the Newton solver's
 
 LAWS = LINEAR_LAWS + CONTACT_LAWS
 SHAPES = ("circle", "ellipse", "line", "half-plane", "expression")
-LOAD_TYPES = ("pressure", "traction", "displacement", "point_displacement", "body_force")
+LOAD_TYPES = (
+    "pressure",
+    "traction",
+    "displacement",
+    "point_displacement",
+    "body_force",
+    "rotation",
+    "tangential_support",
+)
 KINEMATICS = ("small", "large")
 CELLS = ("quadrilateral", "triangle")
 MESH_KINDS = ("rectangle", "annulus", "gmsh")
@@ -36,7 +45,7 @@ BUILTIN_PARTS = {
 }
 #: Keys in which the interfaces of one scene must agree: they lie in one body (the
 #: outside material) and share the kinematics; laws and inside materials may differ
-SHARED_INTERFACE_KEYS = ("kinematics", "outside")
+SHARED_INTERFACE_KEYS = ("kinematics", "outside", "slave", "pairing")
 #: The [mesh] keys each mesh kind reads (besides ``kind``)
 MESH_KEYS = {
     "rectangle": ("corners", "cells", "cell"),
@@ -58,6 +67,8 @@ LOAD_KEYS = {
     "displacement": (("part", "value"), ("component",)),
     "point_displacement": (("point", "component", "value"), ()),
     "body_force": (("value",), ("side",)),
+    "rotation": (("part", "value"), ("centre",)),
+    "tangential_support": (("part", "value"), ()),
 }
 
 
@@ -261,6 +272,11 @@ FIELDS = {
         "augmentation": Field(_POSITIVE, "> 0"),
         "lbb": Field(Choice(LBB_OPTIONS), " | ".join(LBB_OPTIONS)),
         "kinematics": Field(Choice(KINEMATICS), f"one of {KINEMATICS}"),
+        "slave": Field(Choice((-1, 1)), "slave side -1 or +1 (large kinematics; default -1)"),
+        "master": Field(Choice((-1, 1)), "master side, the other one (large kinematics)"),
+        "pairing": Field(
+            Choice(PAIRING_UPDATES), f"one of {PAIRING_UPDATES} (large kinematics; default iterate)"
+        ),
         "inside": Field(Text(), "material of side -1"),
         "outside": Field(Text(), "material of side +1"),
     },
@@ -297,6 +313,7 @@ FIELDS = {
         "side": Field(Choice((-1, 1)), "-1 or +1 (default both)"),
         "component": Field(Choice((0, 1)), "0 or 1 (displacement)"),
         "point": Field(_POINT, "[x, y] (point_displacement)"),
+        "centre": Field(_POINT, "[x, y] (m), centre of a rotation (default [0, 0])"),
     },
     "outputs": {
         "vtx": Field(flag, "write VTX fields (bool)"),
@@ -346,6 +363,8 @@ class InterfaceSpec:
     augmentation: float = 1.0
     lbb: str = "stabilized"
     kinematics: str = "small"
+    slave: int = -1
+    pairing: str = "iterate"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -356,6 +375,7 @@ class LoadSpec:
     side: int | None = None
     component: int | None = None
     point: tuple | None = None
+    centre: tuple = (0.0, 0.0)
 
 
 @dataclasses.dataclass(frozen=True)
