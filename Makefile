@@ -40,6 +40,7 @@ bench: $(VENV)/.installed
 	$(PY) bench/contact_convergence.py
 	$(PY) bench/scaling.py --ranks 2
 	$(PY) bench/iterative.py --tiny
+	$(PY) bench/rotating_inclusion.py --no-progress
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check xfem_contact tests demos bench

@@ -1,0 +1,152 @@
+"""Paper case 3 with rotation (large sliding): accuracy, oscillation and cost.
+
+For each element degree, mesh and rotation angle: the relative L2 error of the
+contact pressure against the exact pressure of the same (Saint Venant-Kirchhoff)
+bulk model, and against the small-strain Lame value, the oscillation amplitude
+(max - min of lambda_n over the interface / 1.1155 MPa), the Newton iterations of
+each load step with the last two residuals (the quadratic end), and the wall
+time. Meshes: n radial x 4n around (n = 10, 20, 40), and the paper's n x n reading
+(20, 40, 80). Angles 0 (1 step), pi/4 (2 steps), pi/2 (4 steps) and 0.3 rad in
+one step (not a multiple of the cell angle: pi/4 and pi/2 map the mesh onto itself).
+The baseline of the time ratios, measured in the same run, is the small-sliding
+solve of case 3 at alpha = 0 on the same mesh (:func:`~xfem_contact.cases.paper.annulus_problem`).
+
+Run: ``python bench/rotating_inclusion.py [--tiny] [--json PATH]``; writes
+``bench/results/rotating_inclusion.{json,md}``.
+"""
+
+import argparse
+import json
+import pathlib
+import time
+
+import xfem_contact  # noqa: F401  (before dolfinx with the PyPI wheel)
+
+# isort: split
+import numpy as np
+from mpi4py import MPI
+
+from xfem_contact.cases.paper import annulus_problem
+from xfem_contact.cases.rotation import pressure_errors, rotating_annulus_problem
+from xfem_contact.io.progress import progress
+from xfem_contact.solvers.newton import NewtonFailure
+
+ANGLES = {"0": (0.0, 1), "pi/4": (np.pi / 4, 2), "pi/2": (np.pi / 2, 4), "0.3": (0.3, 1)}
+RESULTS = pathlib.Path(__file__).parent / "results"
+
+
+def small_sliding_time(n_radial, n_angular, degree) -> float:
+    """Wall time (s) of the small-sliding case-3 solve at alpha = 0 (the baseline)."""
+    start = time.perf_counter()
+    problem = annulus_problem(n_radial, n_angular, degree, 2 if degree == 2 else 1)
+    problem.solve()
+    return time.perf_counter() - start
+
+
+def run(n_radial, n_angular, degree, angle_name) -> dict:
+    alpha, steps = ANGLES[angle_name]
+    start = time.perf_counter()
+    problem = rotating_annulus_problem(n_radial, degree, alpha, n_angular)
+    row = {"n": n_radial, "n_angular": n_angular, "degree": degree, "alpha": angle_name}
+    row["dofs"] = problem.space.dof_counts().total
+    iterations, ends = [], []
+    try:
+        for k in range(1, steps + 1):
+            problem.load_factor.set(k / steps)
+            report = problem.solve()
+            problem.accept_step()
+            iterations.append(report.iterations)
+            ends.append(report.residuals[-3:])
+    except NewtonFailure as failure:
+        row["failure"] = str(failure).splitlines()[0]
+    row["time_s"] = time.perf_counter() - start
+    row["newton_per_step"] = iterations
+    row["last_residuals"] = ends
+    if "failure" not in row:
+        row |= pressure_errors(problem)
+    return row
+
+
+def table(rows) -> str:
+    lines = [
+        "| mesh | degree | alpha | dofs | error (same model) | error (Lame) | oscillation "
+        "| Newton per step | time (s) | x small sliding |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        if "failure" in r:
+            lines.append(
+                f"| {r['n']}x{r['n_angular']} | {r['degree']} | {r['alpha']} | "
+                f"{r['dofs']} | failed: {r['failure']} | | | | | |"
+            )
+            continue
+        lines.append(
+            f"| {r['n']}x{r['n_angular']} | {r['degree']} | {r['alpha']} | {r['dofs']} | "
+            f"{r['error']:.2e} | {r['lame_error']:.2e} | {r['oscillation']:.1e} | "
+            f"{r['newton_per_step']} | {r['time_s']:.2f} | {r['ratio']:.2f} |"
+        )
+    return "\n".join(lines)
+
+
+def rates(rows) -> list[str]:
+    """Observed rates of the error between successive meshes of one family."""
+    out = []
+    for family in ("4n", "n"):
+        for degree in (1, 2):
+            for angle in ANGLES:
+                chosen = [
+                    r
+                    for r in rows
+                    if r["degree"] == degree
+                    and r["alpha"] == angle
+                    and "error" in r
+                    and (r["n_angular"] == 4 * r["n"]) == (family == "4n")
+                ]
+                for a, b in zip(chosen, chosen[1:], strict=False):
+                    rate = np.log(a["error"] / b["error"]) / np.log(b["n"] / a["n"])
+                    out.append(
+                        f"degree {degree}, alpha {angle}, {family}: n {a['n']} -> "
+                        f"{b['n']}: rate {rate:.2f}"
+                    )
+    return out
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--tiny", action="store_true", help="n = 10, 20 only (a quick check)")
+    parser.add_argument("--json", default=str(RESULTS / "rotating_inclusion.json"))
+    parser.add_argument("--no-progress", action="store_true")
+    args = parser.parse_args()
+    comm = MPI.COMM_WORLD
+    meshes = (
+        [(10, 40), (20, 80)]
+        if args.tiny
+        else [(10, 40), (20, 80), (40, 160), (20, 20), (40, 40), (80, 80)]
+    )
+    cases = [(m, d, a) for m in meshes for d in (1, 2) for a in ANGLES]
+    baselines, rows = {}, []
+    for (n, nc), degree, angle in progress(cases, "case 3 rotated", not args.no_progress, comm):
+        if (n, nc, degree) not in baselines:
+            baselines[(n, nc, degree)] = small_sliding_time(n, nc, degree)
+        row = run(n, nc, degree, angle)
+        row["small_sliding_time_s"] = baselines[(n, nc, degree)]
+        row["ratio"] = row["time_s"] / row["small_sliding_time_s"]
+        rows.append(row)
+        if comm.rank == 0 and "error" in row:
+            print(
+                f"{n}x{nc} P{degree} alpha {angle}: error {row['error']:.3e}, oscillation "
+                f"{row['oscillation']:.2e}, Newton {row['newton_per_step']}, "
+                f"{row['time_s']:.2f} s ({row['ratio']:.2f} x small sliding)",
+                flush=True,
+            )
+    if comm.rank == 0:
+        text = table(rows) + "\n\n" + "\n".join(f"- {line}" for line in rates(rows)) + "\n"
+        print(text)
+        path = pathlib.Path(args.json)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps({"ranks": comm.size, "rows": rows}, indent=1))
+        path.with_suffix(".md").write_text(text)
+
+
+if __name__ == "__main__":
+    main()
