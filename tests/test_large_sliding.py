@@ -311,3 +311,46 @@ def test_masters_on_the_other_process_are_paired():
     pairing, _ = coupling.evaluate(problem.w)
     remote = pairing.paired & (coupling.lip.owners[np.maximum(pairing.piece, 0)] != comm.rank)
     assert comm.allreduce(int(remote.sum()), op=MPI.SUM) > 0
+
+
+def test_complex_step_element_equals_the_analytic_frictionless_one():
+    """Two derivations of the frictionless hybrid element (the analytic Jacobian with
+    the foot and normal variations, and the complex-step derivative of the residual
+    the Coulomb element uses) agree to round-off."""
+    problem = rotating_annulus_problem(5, 2, 0.3, lbb="none")
+    _perturbed_state(problem, 0.3, np.random.default_rng(2))
+    coupling = problem.couplings["interface"]
+    coupling.bind(np.arange(problem.w.x.array.size), [])
+    _, analytic = coupling.evaluate(problem.w)
+    coupling.complex_step, coupling._evaluated = True, None
+    _, stepped = coupling.evaluate(problem.w)
+    scale = np.abs(analytic.jacobian).max()
+    assert np.abs(stepped.jacobian - analytic.jacobian).max() < 1e-12 * scale
+    assert (
+        np.abs(stepped.residual - analytic.residual).max() < 1e-12 * np.abs(analytic.residual).max()
+    )
+
+
+@pytest.mark.parametrize("friction, status", [(0.3, "slip"), (1e3, "stick")])
+def test_coulomb_jacobian_matches_central_differences(friction, status):
+    problem = rotating_annulus_problem(5, 2, 0.3, law="coulomb", friction=friction)
+    error, contact = _jacobian_error(problem, 1e-5)
+    counts = problem.interface_status(problem.w)
+    assert contact > 0 and counts[status] == counts["contact"]
+    assert error < 1e-6, error
+
+
+def test_coulomb_in_large_sliding_slides_on_the_cone():
+    """Case 3 with friction 0.3, the outer ring held tangentially: the whole interface
+    slides, the applied tangential traction is on the cone (|P_t| = 0.3 |P_n|) and,
+    by the rotational symmetry, uniform; it opposes the slip increment."""
+    problem = rotating_annulus_problem(8, 2, 0.3, law="coulomb", friction=0.3, outer="tangential")
+    reports = _solve(problem, 2)
+    assert all(r.iterations <= 10 for r in reports)
+    state = problem.interface_state()
+    counts = problem.interface_status(problem.w)
+    assert counts["slip"] == counts["contact"] > 0
+    P_n, P_t = state["P_n"], state["P_t"]
+    assert np.abs(np.abs(P_t) - 0.3 * np.abs(P_n)).max() < 1e-9 * np.abs(P_n).max()
+    assert np.ptp(state["lambda_t"]) < 1e-8 * np.abs(state["lambda_t"]).max()
+    assert np.all(P_t * state["slip_increment"] > 0)

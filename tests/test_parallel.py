@@ -32,6 +32,9 @@ CASES = {
     # large sliding: masters on the other rank, the inner ring turned by 0.3 rad
     "case3 turned, large sliding P2": lambda comm: rotating_annulus_problem(6, 2, 0.3, comm=comm),
     "case3 turned, large sliding P1": lambda comm: rotating_annulus_problem(6, 1, 0.3, comm=comm),
+    "case3 turned, large sliding Coulomb": lambda comm: rotating_annulus_problem(
+        6, 2, 0.3, law="coulomb", friction=0.3, outer="tangential", comm=comm
+    ),
 }
 
 

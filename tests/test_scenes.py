@@ -338,7 +338,7 @@ LARGE_SLIDING_REFUSALS = {
         {"law": "sticking", "kinematics": "large"},
         "interfaces[0].law",
         "'sticking' is not available in large sliding (kinematics = 'large'); valid: "
-        "('frictionless', 'free', 'bonded')",
+        "('frictionless', 'coulomb', 'free', 'bonded')",
     ),
     "restriction": (
         {"law": "frictionless", "kinematics": "large", "lbb": "restriction"},

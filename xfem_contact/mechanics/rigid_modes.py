@@ -42,7 +42,7 @@ import numpy as np
 from mpi4py import MPI
 
 from xfem_contact.fem.evaluation import interface_points
-from xfem_contact.mechanics.laws import Coulomb, Free, Frictionless
+from xfem_contact.mechanics.laws import ContactLaw, Free
 
 #: What a closed interface of each kind transmits (the reason in the messages)
 _KIND_TEXT = {
@@ -114,7 +114,9 @@ def law_kind(law) -> str:
     """What a closed interface of ``law`` transmits: ``none``, ``normal`` or ``full``."""
     if isinstance(law, Free):
         return "none"
-    if isinstance(law, Frictionless) or (isinstance(law, Coulomb) and law.friction == 0):
+    if isinstance(law, ContactLaw) and (  # small or large sliding
+        not law.tangential or getattr(law, "friction", None) == 0
+    ):
         return "normal"
     return "full"
 

@@ -3,8 +3,9 @@
 One table (:data:`FIELDS`) names every key of every table with its type, range and
 meaning (:data:`SCHEMA` is its text); :func:`check_table` checks a table against it.
 Errors are :class:`SceneError`: one line ``KEY: message`` naming the key path
-(``interfaces[0].radius``) and the valid choices. The frozen dataclasses are what
-:func:`xfem_contact.scenes.scene.load_scene` returns.
+(``interfaces[0].radius``) and the valid choices. The frozen dataclasses
+(:mod:`xfem_contact.scenes.records`) are what :func:`xfem_contact.scenes.scene.load_scene`
+returns.
 """
 
 from __future__ import annotations
@@ -12,14 +13,13 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
-import pathlib
 import re
 from collections.abc import Callable
 
 from xfem_contact.mechanics.laws import CONTACT_LAWS, LBB_OPTIONS, LINEAR_LAWS
-from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
 from xfem_contact.scenes.expressions import check_expression
+from xfem_contact.scenes.records import InterfaceSpec, LoadSpec, Scene  # noqa: F401
 from xfem_contact.solvers.options import LINEAR_PRESETS, defaults
 
 _NEWTON = defaults("newton")  # the [solver] defaults are the Newton solver's
@@ -349,56 +349,3 @@ def check_table(value, fields: dict[str, Field], key: str) -> dict:
         elif field.required:
             raise SceneError(join(key, name), f"required: {field.doc}")
     return value
-
-
-@dataclasses.dataclass(frozen=True)
-class InterfaceSpec:
-    shape: str
-    law: str
-    inside: str
-    outside: str
-    params: dict
-    name: str = "interface"
-    friction: float | None = None
-    augmentation: float = 1.0
-    lbb: str = "stabilized"
-    kinematics: str = "small"
-    slave: int = -1
-    pairing: str = "iterate"
-
-
-@dataclasses.dataclass(frozen=True)
-class LoadSpec:
-    part: str | None
-    type: str
-    value: object
-    side: int | None = None
-    component: int | None = None
-    point: tuple | None = None
-    centre: tuple = (0.0, 0.0)
-
-
-@dataclasses.dataclass(frozen=True)
-class Scene:
-    """A validated scene (see the module docstring for the TOML form)."""
-
-    name: str
-    kind: str
-    file: pathlib.Path | None
-    size: float | None
-    corners: tuple
-    radii: tuple
-    geometry_degree: int
-    cells: tuple
-    cell: str
-    degree: int
-    levelset_degree: int
-    quadrature_degree: int
-    materials: dict[str, Material]
-    interfaces: tuple[InterfaceSpec, ...]
-    parts: dict[str, str]
-    loads: tuple[LoadSpec, ...]
-    outputs: dict
-    load_steps: int = 1
-    #: PETSc options of the solver (SNES/KSP, without prefix)
-    petsc_options: dict = dataclasses.field(default_factory=dict)

@@ -15,7 +15,13 @@ from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, Interface
 from xfem_contact.mechanics.laws.bonding import Bonded, Free
 from xfem_contact.mechanics.laws.contact import ContactLaw, Coulomb, Frictionless, Sticking
 from xfem_contact.mechanics.laws.multiplier import LBB_OPTIONS, MultiplierLaw
-from xfem_contact.mechanics.laws.sliding import SLIDING_LAWS, SlidingFrictionless, large_sliding
+from xfem_contact.mechanics.laws.sliding import (
+    SLIDING_LAWS,
+    SlidingContact,
+    SlidingCoulomb,
+    SlidingFrictionless,
+    large_sliding,
+)
 
 #: The laws by name
 LAWS: dict[str, type[InterfaceLaw]] = {
@@ -70,6 +76,8 @@ __all__ = [
     "InterfaceLaw",
     "MultiplierLaw",
     "SLIDING_LAWS",
+    "SlidingContact",
+    "SlidingCoulomb",
     "SlidingFrictionless",
     "large_sliding",
     "Sticking",

@@ -21,19 +21,19 @@ import ufl
 from ufl.algorithms import extract_arguments, extract_coefficients
 
 from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw
-from xfem_contact.mechanics.laws.contact import Frictionless
+from xfem_contact.mechanics.laws.contact import ContactLaw, Coulomb, Frictionless
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES, SlidingCoupling
 
 #: The laws available in large sliding (by their small-sliding name)
-SLIDING_LAWS = ("frictionless",)
+SLIDING_LAWS = ("frictionless", "coulomb")
 #: LBB treatments available in large sliding (the restriction needs a prolongation
 #: the hybrid element's assembly does not apply)
 SLIDING_LBB = ("stabilized", "none")
 
 
-class SlidingFrictionless(Frictionless):
-    """Frictionless contact in large sliding (augmented Lagrangian, normal multiplier
-    on the slave side).
+class SlidingContact(ContactLaw):
+    """Contact in large sliding (augmented Lagrangian, multipliers on the slave side;
+    abstract: :class:`SlidingFrictionless`, :class:`SlidingCoulomb`).
 
     Args:
         slave: The slave side (-1 or +1); the master is the other one.
@@ -47,6 +47,8 @@ class SlidingFrictionless(Frictionless):
 
     #: Large sliding
     sliding = True
+    #: Coulomb coefficient (None: frictionless)
+    friction: float | None = None
 
     def __init__(self, slave: int = -1, pairing: str = "iterate", radius=None, **options):
         super().__init__(**options)
@@ -78,14 +80,16 @@ class SlidingFrictionless(Frictionless):
         return ctx._cache["coupling"]
 
     # -- the UFL part: slave side only -------------------------------------------------
-    def slave_normal_traction(self, ctx: InterfaceContext, u: Fields):
-        """``(P N) . n~`` of the slave side (Pa per unit reference length), UFL."""
+    def slave_traction(self, ctx: InterfaceContext, u: Fields) -> tuple:
+        """``((P N) . n~, (P N) . t~)`` of the slave side (Pa per unit reference
+        length; ``t~ = n~`` turned by +90 degrees), UFL."""
         u_s = u.minus if self.slave == -1 else u.plus
         N = ctx.normal if self.slave == -1 else -ctx.normal
         F = ufl.Identity(len(u_s)) + ufl.grad(u_s)
         deformed = ufl.det(F) * ufl.inv(F).T * N
-        P = ctx.materials[self.slave].piola(u_s)
-        return ufl.dot(P * N, deformed) / ufl.sqrt(ufl.dot(deformed, deformed))
+        n = deformed / ufl.sqrt(ufl.dot(deformed, deformed))
+        T = ctx.materials[self.slave].piola(u_s) * N
+        return ufl.dot(T, n), ufl.dot(T, ufl.as_vector([-n[1], n[0]]))
 
     def residual(self, ctx: InterfaceContext, u: Fields, v: Fields):
         terms = []
@@ -97,8 +101,12 @@ class SlidingFrictionless(Frictionless):
             scale = (
                 self.multiplier_stabilization * ctx.cell_size / (2.0 * ctx.materials[self.slave].mu)
             )
-            misfit = u.multiplier - self.slave_normal_traction(ctx, u)
-            energy = 0.5 * scale * misfit**2 * ctx.measure
+            T_n, T_t = self.slave_traction(ctx, u)
+            lam_n, lam_t = self.multipliers(u)
+            misfit = (lam_n - T_n) ** 2
+            if lam_t is not None:
+                misfit = misfit + (lam_t - T_t) ** 2
+            energy = 0.5 * scale * misfit * ctx.measure
             terms.append(-ufl.derivative(energy, w, test))
         return sum(terms[1:], terms[0]) if terms else None
 
@@ -107,25 +115,61 @@ class SlidingFrictionless(Frictionless):
         """As :meth:`ContactLaw.state`, from the pairing at ``w``: the gap to the
         master foot (unpaired points: the distance to the lip, beyond the search
         radius), ``paired`` (1.0 or 0.0); tangential entries zero. Collective."""
-        pairing, terms = self.coupling(ctx).evaluate(w)
+        coupling = self.coupling(ctx)
+        pairing, terms = coupling.evaluate(w)
         zero = np.zeros(pairing.piece.size)
+        slip, lam_t, P_t = coupling.tangential if self.tangential else (zero, zero, zero)
         gap = np.where(pairing.paired, terms.gap, pairing.distance)
         return {
             "gap": gap,
-            "slip": zero,
-            "slip_increment": zero,
+            "slip": slip,
+            "slip_increment": slip,
             "lambda_n": terms.lambda_n,
-            "lambda_t": zero,
+            "lambda_t": lam_t,
             "P_n": terms.P_n,
-            "P_t": zero,
-            "r": self.coupling(ctx).r,
-            "trial_t": zero,
+            "P_t": P_t,
+            "r": coupling.r,
+            "trial_t": lam_t + coupling.r * slip,
             "paired": pairing.paired.astype(float),
         }
 
     def status(self, state: dict[str, np.ndarray]) -> dict[str, int]:
         counts = super().status(state)
         return counts | {"unpaired": int(np.sum(state["paired"] == 0.0))}
+
+
+class SlidingFrictionless(SlidingContact):
+    """Frictionless contact in large sliding: a normal multiplier only; the hybrid
+    element's Jacobian is the analytic one of :mod:`xfem_contact.mechanics.sliding.element`."""
+
+    name = "frictionless"
+    tangential = False
+
+
+class SlidingCoulomb(SlidingContact):
+    """Coulomb friction in large sliding, on the slip increment between accepted load
+    steps measured along the master surface (:mod:`xfem_contact.mechanics.sliding.friction`;
+    Jacobian by complex step).
+
+    Args:
+        friction: Coulomb coefficient ``mu`` (>= 0).
+        slave, pairing, radius, ...: See :class:`SlidingContact`.
+    """
+
+    name = "coulomb"
+    incremental = True
+
+    def __init__(self, friction: float, **options):
+        if friction is None or not friction >= 0.0:
+            raise ValueError(f"The friction coefficient must be >= 0, got {friction}")
+        super().__init__(**options)
+        self.friction = friction
+
+    def describe(self) -> dict:
+        return super().describe() | {"friction": self.friction}
+
+    def friction_bound(self, P_n, ops):
+        return -self.friction * P_n
 
 
 def large_sliding(law: InterfaceLaw, slave: int = -1, pairing: str = "iterate") -> InterfaceLaw:
@@ -138,20 +182,20 @@ def large_sliding(law: InterfaceLaw, slave: int = -1, pairing: str = "iterate") 
     """
     if getattr(law, "sliding", False) or law.linear:
         return law
-    if type(law) is not Frictionless:
+    if type(law) not in (Frictionless, Coulomb):
         raise ValueError(
             f"The {law.name!r} law is not available in large sliding "
             f"(kinematics = 'large'); valid: {SLIDING_LAWS}"
         )
-    return SlidingFrictionless(
-        slave=slave,
-        pairing=pairing,
-        augmentation=law.augmentation,
-        lbb=law.lbb,
-        multiplier_extension=law.multiplier_extension,
-        **(
-            {"multiplier_stabilization": law.multiplier_stabilization}
-            if law.lbb == "stabilized"
-            else {}
-        ),
-    )
+    options = {
+        "slave": slave,
+        "pairing": pairing,
+        "augmentation": law.augmentation,
+        "lbb": law.lbb,
+        "multiplier_extension": law.multiplier_extension,
+    }
+    if law.lbb == "stabilized":
+        options["multiplier_stabilization"] = law.multiplier_stabilization
+    if isinstance(law, Coulomb):
+        return SlidingCoulomb(law.friction, **options)
+    return SlidingFrictionless(**options)

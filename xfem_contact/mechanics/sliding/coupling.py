@@ -19,6 +19,8 @@ from petsc4py import PETSc
 
 from xfem_contact.fem.evaluation import cell_dofs, lagrange_element, rule_cells
 from xfem_contact.mechanics.sliding.element import PairTerms, frictionless_terms
+from xfem_contact.mechanics.sliding.friction import PointData
+from xfem_contact.mechanics.sliding.friction import terms as friction_terms
 from xfem_contact.mechanics.sliding.lips import MasterLip, global_dofs
 from xfem_contact.mechanics.sliding.projection import Pairing, closest_points
 
@@ -76,6 +78,13 @@ class SlidingCoupling:
         self._frozen: np.ndarray | None = None
         self._accepted_cells: np.ndarray | None = None
         self._merged: set = set()
+        #: Coulomb coefficient (None: frictionless, analytic Jacobian)
+        self.friction = getattr(law, "friction", None) if law.tangential else None
+        #: Frictionless through the complex-step element too (a cross-check)
+        self.complex_step = False
+        #: ``(slip increment (m), lambda_t, P_t (Pa))`` at the points (Coulomb)
+        self.tangential = None
+        self._old_slave = self._old_master = None
         self._coo: tuple | None = None
         #: Pairing counts of the last evaluation (global): paired, unpaired, changed
         self.counts: dict[str, int] = {}
@@ -89,6 +98,9 @@ class SlidingCoupling:
         for bc in bcs:
             columns[bc.dof_indices()[0]] = -1
         self.lip = MasterLip(self.ctx.cut, self.W, self.master_field, self.rows, columns)
+        if self._old_master is None or self._old_master.shape != self.lip.dofs.shape:
+            self._old_slave = np.zeros(self.slave_dofs.shape)
+            self._old_master = np.zeros(self.lip.dofs.shape)
         local = np.concatenate([self.slave_dofs, self.lam_dofs], axis=1)
         self._rows_local = global_dofs(self.W, local)
         self._columns_local = columns[local]
@@ -108,17 +120,20 @@ class SlidingCoupling:
         pairing = closest_points(lip, x_s, self.radius, only=self._frozen)
         pieces = np.where(pairing.paired, pairing.piece, 0)
         curve = lip.curve(pieces, pairing.s)
-        terms = frictionless_terms(
-            x_s,
-            self.phi_s,
-            self.lam_basis,
-            w.x.array[self.lam_dofs],
-            curve,
-            lip.orientation[pieces],
-            self.weights,
-            self.r,
-            pairing.paired,
-        )
+        if self.friction is None and not self.complex_step:
+            terms = frictionless_terms(
+                x_s,
+                self.phi_s,
+                self.lam_basis,
+                w.x.array[self.lam_dofs],
+                curve,
+                lip.orientation[pieces],
+                self.weights,
+                self.r,
+                pairing.paired,
+            )
+        else:
+            terms, self.tangential = self._complex_step_terms(w, pairing, pieces, curve)
         self._evaluated = (w.x.array.copy(), pairing, terms)
         paired = int(pairing.paired.sum())
         changed = 0
@@ -129,6 +144,28 @@ class SlidingCoupling:
         counts = self.comm.allreduce(counts, op=MPI.SUM)
         self.counts = dict(zip(("paired", "unpaired", "changed"), map(int, counts), strict=True))
         return pairing, terms
+
+    def _complex_step_terms(self, w, pairing, pieces, curve):
+        """The element of :mod:`~xfem_contact.mechanics.sliding.friction` (Coulomb,
+        or frictionless with ``complex_step``): terms and ``(slip increment,
+        lambda_t, P_t)``."""
+        X3, dddphi = self.lip.third_derivatives(pieces, pairing.s)
+        data = PointData(
+            self.x_ref,
+            self.phi_s,
+            self.lam_basis,
+            self.weights,
+            self.r,
+            self.lip.orientation[pieces],
+            ((*curve.geometry, X3), (curve.phi, curve.dphi, curve.ddphi, dddphi)),
+            (self._old_slave, self._old_master[pieces]),
+            pairing.paired,
+        )
+        z = np.concatenate(
+            [w.x.array[self.slave_dofs], w.x.array[self.lam_dofs], self.lip.values[pieces]],
+            axis=1,
+        )
+        return friction_terms(z, data, self.friction)
 
     def begin_step(self, w) -> None:
         """At the start of a solve: with ``update="step"``, pair now and keep the
@@ -145,6 +182,8 @@ class SlidingCoupling:
         pairing, _ = self.evaluate(w)
         pieces = np.where(pairing.paired, pairing.piece, 0)
         self._accepted_cells = np.where(pairing.paired, self.lip.cells[pieces], -1)
+        self._old_slave = w.x.array[self.slave_dofs]  # slips are measured from here
+        self._old_master = self.lip.gather(w)
 
     def unpaired_points(self, w) -> np.ndarray:
         """Reference coordinates (m) of the unpaired slave points of all processes,

@@ -32,6 +32,8 @@ class CurvePoint(typing.NamedTuple):
         t2: ``d^2x/ds^2`` (m), ``(m, 2)``.
         phi: The master displacement basis at the point, ``(m, nnodes)``.
         dphi: Its ``d/ds``, ``(m, nnodes)``.
+        ddphi: Its ``d^2/ds^2``, ``(m, nnodes)``.
+        geometry: The undeformed curve ``(X, X', X'')``, each ``(m, 2)`` (m).
     """
 
     x: npt.NDArray[np.float64]
@@ -39,33 +41,39 @@ class CurvePoint(typing.NamedTuple):
     t2: npt.NDArray[np.float64]
     phi: npt.NDArray[np.float64]
     dphi: npt.NDArray[np.float64]
+    ddphi: npt.NDArray[np.float64] | None = None
+    geometry: tuple | None = None
 
 
-def along(element, seg: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A cell basis and its first two ``s``-derivatives along SEG3 pieces.
+def along(element, seg: np.ndarray, s: np.ndarray, order: int = 2) -> tuple[np.ndarray, ...]:
+    """A cell basis and its ``s``-derivatives along SEG3 pieces.
 
     Args:
         element: Scalar Basix element of the cell.
         seg: Piece nodes (a, b, mid) in reference coordinates, ``(m, 3, 2)``.
         s: Piece parameter of each point, ``(m,)``.
+        order: Highest derivative (2 or 3).
 
     Returns:
-        ``(phi, dphi, ddphi)``, each ``(m, ndofs)``.
+        ``(phi, dphi, ddphi[, dddphi])``, each ``(m, ndofs)``.
     """
     N, dN = seg3_basis(s)
     X = np.einsum("mk,mkd->md", N, seg)
-    dX = np.einsum("mk,mkd->md", dN, seg)
-    ddX = np.einsum("k,mkd->md", _SEG3_SECOND, seg)
-    tab = element.tabulate(2, X)[..., 0]  # (6, m, ndofs): 1, x, y, xx, xy, yy
-    dphi = tab[1] * dX[:, :1] + tab[2] * dX[:, 1:]
-    ddphi = (
-        tab[3] * dX[:, :1] ** 2
-        + 2.0 * tab[4] * dX[:, :1] * dX[:, 1:]
-        + tab[5] * dX[:, 1:] ** 2
-        + tab[1] * ddX[:, :1]
-        + tab[2] * ddX[:, 1:]
+    x, y = np.einsum("mk,mkd->dm", dN, seg)[:, :, None]  # X'(s), components (m, 1)
+    xx, yy = np.einsum("k,mkd->dm", _SEG3_SECOND, seg)[:, :, None]  # X''(s); X''' = 0
+    tab = element.tabulate(order, X)[..., 0]  # 1, x, y, xx, xy, yy[, xxx, xxy, xyy, yyy]
+    dphi = tab[1] * x + tab[2] * y
+    ddphi = tab[3] * x * x + 2.0 * tab[4] * x * y + tab[5] * y * y + tab[1] * xx + tab[2] * yy
+    if order == 2:
+        return tab[0], dphi, ddphi
+    dddphi = (
+        tab[6] * x**3
+        + 3.0 * tab[7] * x * x * y
+        + 3.0 * tab[8] * x * y * y
+        + tab[9] * y**3
+        + 3.0 * (tab[3] * xx * x + tab[4] * (xx * y + yy * x) + tab[5] * yy * y)
     )
-    return tab[0], dphi, ddphi
+    return tab[0], dphi, ddphi, dddphi
 
 
 def global_dofs(W, local: np.ndarray) -> np.ndarray:
@@ -152,11 +160,25 @@ class MasterLip:
         master_sign = 1.0 if field == 1 else -1.0
         return np.where(np.sum(left * grad, axis=1) * master_sign < 0.0, 1.0, -1.0)
 
-    def refresh(self, w) -> None:
-        """Gather the master field's dof values of ``w`` (a Function on ``W``).
+    def gather(self, w) -> np.ndarray:
+        """The master field's dof values of ``w`` on every piece, ``(P, 2 nnodes)``.
         Collective."""
         local = w.x.array[self._local_dofs]
-        self.values = np.concatenate(self._comm.allgather(local)).reshape(self.dofs.shape)
+        return np.concatenate(self._comm.allgather(local)).reshape(self.dofs.shape)
+
+    def refresh(self, w) -> None:
+        """Gather the master field's dof values of ``w`` (a Function on ``W``) for
+        :meth:`curve`. Collective."""
+        self.values = self.gather(w)
+
+    def third_derivatives(self, pieces: np.ndarray, s: np.ndarray):
+        """``(X''', phi''')`` along the pieces: the undeformed curve's, ``(m, 2)``, and
+        the displacement basis's, ``(m, nnodes)`` (what a first-order expansion of
+        ``x''`` in ``s`` needs). Local."""
+        seg = self.seg[pieces]
+        dddpsi = along(self.coordinate_element, seg, s, order=3)[3]
+        dddphi = along(self.element, seg, s, order=3)[3]
+        return np.einsum("mi,mid->md", dddpsi, self.nodes[pieces]), dddphi
 
     def curve(self, pieces: np.ndarray, s: np.ndarray) -> CurvePoint:
         """The deformed curve of ``pieces`` ``(m,)`` at parameters ``s`` ``(m,)``
@@ -166,7 +188,8 @@ class MasterLip:
         phi, dphi, ddphi = along(self.element, seg, s)
         nodes = self.nodes[pieces]
         u = self.values[pieces].reshape(pieces.size, -1, 2)
-        x = np.einsum("mi,mid->md", psi, nodes) + np.einsum("mi,mid->md", phi, u)
-        t = np.einsum("mi,mid->md", dpsi, nodes) + np.einsum("mi,mid->md", dphi, u)
-        t2 = np.einsum("mi,mid->md", ddpsi, nodes) + np.einsum("mi,mid->md", ddphi, u)
-        return CurvePoint(x, t, t2, phi, dphi)
+        X = tuple(np.einsum("mi,mid->md", b, nodes) for b in (psi, dpsi, ddpsi))
+        x = X[0] + np.einsum("mi,mid->md", phi, u)
+        t = X[1] + np.einsum("mi,mid->md", dphi, u)
+        t2 = X[2] + np.einsum("mi,mid->md", ddphi, u)
+        return CurvePoint(x, t, t2, phi, dphi, ddphi, X)

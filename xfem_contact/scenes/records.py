@@ -1,0 +1,63 @@
+"""The validated scene records: frozen dataclasses of an interface, a load and a scene
+(:func:`xfem_contact.scenes.scene.load_scene` returns a :class:`Scene`; the keys and
+checks behind them are :mod:`xfem_contact.scenes.schema`'s). SI units."""
+
+from __future__ import annotations
+
+import dataclasses
+import pathlib
+
+from xfem_contact.mechanics.materials import Material
+
+
+@dataclasses.dataclass(frozen=True)
+class InterfaceSpec:
+    shape: str
+    law: str
+    inside: str
+    outside: str
+    params: dict
+    name: str = "interface"
+    friction: float | None = None
+    augmentation: float = 1.0
+    lbb: str = "stabilized"
+    kinematics: str = "small"
+    slave: int = -1
+    pairing: str = "iterate"
+
+
+@dataclasses.dataclass(frozen=True)
+class LoadSpec:
+    part: str | None
+    type: str
+    value: object
+    side: int | None = None
+    component: int | None = None
+    point: tuple | None = None
+    centre: tuple = (0.0, 0.0)
+
+
+@dataclasses.dataclass(frozen=True)
+class Scene:
+    """A validated scene (see the module docstring for the TOML form)."""
+
+    name: str
+    kind: str
+    file: pathlib.Path | None
+    size: float | None
+    corners: tuple
+    radii: tuple
+    geometry_degree: int
+    cells: tuple
+    cell: str
+    degree: int
+    levelset_degree: int
+    quadrature_degree: int
+    materials: dict[str, Material]
+    interfaces: tuple[InterfaceSpec, ...]
+    parts: dict[str, str]
+    loads: tuple[LoadSpec, ...]
+    outputs: dict
+    load_steps: int = 1
+    #: PETSc options of the solver (SNES/KSP, without prefix)
+    petsc_options: dict = dataclasses.field(default_factory=dict)
