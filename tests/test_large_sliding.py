@@ -26,7 +26,7 @@ from xfem_contact.mechanics.problem import Problem
 from xfem_contact.mechanics.sliding import element
 from xfem_contact.mechanics.sliding.lips import CurvePoint
 from xfem_contact.mechanics.sliding.projection import closest_points
-from xfem_contact.solvers.newton import RestrictedNewton
+from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton
 
 
 class ArcLip:
@@ -354,3 +354,21 @@ def test_coulomb_in_large_sliding_slides_on_the_cone():
     assert np.abs(np.abs(P_t) - 0.3 * np.abs(P_n)).max() < 1e-9 * np.abs(P_n).max()
     assert np.ptp(state["lambda_t"]) < 1e-8 * np.abs(state["lambda_t"]).max()
     assert np.all(P_t * state["slip_increment"] > 0)
+
+
+def test_a_failing_step_reports_its_history_and_keeps_the_accepted_state():
+    """A half turn in one step with two Newton iterations allowed: the failure
+    carries the history, ``w`` is the accepted state (not the diverged iterate,
+    not the rigidly turned predictor) and the next, smaller step succeeds."""
+    problem = rotating_annulus_problem(5, 2, np.pi)
+    problem.load_factor.set(0.25)
+    problem.solve()
+    problem.accept_step()
+    accepted = problem.w.x.array.copy()
+    problem.load_factor.set(1.0)
+    with pytest.raises(NewtonFailure, match="iterate  1") as failure:
+        problem.solve({"snes_max_it": 1})
+    assert failure.value.report.iterations == 1
+    assert np.array_equal(problem.w.x.array, accepted)
+    problem.load_factor.set(0.5)
+    assert problem.solve().iterations <= 10
