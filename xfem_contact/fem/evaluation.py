@@ -34,7 +34,8 @@ def cell_dofs(V: dolfinx.fem.FunctionSpace, cells: npt.NDArray[np.int32]) -> np.
     shape ``(len(cells), nnodes, value_size)``."""
     if V.component():
         bs = V.ufl_element().reference_value_size
-        return V.dofmap.list[cells].reshape(len(cells), -1, bs)
+        dofs = V.dofmap.list[cells]  # explicit shape: a process may have no cells here
+        return dofs.reshape(len(cells), dofs.shape[1] // bs, bs)
     bs = V.dofmap.bs
     return V.dofmap.list[cells][:, :, None] * bs + np.arange(bs)
 
