@@ -7,7 +7,7 @@ MPIEXEC := $(VENV)/bin/mpiexec
 PYTHON ?= $(shell for p in python3.12 $$HOME/.pyenv/versions/3.12*/bin/python3.12 python3.13 python3; do \
 	$$p -c 'import sys; assert sys.version_info >= (3, 12)' >/dev/null 2>&1 && { echo $$p; break; }; done)
 
-.PHONY: demo test test-serial test-mpi test-notebooks bench lint clean
+.PHONY: demo test test-serial test-mpi test-notebooks docs bench lint clean
 
 $(VENV)/.installed: pyproject.toml setup.py xfem_contact/_bootstrap.py
 	@test -n "$(PYTHON)" || { echo "error: no Python >= 3.12 found (set PYTHON=...)"; exit 1; }
@@ -23,6 +23,7 @@ test: $(VENV)/.installed
 	$(MAKE) test-serial
 	$(MAKE) test-mpi
 	$(MAKE) test-notebooks
+	$(MAKE) docs
 
 test-serial: $(VENV)/.installed
 	$(PY) -m pytest -q tests
@@ -34,6 +35,11 @@ test-notebooks: $(VENV)/.installed
 	@if ls notebooks/*.ipynb >/dev/null 2>&1; then \
 		$(PY) -m pytest -q --nbmake notebooks; \
 	else echo "no notebooks yet"; fi
+
+# the documentation site, warnings as errors (make test builds it too)
+docs: $(VENV)/.installed
+	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+	@echo "docs: docs/_build/html/index.html"
 
 bench: $(VENV)/.installed
 	$(PY) bench/quadrature.py

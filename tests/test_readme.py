@@ -120,6 +120,9 @@ def run(block: Block, cwd: pathlib.Path) -> None:
 
 
 BLOCKS = python_blocks(README.read_text(encoding="utf-8"))
+#: The documentation pages' own ```python blocks (the README's they include run above)
+DOCS = sorted((README.parent / "docs").glob("*.md"))
+DOC_BLOCKS = [(page.name, b) for page in DOCS for b in python_blocks(page.read_text("utf-8"))]
 
 
 def test_readme_has_python_blocks():
@@ -128,6 +131,13 @@ def test_readme_has_python_blocks():
 
 @pytest.mark.parametrize("block", BLOCKS, ids=[f"line{b.line}" for b in BLOCKS])
 def test_readme_block(block, tmp_path):
+    run(block, tmp_path)
+
+
+@pytest.mark.parametrize(
+    "page, block", DOC_BLOCKS, ids=[f"{page}:line{b.line}" for page, b in DOC_BLOCKS]
+)
+def test_docs_block(page, block, tmp_path):
     run(block, tmp_path)
 
 

@@ -10,7 +10,7 @@ foot ``s`` solves ``(x_s - x_m) . t = 0`` and the gap is ``g = (x_s - x_m) . n``
 Kept linearisation terms: all of them. ``grad g = (S - B)^T n`` (the variations of the
 foot and of the normal drop out of it at a closest point), and its Hessian adds the
 variation of the foot ``ds = -F_z / F_s`` and of the normal through the master's
-tangent derivative ``c = B'^T n`` and curvature ``kappa = n . x_m''``:
+tangent derivative ``c = B'^T n`` and curvature ``kappa = n . x_m''``::
 
     H = -(ds c^T + c ds^T) (1 - g kappa / |t|^2) + (F_s kappa / |t|^2) ds ds^T
         + (g / |t|^2) c c^T,    F_s = -|t|^2 + g kappa,  F_z = (S - B)^T t + g c.
@@ -18,7 +18,7 @@ tangent derivative ``c = B'^T n`` and curvature ``kappa = n . x_m''``:
 The frictionless augmented-Lagrangian law of
 :class:`~xfem_contact.mechanics.laws.contact.ContactLaw` then gives, with
 ``lambda_n = L l``, ``P = min(0, lambda_n + r g)`` and the slave point's weight ``w``
-(reference arc length, m):
+(reference arc length, m)::
 
     R = w (P grad g - (lambda_n - P) L / r)
     K = w (grad g L^T + L grad g^T + r grad g grad g^T + P H)   (contact, P < 0)

@@ -12,7 +12,7 @@ which is why the curve's third derivative is needed.
 Slip increment (between accepted load steps, measured along the master surface):
 ``s_t = tau . (du_s - du_m(s))``, ``du`` the displacements since the last
 accepted step at the slave point and at the current foot, ``tau = (-n_y, n_x)``
-the master tangent (``n`` out of the master). Its gradient, at a closest point:
+the master tangent (``n`` out of the master). Its gradient, at a closest point::
 
     grad s_t = (S - B)^T tau - o (n . d) / |t| (B'^T n + (n . x_m'') grad s)
                - (tau . (B' (b - b_old))) grad s,     grad s = -F_z / F_s,

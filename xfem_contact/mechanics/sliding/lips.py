@@ -94,7 +94,9 @@ class MasterLip:
         columns: Reduced column of every local dof of ``W`` (-1: not an unknown of
             the Jacobian: inactive or Dirichlet), ``(num_local_dofs,)``.
 
-    Attributes (global, identical on all processes, rank by rank):
+    The attributes are global: identical on all processes, pieces rank by rank.
+
+    Attributes:
         seg: Piece nodes in their cell's reference coordinates, ``(P, 3, 2)``.
         nodes: The cell's geometry nodes (m), ``(P, ngeom, 2)``.
         dofs: Global dofs of ``W`` of the master field on the cell, ``(P, 2 nnodes)``

@@ -1,0 +1,46 @@
+"""Sphinx configuration of the xfem-contact documentation (``make docs``).
+
+The pages are markdown (MyST); the API reference comes from the docstrings
+(autodoc + napoleon, Google style); the scene file reference and the solver options
+table are generated from the code at every build (:mod:`reference`), so they cannot
+drift from what the package accepts.
+"""
+
+import pathlib
+import sys
+
+import xfem_contact  # before dolfinx (the PyPI wheel's MPI)
+
+HERE = pathlib.Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+import reference  # noqa: E402
+
+project = "xfem-contact"
+author = "the xfem-contact developers"
+release = version = xfem_contact.__version__
+extensions = [
+    "myst_parser",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.napoleon",
+    "sphinx.ext.viewcode",
+]
+myst_enable_extensions = ["colon_fence"]
+myst_heading_anchors = 3
+source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
+exclude_patterns = ["_build", "README.md"]
+html_theme = "alabaster"
+html_theme_options = {"page_width": "1100px", "sidebar_width": "240px"}
+html_title = f"xfem-contact {release}"
+autodoc_member_order = "bysource"
+autodoc_typehints = "none"  # the docstrings state units and shapes
+autodoc_default_options = {"members": True, "show-inheritance": True}
+napoleon_google_docstring = True
+napoleon_numpy_docstring = False
+napoleon_use_ivar = True  # attributes as fields: no second description of tuple fields
+# pages include README sections, whose headings start at ### under the page's #
+suppress_warnings = ["myst.header"]
+
+
+def setup(app):
+    reference.write(HERE / "generated")
