@@ -7,7 +7,7 @@ pressure is n.sigma.n = -3/2 + cos(2 theta)/2 and the tangential traction
 -sin(2 theta)/2. Quadratic displacement, linear multipliers (the paper's P2-P1
 element) by default; generalized Newton (PETSc SNES) on the augmented Lagrangian.
 
-Writes in --out: VTX files of the displacement of each side and of the
+Writes in ``--out``: VTX files of the displacement of each side and of the
 multipliers, ``result.vtu`` (the lips), ``subcells.vtu``/``interface.vtu`` (the
 cut), a PNG of the contact pressure against the angle with the exact curve, and a
 JSON summary (``--json``, default OUT/summary.json); ``xfem-contact show OUT``
@@ -17,6 +17,12 @@ Run: ``python demos/inclusion_contact.py [--n 40] [--degree 2] [--law sticking]`
 also under ``mpiexec -n 2``.
 """
 
+# %% [markdown]
+# ## Imports
+# The start-up hook installed with xfem-contact loads the PyPI wheel's MPI library
+# before DOLFINx, so the import order is free.
+
+# %%
 import argparse
 import pathlib
 import time
@@ -30,7 +36,15 @@ from xfem_contact.io.output import write_cut_geometry, write_fields, write_json,
 from xfem_contact.io.plots import Series, line_plot
 from xfem_contact.solvers.options import LINEAR_PRESETS, preset
 
+# %% [markdown]
+# ## The run
+# Flags, the problem of paper case 2 ({func}`xfem_contact.cases.paper.inclusion_problem`),
+# one generalized-Newton solve with a line per iterate, the interface errors against the
+# exact uniform-stress pressure, then the output: VTX fields, the lips and the cut as
+# `.vtu`, the pressure plot and the JSON summary with the time of each phase.
 
+
+# %%
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=40, help="cells per side (even)")
@@ -124,6 +138,12 @@ def main():
         say(f"  wrote {path}, {out / 'contact_pressure.png'} and VTX/.vtu files in {out}")
 
 
+# %% [markdown]
+# ## The contact pressure against the angle
+# The multiplier at the interface quadrature points and the exact `n . sigma n`.
+
+
+# %%
 def plot(path, theta, pressure, args):
     t = np.linspace(-np.pi, np.pi, 400)
     line_plot(
@@ -138,5 +158,6 @@ def plot(path, theta, pressure, args):
     )
 
 
+# %%
 if __name__ == "__main__":
     main()

@@ -7,9 +7,9 @@ it). Saint Venant-Kirchhoff bulk (large rotations, small strains); every slave
 point of the inner lip is paired with its closest point on the deformed outer lip
 at every Newton iterate (the paper's hybrid element). The exact contact pressure is
 uniform for any alpha: -1.1155 MPa in small strain, -1.1131 MPa for this bulk model
-(a radial ODE, :func:`xfem_contact.cases.rotation.svk_annulus_pressure`).
+(a radial ODE, ``xfem_contact.cases.rotation.svk_annulus_pressure``).
 
-Writes in --out: VTX files of each side's displacement (the deformed configuration:
+Writes in ``--out``: VTX files of each side's displacement (the deformed configuration:
 warp by ``u`` at scale 1 in ParaView) and of the multiplier, ``result.vtu`` (the
 lips), a PNG of lambda_n against the angle (the paper's Fig. 8; both degrees with
 ``--degree both``) and a JSON summary (``--json``, default OUT/summary.json).
@@ -18,6 +18,12 @@ Run: ``python demos/rotating_inclusion.py [--n 20] [--degree 2] [--alpha 1.5708]
 [--steps 4]``, also under ``mpiexec -n 2``.
 """
 
+# %% [markdown]
+# ## Imports
+# The start-up hook installed with xfem-contact loads the PyPI wheel's MPI library
+# before DOLFINx, so the import order is free.
+
+# %%
 import argparse
 import pathlib
 import sys
@@ -42,7 +48,13 @@ from xfem_contact.mechanics.loading import load_steps
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
 from xfem_contact.solvers.newton import NewtonFailure
 
+# %% [markdown]
+# ## Flags
+# Mesh, degree (or both), angle, load steps, law and friction, the outer support, the
+# pairing update and the output paths.
 
+
+# %%
 def arguments():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=20, help="cells across the annulus")
@@ -61,6 +73,15 @@ def arguments():
     return parser.parse_args()
 
 
+# %% [markdown]
+# ## One degree: the load steps
+# The problem ({func}`xfem_contact.cases.rotation.rotating_annulus_problem`), then per load
+# step one Newton solve (a line per iterate) and the pairing counts; a failing step is
+# reported with its history and the last accepted state is kept and written. Then the
+# errors against the exact pressure of the same bulk model, the fields and the summary.
+
+
+# %%
 def solve(args, degree: int, say, comm) -> tuple[dict, dict]:
     """Build and solve one degree; returns (summary, samples)."""
     timings, start = {}, time.perf_counter()
@@ -145,6 +166,13 @@ def solve(args, degree: int, say, comm) -> tuple[dict, dict]:
     return summary, samples
 
 
+# %% [markdown]
+# ## Both degrees and the figure
+# The paper's Fig. 8: lambda_n against the angle on the reference interface, with the
+# exact pressures of the Saint Venant-Kirchhoff and the small-strain models.
+
+
+# %%
 def main() -> int:
     args = arguments()
     comm = MPI.COMM_WORLD
@@ -184,5 +212,6 @@ def main() -> int:
     return 0 if all(r[0]["completed"] for r in results) else 1
 
 
+# %%
 if __name__ == "__main__":
     sys.exit(main())

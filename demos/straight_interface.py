@@ -16,6 +16,11 @@ Run: ``python demos/straight_interface.py --degree 2 --cell quadrilateral``
 (also under ``mpiexec -n 2``).
 """
 
+# %% [markdown]
+# ## Imports
+# `xfem_contact` first (the PyPI wheel's MPI library), then DOLFINx and UFL.
+
+# %%
 import argparse
 import pathlib
 import time
@@ -33,7 +38,14 @@ from xfem_contact.fem.evaluation import evaluate_at_rules, interface_points
 from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
 from xfem_contact.io.plots import Series, line_plot
 
+# %% [markdown]
+# ## The run
+# Paper case 1: the plate cut by the straight interface y = 1 (free), one linear
+# solve, the interface displacement of both blocks against the exact quadratic field,
+# the output files and the JSON summary.
 
+
+# %%
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--degree", type=int, default=2, choices=[1, 2])
@@ -123,6 +135,11 @@ def main():
         say(f"wrote {path}, {out / 'interface_displacement.png'}, VTX and .vtu files in {out}")
 
 
+# %% [markdown]
+# ## The interface displacement (the paper's Fig. 4)
+
+
+# %%
 def plot(path, upper, lower, args):
     x = np.linspace(-1.5, 1.5, 200)
     line_plot(
@@ -138,5 +155,6 @@ def plot(path, upper, lower, args):
     )
 
 
+# %%
 if __name__ == "__main__":
     main()

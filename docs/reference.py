@@ -150,10 +150,28 @@ def solver_options() -> str:
 def write(folder: pathlib.Path) -> None:
     """Write the generated pages into ``folder`` (created)."""
     folder.mkdir(parents=True, exist_ok=True)
-    for name, text in (
-        ("scene_reference.md", scene_reference()),
-        ("solver_options.md", solver_options()),
-    ):
+    pages = {"scene_reference.md": scene_reference(), "solver_options.md": solver_options()}
+    for demo in sorted((folder.parent.parent / "demos").glob("*.py")):
+        pages[f"demo_{demo.stem}.md"] = demo_page(demo)
+    for name, text in pages.items():
         path = folder / name
         if not path.exists() or path.read_text() != text:  # keep Sphinx's cache valid
             path.write_text(text)
+
+
+def demo_page(path: pathlib.Path) -> str:
+    """A demo (jupytext percent format) as a page: its docstring, then its markdown
+    cells as text and its code cells as code, in order."""
+    source = path.read_text()
+    tree = ast.parse(source)
+    docstring = ast.get_docstring(tree) or path.stem
+    title, _, rest = docstring.partition("\n")
+    lines = [f"# {title}", "", rest.strip(), "", f"Source: `demos/{path.name}`.", ""]
+    body = source[source.index('"""', source.index('"""') + 3) + 3 :]
+    for cell in body.split("# %%")[1:]:
+        if cell.startswith(" [markdown]"):
+            text = [line[2:] if line.startswith("# ") else "" for line in cell.splitlines()[1:]]
+            lines += ["\n".join(text).strip(), ""]
+        elif code := cell.strip("\n"):
+            lines += ["```python", code, "```", ""]
+    return "\n".join(lines)
