@@ -47,7 +47,7 @@ bench: $(VENV)/.installed
 	$(PY) bench/scaling.py --ranks 2
 	$(PY) bench/iterative.py --tiny
 	$(PY) bench/rotating_inclusion.py --no-progress
-	$(PY) bench/accuracy_vs_time.py
+	$(PY) bench/accuracy_vs_time.py --no-progress
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check xfem_contact tests demos bench

@@ -38,6 +38,8 @@ import xfem_contact  # noqa: F401  (before dolfinx with the PyPI wheel)
 # isort: split
 import numpy as np
 
+from xfem_contact.io.progress import note, progress
+
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
 MARKERS = ("<!-- accuracy:start -->", "<!-- accuracy:end -->")
@@ -544,6 +546,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="three sizes per sweep")
     parser.add_argument("--no-readme", action="store_true", help="leave README.md alone")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument(
         "--report-only", action="store_true", help="redo the report from the saved results"
     )
@@ -562,7 +565,9 @@ def main():
         saved = json.loads(out.read_text())
         return publish(saved["rows"], saved["moving"], out, not args.no_readme)
     rows = []
-    for case, method, option, worker_args, sizes, quick in SWEEPS:
+
+    sweeps = progress(SWEEPS, "accuracy vs time: sweeps", not args.no_progress)
+    for case, method, option, worker_args, sizes, quick in sweeps:
         chosen = quick if args.quick else sizes
         command = [sys.executable, __file__, "--worker", *worker_args, "--sizes", *map(str, chosen)]
         start = time.perf_counter()
@@ -574,11 +579,10 @@ def main():
             print(f"{case} / {method} / {option}: failed:\n{result.stderr[-2000:]}", flush=True)
         for row in found:
             rows.append({"case": case, "method": method, "option": option} | row)
-        print(
+        note(  # above the progress bar
             f"{case} / {method} / {option}: {len(found)} sizes in "
             f"{time.perf_counter() - start:.1f} s; errors "
-            + ", ".join(f"{r['error']:.1e}" for r in found),
-            flush=True,
+            + ", ".join(f"{r['error']:.1e}" for r in found)
         )
     result = subprocess.run(
         [sys.executable, __file__, "--moving"], capture_output=True, text=True, cwd=ROOT
