@@ -44,155 +44,43 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
 MARKERS = ("<!-- accuracy:start -->", "<!-- accuracy:end -->")
 
-#: (case, method, option label, worker arguments, sizes, quick sizes)
+#: Mesh sizes of each family of sweeps: (full run, --quick)
+SIZES = {
+    "geometry": ([8, 16, 32, 64, 128], [8, 16, 32]),
+    "case 1": ([5, 9, 17, 33, 65], [5, 9, 17]),
+    "case 2": ([10, 20, 40, 80, 160], [10, 20, 40]),
+    "iterative": ([10, 20, 40, 60, 80], [10, 20]),
+    "case 3": ([5, 10, 20, 40, 80], [5, 10, 20]),
+    "rotated": ([5, 8, 10, 20, 40], [5, 10]),
+}
+X, FIT = "X-FEM", "body-fitted"
+#: (case, method, option label, worker arguments, size family), one row a sweep
+# fmt: off
 SWEEPS = [
-    (
-        "geometry",
-        "X-FEM",
-        "P2 level set, callable",
-        ["geometry", "2", "callable", "6"],
-        [8, 16, 32, 64, 128],
-        [8, 16, 32],
-    ),
-    (
-        "geometry",
-        "X-FEM",
-        "P2 level set, Function",
-        ["geometry", "2", "function", "6"],
-        [8, 16, 32, 64, 128],
-        [8, 16, 32],
-    ),
-    (
-        "geometry",
-        "X-FEM",
-        "P1 level set, callable",
-        ["geometry", "1", "callable", "6"],
-        [8, 16, 32, 64, 128],
-        [8, 16, 32],
-    ),
-    (
-        "geometry",
-        "X-FEM",
-        "P2 level set, quadrature 4",
-        ["geometry", "2", "callable", "4"],
-        [8, 16, 32, 64, 128],
-        [8, 16, 32],
-    ),
-    (
-        "geometry",
-        "X-FEM",
-        "P2 level set, quadrature 8",
-        ["geometry", "2", "callable", "8"],
-        [8, 16, 32, 64, 128],
-        [8, 16, 32],
-    ),
-    ("case 1", "X-FEM", "P1", ["case1", "1"], [5, 9, 17, 33, 65], [5, 9, 17]),
-    ("case 1", "X-FEM", "P2", ["case1", "2"], [5, 9, 17, 33, 65], [5, 9, 17]),
-    (
-        "case 2",
-        "X-FEM",
-        "P1 quads",
-        ["case2", "1", "quadrilateral", "stabilized", "direct"],
-        [10, 20, 40, 80, 160],
-        [10, 20, 40],
-    ),
-    (
-        "case 2",
-        "X-FEM",
-        "P2 quads",
-        ["case2", "2", "quadrilateral", "stabilized", "direct"],
-        [10, 20, 40, 80, 160],
-        [10, 20, 40],
-    ),
-    (
-        "case 2",
-        "X-FEM",
-        "P2 triangles",
-        ["case2", "2", "triangle", "stabilized", "direct"],
-        [10, 20, 40, 80, 160],
-        [10, 20, 40],
-    ),
-    (
-        "case 2",
-        "X-FEM",
-        "P2 quads, LBB restriction",
-        ["case2", "2", "quadrilateral", "restriction", "direct"],
-        [10, 20, 40, 80, 160],
-        [10, 20, 40],
-    ),
-    (
-        "case 2",
-        "X-FEM",
-        "P2 quads, iterative",
-        ["case2", "2", "quadrilateral", "stabilized", "iterative"],
-        [10, 20, 40, 60, 80],
-        [10, 20],
-    ),
-    (
-        "case 2",
-        "body-fitted",
-        "P1 triangles",
-        ["fitted2", "1"],
-        [10, 20, 40, 80, 160],
-        [10, 20, 40],
-    ),
-    (
-        "case 2",
-        "body-fitted",
-        "P2 triangles, curved",
-        ["fitted2", "2"],
-        [10, 20, 40, 80, 160],
-        [10, 20, 40],
-    ),
-    (
-        "case 3, alpha = 0",
-        "X-FEM",
-        "P1 (straight cells)",
-        ["case3", "1"],
-        [5, 10, 20, 40, 80],
-        [5, 10, 20],
-    ),
-    (
-        "case 3, alpha = 0",
-        "X-FEM",
-        "P2 (curved cells)",
-        ["case3", "2"],
-        [5, 10, 20, 40, 80],
-        [5, 10, 20],
-    ),
-    (
-        "case 3, alpha = 0",
-        "body-fitted",
-        "P1 triangles",
-        ["fitted3", "1"],
-        [5, 10, 20, 40, 80],
-        [5, 10, 20],
-    ),
-    (
-        "case 3, alpha = 0",
-        "body-fitted",
-        "P2 triangles, curved",
-        ["fitted3", "2"],
-        [5, 10, 20, 40, 80],
-        [5, 10, 20],
-    ),
-    (
-        "case 3, alpha = pi/2",
-        "X-FEM",
-        "P1, large sliding",
-        ["case3rot", "1"],
-        [5, 8, 10, 20, 40],
-        [5, 10],
-    ),
-    (
-        "case 3, alpha = pi/2",
-        "X-FEM",
-        "P2, large sliding",
-        ["case3rot", "2"],
-        [5, 8, 10, 20, 40],
-        [5, 10],
-    ),
+    ("geometry", X, "P2 level set, callable", ["geometry", "2", "callable", "6"], "geometry"),
+    ("geometry", X, "P2 level set, Function", ["geometry", "2", "function", "6"], "geometry"),
+    ("geometry", X, "P1 level set, callable", ["geometry", "1", "callable", "6"], "geometry"),
+    ("geometry", X, "P2 level set, quadrature 4", ["geometry", "2", "callable", "4"], "geometry"),
+    ("geometry", X, "P2 level set, quadrature 8", ["geometry", "2", "callable", "8"], "geometry"),
+    ("case 1", X, "P1", ["case1", "1"], "case 1"),
+    ("case 1", X, "P2", ["case1", "2"], "case 1"),
+    ("case 2", X, "P1 quads", ["case2", "1", "quadrilateral", "stabilized", "direct"], "case 2"),
+    ("case 2", X, "P2 quads", ["case2", "2", "quadrilateral", "stabilized", "direct"], "case 2"),
+    ("case 2", X, "P2 triangles", ["case2", "2", "triangle", "stabilized", "direct"], "case 2"),
+    ("case 2", X, "P2 quads, LBB restriction",
+     ["case2", "2", "quadrilateral", "restriction", "direct"], "case 2"),
+    ("case 2", X, "P2 quads, iterative",
+     ["case2", "2", "quadrilateral", "stabilized", "iterative"], "iterative"),
+    ("case 2", FIT, "P1 triangles", ["fitted2", "1"], "case 2"),
+    ("case 2", FIT, "P2 triangles, curved", ["fitted2", "2"], "case 2"),
+    ("case 3, alpha = 0", X, "P1 (straight cells)", ["case3", "1"], "case 3"),
+    ("case 3, alpha = 0", X, "P2 (curved cells)", ["case3", "2"], "case 3"),
+    ("case 3, alpha = 0", FIT, "P1 triangles", ["fitted3", "1"], "case 3"),
+    ("case 3, alpha = 0", FIT, "P2 triangles, curved", ["fitted3", "2"], "case 3"),
+    ("case 3, alpha = pi/2", X, "P1, large sliding", ["case3rot", "1"], "rotated"),
+    ("case 3, alpha = pi/2", X, "P2, large sliding", ["case3rot", "2"], "rotated"),
 ]
+# fmt: on
 
 
 # -- the workers (one process per sweep) -----------------------------------------------
@@ -567,8 +455,8 @@ def main():
     rows = []
 
     sweeps = progress(SWEEPS, "accuracy vs time: sweeps", not args.no_progress)
-    for case, method, option, worker_args, sizes, quick in sweeps:
-        chosen = quick if args.quick else sizes
+    for case, method, option, worker_args, family in sweeps:
+        chosen = SIZES[family][1 if args.quick else 0]
         command = [sys.executable, __file__, "--worker", *worker_args, "--sizes", *map(str, chosen)]
         start = time.perf_counter()
         result = subprocess.run(command, capture_output=True, text=True, cwd=ROOT)
