@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
+import weakref
 from collections.abc import Callable, Mapping
 
 import dolfinx.fem
@@ -281,7 +282,7 @@ class Problem(Loads):
                 self._bcs,
                 self.restriction(),
                 petsc_options,
-                status=self.interface_status,
+                status=_weak_method(self.interface_status),
                 log=log,
                 splits=field_splits(self.space) if split else None,
                 near_nullspace=rigid_modes(self.space) if split else None,
@@ -383,3 +384,12 @@ class Problem(Loads):
         local |= {k: state[k] for k in keys if k in state}
         comm = self.mesh.comm
         return {k: np.concatenate(comm.allgather(v)).tolist() for k, v in local.items()}
+
+
+def _weak_method(method: Callable) -> Callable:
+    """``method`` called through a weak reference to its object: the Newton solver a
+    problem owns must not keep the problem alive (a reference cycle holds the meshes'
+    MPI communicators until the cyclic collector runs; MPICH runs out of them after
+    about 120 problems on 2 ranks)."""
+    ref = weakref.WeakMethod(method)
+    return lambda *args: ref()(*args)

@@ -53,7 +53,8 @@ class SlidingCoupling:
         if update not in PAIRING_UPDATES:
             raise ValueError(f"pairing update must be one of {PAIRING_UPDATES}, got {update!r}")
         cut = ctx.cut
-        self.ctx, self.W, self.law, self.update_mode = ctx, W, law, update
+        # not the context itself: it caches this object (a reference cycle)
+        self.cut, self.W, self.law, self.update_mode = cut, W, law, update
         self.slave_field, self.master_field = (0, 1) if slave == -1 else (1, 0)
         self.comm = cut.mesh.comm
         rules = ctx.rules
@@ -66,8 +67,8 @@ class SlidingCoupling:
         V_s, V_l = W.sub(self.slave_field), W.sub(ctx.field)
         self.phi_s = lagrange_element(V_s).tabulate(0, X)[0, :, :, 0]
         self.lam_basis = lagrange_element(V_l).tabulate(0, X)[0, :, :, 0]
-        self.slave_dofs = cell_dofs(V_s, cells).reshape(cells.size, -1)
-        self.lam_dofs = cell_dofs(V_l, cells).reshape(cells.size, -1)
+        self.slave_dofs = _flat(cell_dofs(V_s, cells))  # (m, nodes x components)
+        self.lam_dofs = _flat(cell_dofs(V_l, cells))
         self.r = law.augmentation_coefficient(ctx, ctx.cell_size_at())
         h = ctx.cell_size_at()
         self.radius = radius or self.comm.allreduce(float(h.max(initial=0.0)), op=MPI.MAX)
@@ -97,7 +98,7 @@ class SlidingCoupling:
         columns = np.array(columns, dtype=np.int64)
         for bc in bcs:
             columns[bc.dof_indices()[0]] = -1
-        self.lip = MasterLip(self.ctx.cut, self.W, self.master_field, self.rows, columns)
+        self.lip = MasterLip(self.cut, self.W, self.master_field, self.rows, columns)
         if self._old_master is None or self._old_master.shape != self.lip.dofs.shape:
             self._old_slave = np.zeros(self.slave_dofs.shape)
             self._old_master = np.zeros(self.lip.dofs.shape)
@@ -115,7 +116,8 @@ class SlidingCoupling:
             return self._evaluated[1], self._evaluated[2]
         lip = self.lip
         lip.refresh(w)
-        u_s = w.x.array[self.slave_dofs].reshape(self.slave_dofs.shape[0], -1, 2)
+        m, n = self.slave_dofs.shape
+        u_s = w.x.array[self.slave_dofs].reshape(m, n // 2, 2)
         x_s = self.x_ref + np.einsum("mi,mid->md", self.phi_s, u_s)
         pairing = closest_points(lip, x_s, self.radius, only=self._frozen)
         pieces = np.where(pairing.paired, pairing.piece, 0)
@@ -251,3 +253,9 @@ class SlidingCoupling:
         if self._coo is not None:
             self._coo[1].destroy()
             self._coo = None
+
+
+def _flat(dofs: np.ndarray) -> np.ndarray:
+    """``(m, nodes, components)`` dofs as ``(m, nodes x components)``, node by node
+    (explicit sizes: a process may hold no point of the interface)."""
+    return dofs.reshape(dofs.shape[0], dofs.shape[1] * dofs.shape[2])

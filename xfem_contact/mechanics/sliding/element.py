@@ -66,8 +66,8 @@ def gap_derivatives(x_s, phi_s, curve, orientation):
 
     def slots(basis_a, basis_b, v):
         """``[basis_a (x) v, basis_b (x) v]`` node by node, ``(m, 2 nn_a + 2 nn_b)``."""
-        a = (basis_a[:, :, None] * v[:, None, :]).reshape(m, -1)
-        b = (basis_b[:, :, None] * v[:, None, :]).reshape(m, -1)
+        a = (basis_a[:, :, None] * v[:, None, :]).reshape(m, 2 * basis_a.shape[1])
+        b = (basis_b[:, :, None] * v[:, None, :]).reshape(m, 2 * basis_b.shape[1])
         return np.concatenate([a, b], axis=1)
 
     zero_s = np.zeros_like(phi_s)

@@ -90,9 +90,10 @@ def residual(z: np.ndarray, data: PointData, friction: float | None):
     c = 1 if friction is None else 2
     a = z[:, : 2 * nn_s].reshape(m, nn_s, 2)
     lam = z[:, 2 * nn_s : 2 * nn_s + c * nl].reshape(m, nl, c)
-    b = z[:, 2 * nn_s + c * nl :].reshape(m, -1, 2)
+    nn_m = data.curve[1][0].shape[1]
+    b = z[:, 2 * nn_s + c * nl :].reshape(m, nn_m, 2)
     (X, X1, X2, X3), (phi, dphi, ddphi, dddphi) = data.curve
-    a_old, b_old = (v.reshape(m, -1, 2) for v in data.old)
+    a_old, b_old = data.old[0].reshape(m, nn_s, 2), data.old[1].reshape(m, nn_m, 2)
 
     def field(basis, values):
         return np.einsum("mi,mid->md", basis, values)
@@ -113,8 +114,8 @@ def residual(z: np.ndarray, data: PointData, friction: float | None):
     kappa = _dot(n, t2)
 
     def slots(basis_s, basis_m, v):
-        zs = (basis_s[:, :, None] * v[:, None, :]).reshape(m, -1)
-        zm = (basis_m[:, :, None] * v[:, None, :]).reshape(m, -1)
+        zs = (basis_s[:, :, None] * v[:, None, :]).reshape(m, 2 * basis_s.shape[1])
+        zm = (basis_m[:, :, None] * v[:, None, :]).reshape(m, 2 * basis_m.shape[1])
         return np.concatenate([zs, np.zeros((m, c * nl), dtype=zs.dtype), zm], axis=1)
 
     def multiplier_slot(k):

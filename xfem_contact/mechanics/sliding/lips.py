@@ -121,7 +121,8 @@ class MasterLip:
         V = W.sub(field)
         self.element = lagrange_element(V)
         self.coordinate_element = cut.maps.coordinate_element
-        local_dofs = cell_dofs(V, cells).reshape(cells.size, -1)
+        dofs = cell_dofs(V, cells)  # explicit sizes: a process may hold no piece
+        local_dofs = dofs.reshape(cells.size, dofs.shape[1] * dofs.shape[2])
         self._local_dofs = local_dofs
         orientation = self._orientation(cut, cells, seg, field)
         tdim = cut.mesh.topology.dim
@@ -189,7 +190,7 @@ class MasterLip:
         psi, dpsi, ddpsi = along(self.coordinate_element, seg, s)
         phi, dphi, ddphi = along(self.element, seg, s)
         nodes = self.nodes[pieces]
-        u = self.values[pieces].reshape(pieces.size, -1, 2)
+        u = self.values[pieces].reshape(pieces.size, self.values.shape[1] // 2, 2)
         X = tuple(np.einsum("mi,mid->md", b, nodes) for b in (psi, dpsi, ddpsi))
         x = X[0] + np.einsum("mi,mid->md", phi, u)
         t = X[1] + np.einsum("mi,mid->md", dphi, u)
