@@ -121,3 +121,20 @@ def test_two_interfaces_a_cell_apart(gap_cells):
         theta = np.arctan2(np.array(samples["y"]) - cy, np.array(samples["x"]) - cx)
         exact = -1.5 + 0.5 * np.cos(2 * theta)
         assert np.abs(np.array(samples["lambda_n"]) - exact).max() < 1e-2
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize(
+    "radius, what", [(0.2, "tangent to the lines x, y = 0.3, 0.7"), (0.25, "through vertices")]
+)
+def test_tangent_and_vertex_cuts_keep_the_error(radius, what):
+    """20 x 20 cells: the circle of radius 0.2 touches four mesh lines tangentially, the
+    one of radius 0.25 passes through mesh vertices; errors within twice the generic
+    cut's (radius 0.225)."""
+
+    def error(r):
+        problem = inclusion_problem(20, 2, "sticking", radius=r)
+        assert problem.solve().iterations <= 30
+        return inclusion_errors(problem, problem.w).pressure
+
+    assert error(radius) <= ERROR_FACTOR * error(0.225), what
