@@ -106,6 +106,7 @@ def solve(args, degree: int, say, comm) -> tuple[dict, dict]:
             break
         problem.accept_step()
         counts = problem.pairing_counts()["interface"]
+        unpaired = problem.unpaired_points()["interface"]  # collective
         history.append(
             {
                 "load_factor": float(t),
@@ -113,6 +114,7 @@ def solve(args, degree: int, say, comm) -> tuple[dict, dict]:
                 "newton_iterations": report.iterations,
                 "newton_residuals": report.residuals,
                 "pairing": counts,
+                "unpaired_points": unpaired.tolist(),
             }
         )
         say(

@@ -306,13 +306,11 @@ class Problem(Loads):
             ) from None
 
     def _check_support(self, log: Callable[[str], None] | None) -> None:
-        """Free rigid modes, found before solving (:mod:`xfem_contact.mechanics.rigid_modes`):
-        a body without support is an error naming the modes and the point constraints
-        that remove them. A spin that only a frictionless interface leaves free is a
-        warning: the discrete interface holds it weakly (its normal is not exactly
-        rotation invariant), and a point constraint added for it would carry a spurious
-        reaction (hydrostatic case 2: pressure error 1.2e-2 instead of 1.9e-4), so none
-        is added. Runs again only when the loads changed. Collective."""
+        """Free rigid modes (:mod:`xfem_contact.mechanics.rigid_modes`): a body without
+        support is an error naming the modes and the constraints that remove them; a
+        spin only a frictionless interface leaves free is a warning (a point constraint
+        for it carries a spurious reaction: hydrostatic case 2, pressure error 1.2e-2
+        instead of 1.9e-4). Runs again only when the loads changed. Collective."""
         if self._checked_loads == self.loads_revision:
             return
         free = free_bodies(self)
@@ -349,6 +347,12 @@ class Problem(Loads):
         pairs whose master cell changed since the last accepted step, at the last
         evaluation (global counts; empty in small sliding)."""
         return {name: dict(c.counts) for name, c in self.couplings.items()}
+
+    def unpaired_points(self) -> dict[str, np.ndarray]:
+        """Per large-sliding interface, the reference coordinates (m, ``(k, 2)``) of the
+        slave points of all processes that found no master within the search radius
+        at the current state (they carry no contact). Collective."""
+        return {name: c.unpaired_points(self.w) for name, c in self.couplings.items()}
 
     # -- interface state -------------------------------------------------------------
     def interface_state(

@@ -137,12 +137,18 @@ def run(
             if not problem.linear:
                 residuals.append(problem.last_report.residuals)
             if getattr(problem, "couplings", None):
-                pairing.append(problem.pairing_counts())
+                unpaired = problem.unpaired_points()  # collective
+                pairing.append(
+                    {
+                        name: counts | {"unpaired_points": unpaired[name].tolist()}
+                        for name, counts in problem.pairing_counts().items()
+                    }
+                )
                 status = status | {
                     f"{key} {name}": value
                     for name, counts in pairing[-1].items()
                     for key, value in counts.items()
-                    if key != "unpaired"  # in the status already
+                    if key not in ("unpaired", "unpaired_points")  # status has the count
                 }
             result.update(solution)
             for writer in series:
