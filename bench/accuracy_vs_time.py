@@ -73,10 +73,12 @@ SWEEPS = [
      ["case2", "2", "quadrilateral", "stabilized", "iterative"], "iterative"),
     ("case 2", FIT, "P1 triangles", ["fitted2", "1"], "case 2"),
     ("case 2", FIT, "P2 triangles, curved", ["fitted2", "2"], "case 2"),
+    ("case 2", FIT, "P2, duplicated lines + Nitsche", ["nitsche2", "2"], "case 2"),
     ("case 3, alpha = 0", X, "P1 (straight cells)", ["case3", "1"], "case 3"),
     ("case 3, alpha = 0", X, "P2 (curved cells)", ["case3", "2"], "case 3"),
     ("case 3, alpha = 0", FIT, "P1 triangles", ["fitted3", "1"], "case 3"),
     ("case 3, alpha = 0", FIT, "P2 triangles, curved", ["fitted3", "2"], "case 3"),
+    ("case 3, alpha = 0", FIT, "P2, duplicated lines + Nitsche", ["nitsche3", "2"], "case 3"),
     ("case 3, alpha = pi/2", X, "P1, large sliding", ["case3rot", "1"], "rotated"),
     ("case 3, alpha = pi/2", X, "P2, large sliding", ["case3rot", "2"], "rotated"),
 ]
@@ -203,11 +205,15 @@ def case3rot(n, degree):
 
 def fitted(which, N, degree):
     from xfem_contact.cases.body_fitted import fitted_annulus, fitted_inclusion
+    from xfem_contact.cases.fitted_nitsche import nitsche_annulus, nitsche_inclusion
 
-    if which == "fitted2":
-        row = fitted_inclusion(1.0 / N, degree)
-    else:
-        row = fitted_annulus(17.0 / N, degree)  # the annulus' radial cell size
+    build = {
+        "fitted2": lambda: fitted_inclusion(1.0 / N, degree),
+        "fitted3": lambda: fitted_annulus(17.0 / N, degree),  # the annulus' radial cell size
+        "nitsche2": lambda: nitsche_inclusion(1.0 / N, degree),
+        "nitsche3": lambda: nitsche_annulus(17.0 / N, degree),
+    }
+    row = build[which]()
     return row | {"newton": 0}
 
 

@@ -5,8 +5,8 @@ for degree 2), solve standard DOLFINx elasticity, read the contact pressure off 
 stress on the interface facets. For the paper's cases 2 (closed and sticking: no gap,
 no slip) and 3 at alpha = 0 (closed, frictionless, no shear by symmetry) the contact
 problem has the solution of the bonded body, so a conforming mesh with shared nodes
-is the body-fitted route; an interface that opens or slides would need duplicated
-nodes and a contact formulation (not built here). The meshing time is part of the
+is one body-fitted route; the other, duplicated interface lines tied by Nitsche's
+method, is :mod:`xfem_contact.cases.fitted_nitsche`. The meshing time is part of the
 cost. SI units (m, Pa).
 """
 
