@@ -26,17 +26,8 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from xfem_contact.cases import paper
 from xfem_contact.cases.body_fitted import _INCLUSION_GEO, _annulus_geo, _mesh
-from xfem_contact.cases.paper import (
-    ANNULUS_CONTACT_PRESSURE,
-    ANNULUS_E,
-    ANNULUS_PRESSURE,
-    ANNULUS_RADII,
-    INCLUSION_CENTRE,
-    INCLUSION_E,
-    INCLUSION_RADIUS,
-    LOADINGS,
-)
 from xfem_contact.mechanics.bulk import cell_size
 from xfem_contact.mechanics.materials import Material
 
@@ -194,18 +185,18 @@ def _run(gm, bodies: TwoBodies, exact, timings: dict, start: float) -> dict:
 
 
 def nitsche_inclusion(
-    h: float, degree: int, radius: float = INCLUSION_RADIUS, comm: MPI.Comm = MPI.COMM_WORLD
+    h: float, degree: int, radius: float = paper.INCLUSION_RADIUS, comm: MPI.Comm = MPI.COMM_WORLD
 ) -> dict:
     """Paper case 2, the inclusion and the plate as two meshes tied by Nitsche (cell
     size ``h``, m): pressure error against ``-3/2 + cos(2 theta)/2`` Pa, dofs and wall
     times (s) of meshing, building, solving and post-processing. Collective."""
-    cx, cy = INCLUSION_CENTRE
+    cx, cy = paper.INCLUSION_CENTRE
     start = time.perf_counter()
     gm = _mesh(_INCLUSION_GEO.format(h=h, cx=cx, cy=cy, r=radius), degree, "triangle", comm)
     timings = {"mesh": time.perf_counter() - start}
     start = time.perf_counter()
-    bodies = TwoBodies(gm, degree, Material(INCLUSION_E, 0.0))
-    sxx, syy = LOADINGS["paper"]
+    bodies = TwoBodies(gm, degree, Material(paper.INCLUSION_E, 0.0))
+    sxx, syy = paper.LOADINGS["paper"]
     bodies.add_pressure(1, lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), -sxx)
     bodies.add_pressure(1, lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), -syy)
     for point, component in (((0.5, 0.0), 0), ((0.5, 1.0), 0), ((0.0, 0.5), 1)):
@@ -223,10 +214,12 @@ def nitsche_annulus(h: float, degree: int, comm: MPI.Comm = MPI.COMM_WORLD) -> d
     gm = _mesh(_annulus_geo(h), degree, "triangle", comm)
     timings = {"mesh": time.perf_counter() - start}
     start = time.perf_counter()
-    bodies = TwoBodies(gm, degree, Material(ANNULUS_E, 0.0), normal_only=True)
-    r_in, _, r_out = ANNULUS_RADII
+    bodies = TwoBodies(gm, degree, Material(paper.ANNULUS_E, 0.0), normal_only=True)
+    r_in, _, r_out = paper.ANNULUS_RADII
     tol = 1e-6 * r_out
     bodies.fix(1, lambda x: np.abs(np.hypot(x[0], x[1]) - r_in) < tol)
-    bodies.add_pressure(2, lambda x: np.abs(np.hypot(x[0], x[1]) - r_out) < tol, ANNULUS_PRESSURE)
+    bodies.add_pressure(
+        2, lambda x: np.abs(np.hypot(x[0], x[1]) - r_out) < tol, paper.ANNULUS_PRESSURE
+    )
     bodies.fix(2, lambda x: np.isclose(x[0], r_out) & np.isclose(x[1], 0.0), 1)
-    return _run(gm, bodies, ANNULUS_CONTACT_PRESSURE, timings, start)
+    return _run(gm, bodies, paper.ANNULUS_CONTACT_PRESSURE, timings, start)
