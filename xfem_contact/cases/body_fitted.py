@@ -35,7 +35,9 @@ from xfem_contact.io.gmsh import read_gmsh
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.plain import PlainElasticityProblem
 
-_INCLUSION_GEO = """
+#: The unit square with the circle (centre cx, cy; radius r) as a meshed curve: surfaces
+#: 1 "plate", 2 "inclusion", curve group "interface"; format with h, cx, cy, r
+INCLUSION_GEO = """
 lc = {h};
 Point(1) = {{0, 0, 0, lc}}; Point(2) = {{0.5, 0, 0, lc}}; Point(3) = {{1, 0, 0, lc}};
 Point(4) = {{1, 0.5, 0, lc}}; Point(5) = {{1, 1, 0, lc}}; Point(6) = {{0.5, 1, 0, lc}};
@@ -53,7 +55,7 @@ Physical Surface("plate") = {{1}}; Physical Surface("inclusion") = {{2}};
 Physical Curve("interface") = {{9, 10, 11, 12}};
 """
 
-_ANNULUS_GEO = """
+ANNULUS_GEO = """
 lc = {h};
 Point(1) = {{0, 0, 0, lc}};
 {points}
@@ -66,7 +68,7 @@ Physical Curve("interface") = {{5, 6, 7, 8}};
 """
 
 
-def _annulus_geo(h: float) -> str:
+def annulus_geo(h: float) -> str:
     """Three circles, each of four arcs through the axes' points: curves 1-4 r = 20 m,
     5-8 the interface r = 8 m, 9-12 r = 3 m."""
     points, circles, tag = [], [], 2
@@ -79,11 +81,13 @@ def _annulus_geo(h: float) -> str:
         first = 1 + 4 * k
         for j in range(4):
             circles.append(f"Circle({first + j}) = {{{ids[j]}, 1, {ids[(j + 1) % 4]}}};")
-    return _ANNULUS_GEO.format(h=h, points="\n".join(points), circles="\n".join(circles))
+    return ANNULUS_GEO.format(h=h, points="\n".join(points), circles="\n".join(circles))
 
 
-def _mesh(text: str, degree: int, cell: str, comm: MPI.Comm):
-    """Mesh a .geo text with gmsh (rank 0) and distribute it; returns the GmshMesh."""
+def mesh_geo(text: str, degree: int, cell: str, comm: MPI.Comm):
+    """Mesh a .geo text (e.g. :data:`INCLUSION_GEO` formatted with ``h, cx, cy, r``, or
+    :func:`annulus_geo`) with gmsh on rank 0, cells of ``degree``, and distribute it;
+    returns the :class:`~xfem_contact.io.gmsh.GmshMesh`. Collective."""
     with tempfile.TemporaryDirectory() as folder:
         path = pathlib.Path(comm.bcast(folder if comm.rank == 0 else None, root=0)) / "m.geo"
         if comm.rank == 0:
@@ -115,7 +119,7 @@ def fitted_inclusion(
     solving (forms, assembly, LU) and post-processing. Collective."""
     cx, cy = INCLUSION_CENTRE
     start = time.perf_counter()
-    gm = _mesh(_INCLUSION_GEO.format(h=h, cx=cx, cy=cy, r=radius), degree, cell, comm)
+    gm = mesh_geo(INCLUSION_GEO.format(h=h, cx=cx, cy=cy, r=radius), degree, cell, comm)
     timings = {"mesh": time.perf_counter() - start}
     material = Material(INCLUSION_E, 0.0)
     problem = PlainElasticityProblem(gm.mesh, degree, material)
@@ -141,7 +145,7 @@ def fitted_annulus(h: float, degree: int, cell: str = "triangle", comm=MPI.COMM_
     """Paper case 3 at alpha = 0 on a mesh that follows r = 8 m: the pressure error
     against -1825/1636 MPa, dofs and wall times (s), as :func:`fitted_inclusion`."""
     start = time.perf_counter()
-    gm = _mesh(_annulus_geo(h), degree, cell, comm)
+    gm = mesh_geo(annulus_geo(h), degree, cell, comm)
     timings = {"mesh": time.perf_counter() - start}
     material = Material(ANNULUS_E, 0.0)
     problem = PlainElasticityProblem(gm.mesh, degree, material)

@@ -27,7 +27,7 @@ import ufl
 from mpi4py import MPI
 
 from xfem_contact.cases import paper
-from xfem_contact.cases.body_fitted import _INCLUSION_GEO, _annulus_geo, _mesh
+from xfem_contact.cases.body_fitted import INCLUSION_GEO, annulus_geo, mesh_geo
 from xfem_contact.mechanics.bulk import cell_size
 from xfem_contact.mechanics.materials import Material
 
@@ -192,7 +192,7 @@ def nitsche_inclusion(
     times (s) of meshing, building, solving and post-processing. Collective."""
     cx, cy = paper.INCLUSION_CENTRE
     start = time.perf_counter()
-    gm = _mesh(_INCLUSION_GEO.format(h=h, cx=cx, cy=cy, r=radius), degree, "triangle", comm)
+    gm = mesh_geo(INCLUSION_GEO.format(h=h, cx=cx, cy=cy, r=radius), degree, "triangle", comm)
     timings = {"mesh": time.perf_counter() - start}
     start = time.perf_counter()
     bodies = TwoBodies(gm, degree, Material(paper.INCLUSION_E, 0.0))
@@ -211,7 +211,7 @@ def nitsche_annulus(h: float, degree: int, comm: MPI.Comm = MPI.COMM_WORLD) -> d
     frictionless (normal) Nitsche tie: pressure error against -1825/1636 MPa, as
     :func:`nitsche_inclusion`."""
     start = time.perf_counter()
-    gm = _mesh(_annulus_geo(h), degree, "triangle", comm)
+    gm = mesh_geo(annulus_geo(h), degree, "triangle", comm)
     timings = {"mesh": time.perf_counter() - start}
     start = time.perf_counter()
     bodies = TwoBodies(gm, degree, Material(paper.ANNULUS_E, 0.0), normal_only=True)
