@@ -30,6 +30,7 @@ from xfem_contact.cases import paper
 from xfem_contact.cases.body_fitted import INCLUSION_GEO, annulus_geo, mesh_geo
 from xfem_contact.mechanics.bulk import cell_size
 from xfem_contact.mechanics.materials import Material
+from xfem_contact.solvers.options import remove_options, unique_prefix
 
 #: Nitsche's penalty: gamma = NITSCHE * degree^2 (dimensionless)
 NITSCHE = 10.0
@@ -141,11 +142,12 @@ class TwoBodies:
 
     def solve(self):
         """One linear solve (MUMPS LU); returns the two displacements. Collective."""
+        prefix = unique_prefix("xfem_fitted_nitsche_")
         problem = dolfinx.fem.petsc.LinearProblem(
             ufl.extract_blocks(self.a),
             self._load_forms(),
             bcs=self.bcs,
-            petsc_options_prefix="xfem_fitted_nitsche_",
+            petsc_options_prefix=prefix,
             petsc_options={
                 "ksp_type": "preonly",
                 "pc_type": "lu",
@@ -154,7 +156,10 @@ class TwoBodies:
             entity_maps=self.entity_maps,
             kind="mpi",
         )
-        return problem.solve()
+        try:
+            return problem.solve()
+        finally:
+            remove_options(prefix)  # nothing of ours outlives the solve
 
     def pressure_error(self, w, exact) -> float:
         """Relative L2 error of ``n . {sigma(w) n}`` on the interface (collective)."""

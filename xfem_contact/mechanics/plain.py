@@ -15,6 +15,7 @@ from mpi4py import MPI
 
 from xfem_contact.mechanics.loading import Facets, LoadFactor, boundary_facets
 from xfem_contact.mechanics.materials import Material
+from xfem_contact.solvers.options import remove_options, unique_prefix
 
 
 class PlainElasticityProblem:
@@ -91,14 +92,18 @@ class PlainElasticityProblem:
         ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=entities)
         L = sum((ufl.inner(t, v) * ds(k) for k, t in self._rhs), ufl.ZeroBaseForm((v,)))
         L += sum((ufl.inner(f, v) * ufl.dx for f in self._body), ufl.ZeroBaseForm((v,)))
+        prefix = unique_prefix("xfem_plain_")
         problem = dolfinx.fem.petsc.LinearProblem(
             a,
             L,
             bcs=self._bcs,
-            petsc_options_prefix="xfem_plain_",
+            petsc_options_prefix=prefix,
             petsc_options={"ksp_type": "preonly", "pc_type": "lu", **(petsc_options or {})},
         )
-        return problem.solve()
+        try:
+            return problem.solve()
+        finally:
+            remove_options(prefix)  # nothing of ours outlives the solve
 
     def _pairs(self, facets):
         tdim = self.mesh.topology.dim

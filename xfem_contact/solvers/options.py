@@ -164,6 +164,16 @@ def set_petsc_options(prefix: str, options: dict[str, OptionValue]) -> None:
         database[f"{prefix}{key}"] = value
 
 
+def remove_options(prefix: str) -> None:
+    """Remove every option under ``prefix`` from the PETSc options database (after a
+    solver that writes its own, e.g. DOLFINx's ``LinearProblem``, has read them).
+    Not collective."""
+    database = PETSc.Options()
+    for key in list(database.getAll()):
+        if key.startswith(prefix):
+            database.delValue(key)
+
+
 _prefixes = itertools.count()
 
 
