@@ -69,8 +69,8 @@ class SlidingCoupling:
         self.lam_basis = lagrange_element(V_l).tabulate(0, X)[0, :, :, 0]
         self.slave_dofs = _flat(cell_dofs(V_s, cells))  # (m, nodes x components)
         self.lam_dofs = _flat(cell_dofs(V_l, cells))
-        self.r = law.augmentation_coefficient(ctx, ctx.cell_size_at())
         h = ctx.cell_size_at()
+        self.r = law.augmentation_coefficient(ctx, h)
         self.radius = radius or self.comm.allreduce(float(h.max(initial=0.0)), op=MPI.MAX)
         tdim = cut.mesh.topology.dim
         self.slave_cells = cut.mesh.topology.index_map(tdim).local_to_global(cells)
@@ -195,9 +195,10 @@ class SlidingCoupling:
 
     # -- assembly --------------------------------------------------------------------
     def _indices(self, pairing: Pairing, master) -> np.ndarray:
+        """Per-piece indices ``master`` (``(P, k)``) at each point's foot, -1 where
+        unpaired (PETSc drops negative indices)."""
         pieces = np.where(pairing.paired, pairing.piece, 0)
-        theirs = np.where(pairing.paired[:, None], master[pieces], -1)
-        return theirs
+        return np.where(pairing.paired[:, None], master[pieces], -1)
 
     def add_residual(self, w, b: PETSc.Vec) -> None:
         """Add the hybrid elements' residual at ``w`` to ``b`` (a vector of ``W``,

@@ -46,6 +46,13 @@ class PairTerms(typing.NamedTuple):
     P_n: npt.NDArray[np.float64]
 
 
+def node_slots(basis: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``basis (x) v`` node by node: the vector field ``sum_i basis_i v`` as
+    coefficients of the 2-D nodal dofs, ``(m, 2 nnodes)`` for ``basis`` ``(m, nnodes)``
+    and ``v`` ``(m, 2)``."""
+    return (basis[:, :, None] * v[:, None, :]).reshape(basis.shape[0], 2 * basis.shape[1])
+
+
 def gap_derivatives(x_s, phi_s, curve, orientation):
     """Gap, its gradient ``(m, nz_u)`` and Hessian ``(m, nz_u, nz_u)`` in the
     displacement unknowns ``(a, b)`` of the pairs (the multiplier slots excluded).
@@ -56,7 +63,6 @@ def gap_derivatives(x_s, phi_s, curve, orientation):
         curve: The :class:`~xfem_contact.mechanics.sliding.lips.CurvePoint` at the feet.
         orientation: Piece orientation (+-1) of each foot, ``(m,)``.
     """
-    m = x_s.shape[0]
     t, t2 = curve.t, curve.t2
     tt = np.sum(t * t, axis=1)
     n = orientation[:, None] * np.column_stack([-t[:, 1], t[:, 0]]) / np.sqrt(tt)[:, None]
@@ -65,10 +71,7 @@ def gap_derivatives(x_s, phi_s, curve, orientation):
     kappa = np.sum(n * t2, axis=1)
 
     def slots(basis_a, basis_b, v):
-        """``[basis_a (x) v, basis_b (x) v]`` node by node, ``(m, 2 nn_a + 2 nn_b)``."""
-        a = (basis_a[:, :, None] * v[:, None, :]).reshape(m, 2 * basis_a.shape[1])
-        b = (basis_b[:, :, None] * v[:, None, :]).reshape(m, 2 * basis_b.shape[1])
-        return np.concatenate([a, b], axis=1)
+        return np.concatenate([node_slots(basis_a, v), node_slots(basis_b, v)], axis=1)
 
     zero_s = np.zeros_like(phi_s)
     grad = slots(phi_s, -curve.phi, n)

@@ -30,7 +30,7 @@ import typing
 
 import numpy as np
 
-from xfem_contact.mechanics.sliding.element import PairTerms
+from xfem_contact.mechanics.sliding.element import PairTerms, node_slots
 
 #: Complex step (any tiny number: no cancellation)
 STEP = 1e-30
@@ -113,9 +113,8 @@ def residual(z: np.ndarray, data: PointData, friction: float | None):
     g = _dot(x_s - x_m, n)
     kappa = _dot(n, t2)
 
-    def slots(basis_s, basis_m, v):
-        zs = (basis_s[:, :, None] * v[:, None, :]).reshape(m, 2 * basis_s.shape[1])
-        zm = (basis_m[:, :, None] * v[:, None, :]).reshape(m, 2 * basis_m.shape[1])
+    def slots(basis_s, basis_m, v):  # (a, l, b) with the multiplier slots empty
+        zs, zm = node_slots(basis_s, v), node_slots(basis_m, v)
         return np.concatenate([zs, np.zeros((m, c * nl), dtype=zs.dtype), zm], axis=1)
 
     def multiplier_slot(k):
