@@ -3,7 +3,8 @@
 No cut, no enrichment, no xfem_contact import: unit square, ``--n`` x ``--n`` cells,
 Lagrange ``--degree`` displacement, E = 100 MPa, nu = 0, the case-2 tractions (-1 Pa
 lateral, -2 Pa top and bottom) and the same three point constraints, one direct solve
-(MUMPS LU; ``--ordering`` sets its ICNTL(7), as xfem-contact's solver options do) and
+(MUMPS LU; ``--mumps icntl_7=4`` sets a MUMPS control, so that ``bench/scaling.py`` gives it
+the ones xfem-contact's solver options set) and
 the displacement written as VTX, as the demo does. Prints one JSON line
 of dofs and wall times per phase (s); ``bench/scaling.py`` runs it as a process of its
 own next to the demo. Run: ``python bench/plain_elasticity.py --n 160 [--degree 2]``,
@@ -33,7 +34,7 @@ E, NU = 100e6, 0.0
 OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 
 
-def solve(n: int, degree: int, cell: str, out: pathlib.Path, ordering: int | None) -> dict:
+def solve(n: int, degree: int, cell: str, out: pathlib.Path, mumps: dict[str, int]) -> dict:
     """Solve and write; returns the dofs and the wall time of each phase (s). Collective."""
     comm = MPI.COMM_WORLD
     times = {}
@@ -88,7 +89,7 @@ def solve(n: int, degree: int, cell: str, out: pathlib.Path, ordering: int | Non
     ksp.setOperators(A)
     ksp.setOptionsPrefix("plain_")
     opts = PETSc.Options()
-    options = OPTIONS | ({} if ordering is None else {"mat_mumps_icntl_7": ordering})
+    options = OPTIONS | {f"mat_mumps_{key}": value for key, value in mumps.items()}
     for key, value in options.items():
         opts[f"plain_{key}"] = value
     ksp.setFromOptions()
@@ -113,10 +114,15 @@ def main():
     parser.add_argument("--cell", default="quadrilateral", choices=["quadrilateral", "triangle"])
     parser.add_argument("--out", default="results/plain_elasticity")
     parser.add_argument(
-        "--ordering", type=int, default=None, help="MUMPS ICNTL(7) (default: MUMPS's choice)"
+        "--mumps",
+        nargs="*",
+        default=[],
+        metavar="icntl_K=V",
+        help="MUMPS controls, e.g. icntl_7=4 (default: MUMPS's own choices)",
     )
     args = parser.parse_args()
-    result = solve(args.n, args.degree, args.cell, pathlib.Path(args.out), args.ordering)
+    mumps = dict(item.split("=", 1) for item in args.mumps)
+    result = solve(args.n, args.degree, args.cell, pathlib.Path(args.out), mumps)
     if MPI.COMM_WORLD.rank == 0:
         print(json.dumps(result))
 

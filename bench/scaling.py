@@ -63,13 +63,15 @@ def run(command: list[str], env: dict | None = None) -> tuple[float, float, str]
     return wall, usage.ru_maxrss / 1024.0, text
 
 
-def mumps_ordering() -> int:
-    """The MUMPS ordering of xfem-contact's solvers (so the plain solve uses it too)."""
+def mumps_controls() -> list[str]:
+    """The MUMPS controls xfem-contact's solvers set (``["icntl_7=4", ...]``), so that
+    the plain solve uses them too."""
     code = (
-        "from xfem_contact.solvers.options import SOLVER_OPTIONS;"
-        "print(SOLVER_OPTIONS['mat_mumps_icntl_7'].default)"
+        "from xfem_contact.solvers.options import SOLVER_OPTIONS as S;"
+        "print(' '.join(f'{k[10:]}={o.default}' for k, o in S.items() "
+        "if k.startswith('mat_mumps_')))"
     )
-    return int(subprocess.check_output([sys.executable, "-c", code], text=True).strip())
+    return subprocess.check_output([sys.executable, "-c", code], text=True).split()
 
 
 def demo(n, degree, work, env=None, ranks=1, samples=False) -> dict:
@@ -106,23 +108,25 @@ def max_difference(a: dict, b: dict) -> float:
     return float(np.abs(la - lb).max() / np.abs(la).max())
 
 
-def plain(n, degree, work, ordering, env=None) -> dict:
+def plain(n, degree, work, mumps, env=None, ranks=1) -> dict:
     command = [sys.executable, str(ROOT / "bench" / "plain_elasticity.py")]
     command += ["--n", str(n), "--degree", str(degree), "--out", str(work / "plain")]
-    command += ["--ordering", str(ordering)]
+    command += ["--mumps", *mumps]
+    if ranks > 1:
+        command = [str(pathlib.Path(sys.executable).parent / "mpiexec"), "-n", str(ranks)] + command
     wall, rss, text = run(command, env)
     data = json.loads(text.strip().splitlines()[-1])
     return {"wall": wall, "rss_mb": rss, "dofs": data["dofs"], "timings": data["timings"]}
 
 
-def cold_jit(degree, n, work, ordering) -> dict:
+def cold_jit(degree, n, work, mumps) -> dict:
     """Process time with an empty FFCx cache minus the warm time (the JIT's cost)."""
     cache = work / f"cold_cache_{degree}"
     env = os.environ | {"XDG_CACHE_HOME": str(cache)}
     cold = demo(n, degree, work, env)["wall"]
     warm = demo(n, degree, work, env)["wall"]
-    plain_cold = plain(n, degree, work, ordering, env | {"XDG_CACHE_HOME": str(cache) + "p"})
-    plain_warm = plain(n, degree, work, ordering, env | {"XDG_CACHE_HOME": str(cache) + "p"})
+    plain_cold = plain(n, degree, work, mumps, env | {"XDG_CACHE_HOME": str(cache) + "p"})
+    plain_warm = plain(n, degree, work, mumps, env | {"XDG_CACHE_HOME": str(cache) + "p"})
     shutil.rmtree(cache, ignore_errors=True)
     shutil.rmtree(str(cache) + "p", ignore_errors=True)
     return {"cut": cold - warm, "plain": plain_cold["wall"] - plain_warm["wall"]}
@@ -203,24 +207,24 @@ def main():
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args()
     RESULTS.mkdir(parents=True, exist_ok=True)
-    ordering = mumps_ordering()
+    mumps = mumps_controls()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         work = pathlib.Path(tmp)
         for degree in args.degrees:
             demo(args.sizes[0], degree, work)  # warm the caches of this degree
-            plain(args.sizes[0], degree, work, ordering)
+            plain(args.sizes[0], degree, work, mumps)
             for n in progress(args.sizes, f"P{degree} sizes", not args.no_progress):
                 row = {"degree": degree, "n": n}
                 last = degree == 2 and n == args.sizes[-1]
                 row["cut"] = demo(n, degree, work, samples=last and args.ranks > 1)
-                row["plain"] = plain(n, degree, work, ordering)
+                row["plain"] = plain(n, degree, work, mumps)
                 rows.append(row)
                 note(line(row))
         jit = (
             {}
             if args.no_jit
-            else {d: cold_jit(d, args.sizes[0], work, ordering) for d in args.degrees}
+            else {d: cold_jit(d, args.sizes[0], work, mumps) for d in args.degrees}
         )
         for degree, cost in jit.items():
             print(
@@ -244,9 +248,7 @@ def main():
                 s, p = serial["timings"].get(key, 0.0), distributed["timings"].get(key, 0.0)
                 print(f"    {label:24s} {s:8.3f} s -> {p:8.3f} s  ({s / max(p, 1e-9):.2f}x)")
     (RESULTS / "scaling.json").write_text(
-        json.dumps(
-            {"rows": rows, "jit": jit, "parallel": parallel, "mumps_ordering": ordering}, indent=1
-        )
+        json.dumps({"rows": rows, "jit": jit, "parallel": parallel, "mumps": mumps}, indent=1)
     )
     text = table(rows)
     (RESULTS / "scaling.md").write_text(text + "\n")
