@@ -27,7 +27,7 @@ from xfem_contact.geometry.levelset import (
 )
 from xfem_contact.quadrature import boundary
 from xfem_contact.quadrature import rules as quadrature
-from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart
+from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart, marker_space
 
 _SIDE_MINUS, _SIDE_PLUS, _INTERFACE = 1, 2, 3
 _INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + index
@@ -148,10 +148,9 @@ class CutMesh:
         #: Interface (index into ``interface_names``) of every cut cell, shape ``(ncut,)``
         self.cell_interface = cell_interfaces(maps, cut_cells, rules[_INTERFACE], components)
         self._interface_rules = {}
-        self._cell_rules = {
-            sid: CellRules(mesh, cut_cells, r.points, r.weights, r.offsets)
-            for sid, r in rules.items()
-        }
+        if getattr(self, "_marker_space", None) is None:  # one for all the rules, all cuts
+            self._marker_space = marker_space(mesh)
+        self._cell_rules = {sid: self._rules(cut_cells, r) for sid, r in rules.items()}
         self._standard = {_SIDE_MINUS: owned[side == -1], _SIDE_PLUS: owned[side == 1]}
         self.maps = maps
         self._boundary_parts = {}
@@ -308,6 +307,11 @@ class CutMesh:
             "ds", domain=self.mesh, subdomain_data=self, subdomain_id=_BOUNDARY0 + slot
         )
 
+    def _rules(self, cells, rule) -> CellRules:
+        """``rule`` (points, weights, offsets) on ``cells`` as :class:`CellRules`."""
+        args = (rule.points, rule.weights, rule.offsets)
+        return CellRules(self.mesh, cells, *args, marker_space=self._marker_space)
+
     def _facet_array(self, facets, value) -> np.ndarray:
         mesh, fdim = self.mesh, self.mesh.topology.dim - 1
         if isinstance(facets, dolfinx.mesh.MeshTags):
@@ -363,9 +367,7 @@ class CutMesh:
             )
             normal = ufl.dot(ufl.inv(J).T, ufl.as_vector(n_ref.tolist()))
             normal = normal / ufl.sqrt(ufl.inner(normal, normal))
-            rules = CellRules(
-                mesh, self.cut_cells[cells_rows], rule.points, rule.weights, rule.offsets
-            )
+            rules = self._rules(self.cut_cells[cells_rows], rule)
             parts.append(
                 IntegrationPart("cell", rules=rules, replace={ufl.FacetNormal(mesh): normal})
             )
@@ -384,9 +386,7 @@ class CutMesh:
             k = subdomain_id - _INTERFACE0
             if subdomain_id not in self._cell_rules:
                 r = self.interface_rules_of(self.interface_names[k])
-                self._cell_rules[k + _INTERFACE0] = CellRules(
-                    self.mesh, self.cut_cells, r.points, r.weights, r.offsets
-                )
+                self._cell_rules[k + _INTERFACE0] = self._rules(self.cut_cells, r)
             return [IntegrationPart("cell", rules=self._cell_rules[subdomain_id])]
         if subdomain_id not in self._cell_rules:
             raise ValueError(f"Unknown CutMesh measure id {subdomain_id}")

@@ -186,13 +186,12 @@ class EnrichedSpace:
         comm = self.cut.mesh.comm
         counts = []
         for field in range(2 + len(self.multiplier_fields)):
-            dofs = np.unique(self.W.sub(field).dofmap.list.ravel())
-            dofs = dofs[dofs < nowned]
-            counts.append(comm.allreduce(int(self._active[dofs].sum()), op=MPI.SUM))
-        V = dolfinx.fem.functionspace(
-            self.cut.mesh, ("Lagrange", self.degree, (self.cut.mesh.geometry.dim,))
-        )
-        standard = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+            of_field = np.zeros(nowned, dtype=bool)
+            dofs = self.W.sub(field).dofmap.list.ravel()
+            of_field[dofs[dofs < nowned]] = True
+            if field == 0:  # a displacement field: the whole mesh's Lagrange space
+                standard = comm.allreduce(int(of_field.sum()), op=MPI.SUM)
+            counts.append(comm.allreduce(int(self._active[:nowned][of_field].sum()), op=MPI.SUM))
         multiplier = sum(counts[2:])
         return DofCounts(standard, counts[0] + counts[1] - standard, multiplier)
 

@@ -90,9 +90,11 @@ def restriction_matrix(
     rows = np.concatenate(entries_rows)
     cols = np.concatenate(entries_cols)
     vals = np.concatenate(entries_vals)
-    keys, inverse = np.unique(np.c_[rows, cols], axis=0, return_inverse=True)
-    rows, cols = keys[:, 0], keys[:, 1]
-    vals = np.bincount(inverse.ravel(), weights=vals, minlength=keys.shape[0])
+    if len(entries_rows) > 1:  # sum repeated (row, column) pairs; sort by row, column
+        n_cols = comm.allreduce(n_red, op=MPI.SUM)
+        keys, inverse = np.unique(rows * n_cols + cols, return_inverse=True)
+        rows, cols = np.divmod(keys, n_cols)
+        vals = np.bincount(inverse, weights=vals, minlength=keys.size)
     indptr = np.searchsorted(rows, np.arange(n_owned + 1)).astype(PETSc.IntType)
     R = PETSc.Mat().createAIJ(((n_owned, PETSc.DETERMINE), (n_red, PETSc.DETERMINE)), comm=comm)
     R.setPreallocationCSR((indptr, cols.astype(PETSc.IntType), vals))

@@ -28,6 +28,12 @@ def _address(array: np.ndarray) -> int:
     return int(array.ctypes.data)
 
 
+def marker_space(mesh: dolfinx.mesh.Mesh) -> dolfinx.fem.FunctionSpace:
+    """The space of the marker coefficients of rules on ``mesh`` (one may serve all the
+    rules of a mesh: each has its own :class:`dolfinx.fem.Function` on it). Collective."""
+    return dolfinx.fem.functionspace(mesh, marker_element(mesh.basix_cell().name))
+
+
 class IntegrationPart(typing.NamedTuple):
     """One piece of a cut measure, as the ``integration_parts`` of its source lists it.
 
@@ -59,6 +65,8 @@ class CellRules:
             multiplies them by ``|det J|`` of the cell map.
         offsets: Shape ``(n + 1,)``; rule ``i`` (cell ``cells[i]``) is
             ``points[offsets[i]:offsets[i + 1]]``.
+        marker_space: The space of :attr:`marker` (:func:`marker_space` of ``mesh``),
+            to share one among the rules of a mesh; made here if not given.
     """
 
     def __init__(
@@ -68,8 +76,10 @@ class CellRules:
         points: npt.ArrayLike,
         weights: npt.ArrayLike,
         offsets: npt.ArrayLike,
+        marker_space: dolfinx.fem.FunctionSpace | None = None,
     ):
         self.mesh = mesh
+        self._marker_space = marker_space
         self.cells = np.ascontiguousarray(cells, dtype=np.int32)
         self.points = np.ascontiguousarray(points, dtype=np.float64)
         self.weights = np.ascontiguousarray(weights, dtype=np.float64)
@@ -101,9 +111,7 @@ class CellRules:
     def marker(self) -> dolfinx.fem.Function:
         """The marker coefficient that routes runtime kernels to these rules."""
         if self._marker is None:
-            space = dolfinx.fem.functionspace(
-                self.mesh, marker_element(self.mesh.basix_cell().name)
-            )
+            space = self._marker_space or marker_space(self.mesh)
             self._marker = dolfinx.fem.Function(space, name="xfem_marker")
             self._write_marker()
         return self._marker
