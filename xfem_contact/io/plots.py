@@ -20,15 +20,18 @@ class Series(typing.NamedTuple):
 def line_plot(
     path: str | pathlib.Path, series: list[Series], xlabel: str, ylabel: str, title: str
 ) -> pathlib.Path:
-    """Write a PNG of several curves (e.g. computed points and the exact curve)."""
-    import matplotlib
+    """Write a PNG of several curves (e.g. computed points and the exact curve).
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    Draws on a :class:`matplotlib.figure.Figure` of its own with the Agg canvas: no
+    pyplot, so neither the process's backend nor pyplot's figure list is touched."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig = Figure(figsize=(6, 4))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
     for s in series:
         ax.plot(s.x, s.y, s.style, ms=3, label=s.label)
     ax.set_xlabel(xlabel)
@@ -37,7 +40,6 @@ def line_plot(
     ax.legend()
     fig.tight_layout()
     fig.savefig(path, dpi=120)
-    plt.close(fig)
     return path
 
 
