@@ -42,6 +42,7 @@ import numpy as np
 from mpi4py import MPI
 
 from xfem_contact.fem.evaluation import interface_points
+from xfem_contact.fem.subspaces import collapse
 from xfem_contact.mechanics.laws import ContactLaw, Free
 
 #: What a closed interface of each kind transmits (the reason in the messages)
@@ -263,16 +264,20 @@ def _bodies(problem) -> tuple[list[_Body], int | None, dict[str, int]]:
     partner = np.full(space.active.size, -1, dtype=np.int64)
     for f in (0, 1):
         partner[W.sub(f).dofmap.list.ravel()] = W.sub(1 - f).dofmap.list.ravel()
+    nodes = {}  # field -> (parent dof of each component of each node, node coordinates)
+    for field in (0, 1):
+        V, parent = collapse(W.sub(field))
+        bs = V.dofmap.bs
+        nodes[field] = ([parent[c::bs] for c in range(bs)], V.tabulate_dof_coordinates())
     bodies, plus, inside = [], None, {}
     for label, field, cells, name in parts:
         mask = _marked(W, field, cells) & space.active
         dofs, coords, alone = [], [], []
-        for c in (0, 1):
-            V, parent = W.sub(field).sub(c).collapse()
-            parent = np.asarray(parent).ravel()
+        parents, x = nodes[field]
+        for parent in parents[:2]:  # components x, y
             keep = (parent < nowned) & mask[parent]
             dofs.append(parent[keep])
-            coords.append(V.tabulate_dof_coordinates()[keep, :2])
+            coords.append(x[keep, :2])
             alone.append(~space.active[partner[parent[keep]]])
         if comm.allreduce(coords[0].shape[0], op=MPI.SUM) == 0:
             continue
