@@ -26,7 +26,7 @@ def test_defaults_per_solver():
         "pc_type": "lu",
         "pc_factor_mat_solver_type": "mumps",
         "mat_mumps_icntl_7": 4,  # PORD
-        "mat_mumps_icntl_8": 0,  # no scaling of its own (the systems are scaled)
+        "mat_mumps_icntl_8": 7,  # its iterative scaling, not the weighted matching
     }
     assert linear.items() <= newton.items()  # Newton's linear solves are the linear solver's
     assert all(key.startswith("snes_") for key in newton.keys() - linear.keys())
