@@ -99,7 +99,7 @@ class RestrictedNewton:
         self.F_r = R.createVecRight()
         self.status, self.log = status, log
         start = time.perf_counter()
-        self.jacobian = ReducedMatrix(self.J, bcs, R)
+        self.jacobian = ReducedMatrix(self.J, bcs, R, blocks=not self.couplings)
         self.timings["sparsity"] = time.perf_counter() - start
         if self.couplings and not self.jacobian.direct:
             raise ValueError(
