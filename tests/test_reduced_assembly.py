@@ -1,7 +1,8 @@
 """The fast paths of the solvers give what the slow ones gave.
 
 - :func:`xfem_contact.fem.subspaces.collapse` equals DOLFINx's ``collapse``;
-- a form assembled straight into the reduced numbering equals ``R^T A R`` by PtAP,
+- a form assembled straight into the reduced numbering (on 2 x 2 blocks where the
+  unknowns pair up) equals ``R^T A R`` by PtAP,
   bit for bit, and a prolongation in ``R`` takes the PtAP path;
 - the runtime-table layouts read back from disk equal the ones FFCx's IR gives;
 - the first Newton iterate reuses the Jacobian assembled for the scaling only when
@@ -71,6 +72,29 @@ def test_direct_assembly_equals_ptap(problem):
     for mat in (full, reference, R):
         mat.destroy()
     reduced.destroy()
+
+
+@pytest.mark.parametrize("law, block_size", [("coulomb", 2), ("frictionless", 1)])
+def test_pattern_on_pairs_only_where_the_unknowns_pair_up(law, block_size):
+    """Vector fields give 2 x 2 blocks, a scalar multiplier does not; either way, and
+    with the blocks switched off, the matrix is PtAP's."""
+    options = {"friction": 0.3} if law == "coulomb" else {}
+    problem = inclusion_problem(8, 2, law, **options)
+    J, R = _jacobian(problem), problem.restriction()
+    full = dolfinx.fem.petsc.assemble_matrix(J, bcs=problem._bcs)
+    full.assemble()
+    reference = full.PtAP(R)
+    for blocks in (True, False):
+        reduced = ReducedMatrix(J, problem._bcs, R, blocks=blocks)
+        A = reduced.assemble()
+        assert A.getBlockSize() == (block_size if blocks else 1)
+        difference = reference.copy()
+        difference.axpy(-1.0, A, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        assert difference.norm() == 0.0
+        difference.destroy()
+        reduced.destroy()
+    for mat in (full, reference, R):
+        mat.destroy()
 
 
 def test_prolongation_takes_the_ptap_path():

@@ -101,20 +101,22 @@ def _coupled_cells(a: dolfinx.fem.Form) -> tuple[npt.NDArray, npt.NDArray]:
     return np.unique(np.concatenate(cells)), np.unique(np.concatenate(pairs), axis=0)
 
 
-def _pairs(chosen: Selection, comm) -> dolfinx.cpp.common.IndexMap | None:
-    """The index map of the reduced unknowns taken two by two, if they pair up on
+def _pairs(chosen: Selection, W, comm) -> dolfinx.cpp.common.IndexMap | None:
+    # W: the (C++) mixed space of the form
+    """The index map of the reduced unknowns taken two by two (the two components of a
+    node), if every field of ``W`` has two components and the unknowns pair up on
     every process (owned and ghost ones alike: even counts, ghost pairs ``2m, 2m + 1``),
-    else ``None``. Collective.
+    else ``None`` (e.g. a scalar multiplier: frictionless contact). Collective.
 
-    The unknowns of vector fields do (a node's two components are consecutive in
-    ``W`` and active together); a scalar multiplier (frictionless contact) may not.
-    A pair need not be one node: a pattern of 2 x 2 blocks holds every entry of the
-    scalar pattern, and some stored zeros."""
+    A node's two components are consecutive in ``W`` and active together, so they are
+    consecutive in the reduced numbering too."""
     imap = chosen.index_map
     ghosts, owners = imap.ghosts, imap.owners
     first = imap.local_range[0]
+    fields = [W.sub([i]).dofmap.map() for i in range(W.element.num_sub_elements)]
     paired = (
-        imap.size_local % 2 == 0
+        all(d.shape[1] % 2 == 0 and np.all(d[:, 1::2] == d[:, 0::2] + 1) for d in fields)
+        and imap.size_local % 2 == 0
         and first % 2 == 0
         and ghosts.size % 2 == 0
         and np.all(ghosts[0::2] % 2 == 0)
@@ -137,7 +139,7 @@ def reduced_matrix(a: dolfinx.fem.Form, chosen: Selection, blocks: bool = True) 
     at 320 x 320 its finalisation took 0.2 s instead of 0.8 s), and the matrix has
     block size 2."""
     comm = a.mesh.comm  # lives as long as the mesh (the index map's own does not)
-    pairs_map = _pairs(chosen, comm) if blocks else None
+    pairs_map = _pairs(chosen, a.function_spaces[0], comm) if blocks else None
     bs = 1 if pairs_map is None else 2
     index_map = chosen.index_map if pairs_map is None else pairs_map
     pattern = dolfinx.cpp.la.SparsityPattern(comm, [index_map] * 2, [bs, bs])
