@@ -5,21 +5,33 @@ multipliers whose block is ``h^2 / E`` or zero (a closed contact point without
 stabilisation is a pure Lagrange multiplier): unscaled, the 2-norm condition number
 of a small case-2 Jacobian was 2.6e19 and the direct solver's round-off differed
 from machine to machine at 1e-8. Both solves therefore work with ``R_s = R D`` (the
-unknowns ``y = D^-1 y_r``) and factor ``D R^T J R D``, with
+unknowns ``y = D^-1 y_r``) and factor ``D R^T J R D``, with ``D_ii = d_i^-1/2`` and
 
-    d_i = max(|J_ii|, sum_{j != i, J_jj != 0} J_ij^2 / |J_jj|),    D_ii = d_i^-1/2
+    d_i = |J_ii|                                              (Jacobi), or
+    d_i = max(|J_ii|, sum_{j != i, J_jj != 0} J_ij^2 / |J_jj|)  on the rows whose
+          diagonal is small: |J_ii| <= 1e-8 max_j |J_jj|
 
-on the reduced Jacobian ``J`` of the first assembly: Jacobi where the diagonal
-dominates, and for a multiplier row the diagonal of the Schur complement
-``B A^-1 B^T`` it couples into (the scale a zero-diagonal row needs). ``D`` is kept
-for the whole solve (any fixed positive ``D`` gives the same solution in exact
-arithmetic); a row with ``d_i = 0`` keeps ``D_ii = 1``.
+on the reduced Jacobian ``J`` of the first assembly. A multiplier row (zero diagonal,
+or ``h^2 / E`` against ``E`` in SI units) gets the diagonal of the Schur complement
+``B A^-1 B^T`` it couples into, the scale a zero-diagonal row needs; only those rows
+are read entry by entry (reading all of them, 29 M entries at 320 x 320, took 1.4 s).
+Where a multiplier block is not small against the displacements' (units in which
+``E ~ 1``), Jacobi scales its coupling ``B_ij / (C_ii A_jj)^1/2`` to order one too.
+``D`` is kept for the whole solve (any fixed positive ``D`` gives the same solution in
+exact arithmetic); a row with ``d_i = 0`` keeps ``D_ii = 1``. Measured: condition
+numbers of case 2 (P1, P2, cut fractions down to 1e-10) at most 2.2e5, as with the
+Schur diagonal on every row.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from mpi4py import MPI
 from petsc4py import PETSc
+
+
+#: A diagonal at most this fraction of the largest is small (see the module docstring)
+SMALL_DIAGONAL = 1e-8
 
 
 def saddle_point_scaling(J: PETSc.Mat) -> PETSc.Vec:
@@ -34,28 +46,28 @@ def saddle_point_scaling(J: PETSc.Mat) -> PETSc.Vec:
     diagonal = J.getDiagonal()
     d = np.abs(diagonal.getArray(readonly=True))
     diagonal.destroy()
+    comm = J.getComm()
+    largest = comm.tompi4py().allreduce(float(d.max(initial=0.0)), op=MPI.MAX)
+    small = np.flatnonzero(d <= SMALL_DIAGONAL * largest)
+    first = J.getOwnershipRange()[0]
+    rows = PETSc.IS().createGeneral((first + small).astype(PETSc.IntType), comm=comm)
+    first_column = J.getOwnershipRangeColumn()[0]
+    columns = PETSc.IS().createStride(J.getLocalSize()[1], first_column, 1, comm=comm)
+    part = J.createSubMatrix(rows, columns)  # the small rows, all columns as in J
+    indptr, cols, values = part.getValuesCSR()
+    for obj in (rows, columns, part):
+        obj.destroy()
     inverse = np.divide(1.0, d, out=np.zeros_like(d), where=d > 0)
-    indptr, columns, values = J.getValuesCSR()  # owned rows, global columns
-    lookup = _column_values(J, inverse, columns)
-    # s_i = sum_j J_ij^2 / |J_jj| row by row, a block of rows at a time (no temporary
-    # of the matrix's size: at 830 k rows J has 29 M entries)
-    s = np.zeros_like(d)
-    lengths = np.diff(indptr)
-    for begin in range(0, d.size, _ROWS_PER_BLOCK):
-        end = min(d.size, begin + _ROWS_PER_BLOCK)
-        a, b = indptr[begin], indptr[end]
-        weighted = values[a:b] ** 2 * lookup(columns[a:b])
-        rows = np.flatnonzero(lengths[begin:end] > 0)
-        s[begin + rows] = np.add.reduceat(weighted, indptr[begin + rows] - a)
-    s -= np.where(d > 0, d, 0.0)  # without j = i (J_ii^2 / |J_ii|)
-    scale = np.maximum(d, s)
+    weighted = values**2 * _column_values(J, inverse, cols)(cols)
+    s = np.zeros(small.size)
+    nonempty = np.flatnonzero(np.diff(indptr) > 0)
+    s[nonempty] = np.add.reduceat(weighted, indptr[nonempty])
+    s -= np.where(d[small] > 0, d[small], 0.0)  # without j = i (J_ii^2 / |J_ii|)
+    scale = d.copy()
+    scale[small] = np.maximum(d[small], s)
     D = J.createVecRight()
     D.setArray(np.divide(1.0, np.sqrt(scale), out=np.ones_like(scale), where=scale > 0))
     return D
-
-
-#: Rows per block of the row sums in :func:`saddle_point_scaling`
-_ROWS_PER_BLOCK = 1 << 15
 
 
 def _column_values(J: PETSc.Mat, owned: np.ndarray, columns: np.ndarray):
