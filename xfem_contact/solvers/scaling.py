@@ -29,7 +29,6 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-
 #: A diagonal at most this fraction of the largest is small (see the module docstring)
 SMALL_DIAGONAL = 1e-8
 
