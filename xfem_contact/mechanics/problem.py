@@ -32,7 +32,7 @@ from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw, large_sl
 from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loading import Loads
 from xfem_contact.mechanics.rigid_modes import free_bodies
-from xfem_contact.mechanics.splits import field_splits, rigid_modes
+from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
 from xfem_contact.solvers.linear import solve_restricted
 from xfem_contact.solvers.newton import NewtonFailure, NewtonReport, RestrictedNewton
 
@@ -275,7 +275,7 @@ class Problem(Loads):
             self._newton.destroy()  # loads or solver options changed since it was built
             self._newton = None
         if self._newton is None:
-            split = (petsc_options or {}).get("pc_type") == "fieldsplit"
+            split = (petsc_options or {}).get("pc_type") in ("fieldsplit", "python")
             self._newton = RestrictedNewton(
                 self.residual(),
                 self.w,
@@ -286,6 +286,7 @@ class Problem(Loads):
                 log=log,
                 splits=field_splits(self.space) if split else None,
                 near_nullspace=rigid_modes(self.space) if split else None,
+                interpolation=vertex_interpolation(self.space) if split else None,
                 couplings=list(self.couplings.values()),
             )
             self._newton_key = key

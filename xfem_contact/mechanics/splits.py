@@ -10,6 +10,7 @@ block for algebraic multigrid (GAMG). Used by
 
 from __future__ import annotations
 
+import basix
 import dolfinx.fem
 import numpy as np
 
@@ -35,7 +36,60 @@ def field_splits(space: EnrichedSpace) -> dict[str, np.ndarray]:
     multipliers = [field for field, _, _ in space.multiplier_fields]
     if multipliers:
         splits["lambda"] = dofs(multipliers)
+    splits["band"] = np.union1d(_band_displacements(space), splits.get("lambda", []))
     return splits
+
+
+def _band_displacements(space: EnrichedSpace) -> np.ndarray:
+    """Local dofs of ``space.W`` of both displacement fields on the cut cells and on
+    the cells sharing a facet with one (where the ghost penalty acts). Not collective
+    (ghost cells are local cells too)."""
+    mesh = space.cut.mesh
+    tdim = mesh.topology.dim
+    mesh.topology.create_connectivity(tdim, tdim - 1)
+    mesh.topology.create_connectivity(tdim - 1, tdim)
+    c2f = mesh.topology.connectivity(tdim, tdim - 1)
+    f2c = mesh.topology.connectivity(tdim - 1, tdim)
+    cut = space.cut.cut_cells
+    facets = np.unique(np.concatenate([c2f.links(c) for c in cut] or [np.zeros(0, np.int32)]))
+    cells = np.unique(np.concatenate([cut] + [f2c.links(f) for f in facets]))
+    dofs = [space.W.sub(field).dofmap.list[cells].ravel() for field in SIDE_FIELDS]
+    return np.unique(np.concatenate(dofs))
+
+
+def vertex_interpolation(space: EnrichedSpace):
+    """The interpolation of each displacement field from its vertex values (degree 1 in
+    degree 2: the coarse level of a two-level p-multigrid), or ``None`` for degree 1.
+
+    Returns:
+        ``(rows, cols, weights)``: local dofs of ``space.W`` (``rows`` owned and active,
+        ``cols`` the active vertex dofs of the same field and component, owned or ghost)
+        and the weights of the degree-1 basis at the rows' nodes; each ``(row, col)``
+        once, taken from a cell on which the field is active. Not collective.
+    """
+    if space.degree == 1:
+        return None
+    W, active = space.W, space.active
+    cell_name = W.mesh.basix_cell()
+    fine = basix.create_element(basix.ElementFamily.P, cell_name, space.degree)
+    coarse = basix.create_element(basix.ElementFamily.P, cell_name, 1)
+    table = coarse.tabulate(0, fine.points)[0, :, :, 0]  # (fine nodes, vertices)
+    n_owned = W.dofmap.index_map.size_local * W.dofmap.index_map_bs
+    gdim = W.mesh.geometry.dim
+    rows, cols, weights = [], [], []
+    for field in SIDE_FIELDS:
+        dofs = W.sub(field).dofmap.list  # (cells, nodes * gdim), a node's components together
+        dofs = dofs[np.all(active[dofs], axis=1)]
+        node, vertex = np.nonzero(np.abs(table) > 1e-14)
+        for c in range(gdim):
+            rows.append(dofs[:, gdim * node + c].ravel())
+            cols.append(dofs[:, gdim * vertex + c].ravel())
+            weights.append(np.tile(table[node, vertex], dofs.shape[0]))
+    rows, cols, weights = (np.concatenate(a) for a in (rows, cols, weights))
+    keep = rows < n_owned
+    key = rows[keep].astype(np.int64) * active.size + cols[keep]
+    _, first = np.unique(key, return_index=True)
+    return rows[keep][first], cols[keep][first], weights[keep][first]
 
 
 def rigid_modes(space: EnrichedSpace) -> list[dolfinx.fem.Function]:

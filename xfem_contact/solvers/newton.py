@@ -24,6 +24,7 @@ from petsc4py import PETSc
 
 from xfem_contact.fem.forms import form
 from xfem_contact.solvers.assembly import ReducedMatrix
+from xfem_contact.solvers.band_multigrid import gather
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
@@ -56,8 +57,9 @@ class RestrictedNewton:
         status: Called with ``w`` at every iterate, on every process; returns a
             dict shown in the log.
         log: Called with each log line (e.g. ``print``); ``None`` for silence.
-        splits: For a ``fieldsplit`` preconditioner (e.g. the ``"iterative"`` preset of
-            :data:`~xfem_contact.solvers.options.LINEAR_PRESETS`): split name to the
+        splits: For a ``fieldsplit`` preconditioner, or the band multigrid of the
+            ``"iterative"`` preset of :data:`~xfem_contact.solvers.options.LINEAR_PRESETS`
+            (which reads ``"u"`` and ``"band"``): split name to the
             local dofs of ``W`` it holds: shape ``(n,)``, the reduced unknowns touching
             them; or ``(n, bs)``, blocks of dofs that are reduced unknowns themselves
             (a node's components), kept together as blocks of size ``bs`` (what
@@ -70,6 +72,9 @@ class RestrictedNewton:
             ``add_residual(w, b)`` (into the residual of ``W``, global numbering) and
             ``add_jacobian(w, J)`` (into the unscaled reduced Jacobian). They need a
             selecting ``R`` (no multiplier prolongation).
+        interpolation: For the band multigrid (the ``"iterative"`` preset): ``(rows,
+            cols, weights)`` on local dofs of ``W``
+            (:func:`xfem_contact.mechanics.splits.vertex_interpolation`), or ``None``.
     """
 
     def __init__(
@@ -85,6 +90,7 @@ class RestrictedNewton:
         splits: dict[str, np.ndarray] | None = None,
         near_nullspace: list[dolfinx.fem.Function] | None = None,
         couplings: list | None = None,
+        interpolation=None,
     ):
         self.w, self.bcs, self.R = w, bcs, R
         self.couplings = list(couplings or [])
@@ -129,7 +135,7 @@ class RestrictedNewton:
         self.snes.setOptionsPrefix(self._prefix)
         with applied_options(self._prefix, self._options):
             self.snes.setFromOptions()
-        self._split_objects = self._field_splits(splits or {}, near_nullspace or [])
+        self._split_objects = self._field_splits(splits or {}, near_nullspace or [], interpolation)
         # PETSc keeps its callbacks alive, and the garbage collector cannot see through
         # PETSc objects: callbacks hold this object weakly, or it would never be freed.
         this = weakref.ref(self)
@@ -139,11 +145,15 @@ class RestrictedNewton:
         self.report = NewtonReport()
         self._projection: PETSc.KSP | None = None
 
-    def _field_splits(self, splits: dict, near_nullspace: list) -> list:
-        """Give a fieldsplit preconditioner its index sets (and ``"u"`` its near null
-        space); returns the PETSc objects to destroy. Collective."""
+    def _field_splits(self, splits: dict, near_nullspace: list, interpolation=None) -> list:
+        """Give a fieldsplit preconditioner its index sets ``"u"`` and ``"lambda"`` (and
+        ``"u"`` its near null space), or a Python one with a ``configure`` method
+        (:class:`~xfem_contact.solvers.band_multigrid.BandMultigrid`) the sets ``"u"``
+        and ``"band"``, the near null space and the ``interpolation`` in the reduced
+        unknowns; returns the PETSc objects to destroy. Collective."""
         pc = self.snes.getKSP().getPC()
-        if pc.getType() != PETSc.PC.Type.FIELDSPLIT or not splits:
+        kind = pc.getType()
+        if kind not in (PETSc.PC.Type.FIELDSPLIT, PETSc.PC.Type.PYTHON) or not splits:
             return []
         comm = self.R.getComm()
         first = self.R.getOwnershipRangeColumn()[0]
@@ -169,8 +179,9 @@ class RestrictedNewton:
                 index = PETSc.IS().createGeneral((first + local).astype(PETSc.IntType), comm=comm)
             sets.append((name, index))
             objects.append(index)
-        pc.setFieldSplitIS(*sets)
-        index = dict(sets).get("u")
+        if kind == PETSc.PC.Type.FIELDSPLIT:
+            pc.setFieldSplitIS(*[(name, index) for name, index in sets if name != "band"])
+        index, vectors = dict(sets).get("u"), []
         if index is not None and near_nullspace:
             squared = self.D.copy()
             squared.pointwiseMult(self.D, self.D)
@@ -187,7 +198,24 @@ class RestrictedNewton:
             objects += [space, squared, *vectors]
         marker.destroy()
         reduced.destroy()
+        context = pc.getPythonContext() if kind == PETSc.PC.Type.PYTHON else None
+        if hasattr(context, "configure"):
+            reduced_interpolation = self._reduced(interpolation)
+            context.configure(dict(sets)["u"], dict(sets)["band"], vectors, reduced_interpolation)
         return objects
+
+    def _reduced(self, interpolation):
+        """``(rows, cols, weights)`` on local dofs of ``W`` in the reduced, scaled
+        unknowns (``y = D^-1 x``: ``w D_col / D_row``); ``None`` without a selecting
+        ``R`` (a multiplier prolongation). Collective."""
+        chosen = self.jacobian.selection
+        if interpolation is None or chosen is None:
+            return None
+        rows, cols, weights = interpolation
+        rows, cols = chosen.columns[rows], chosen.columns[cols]
+        first = self.D.getOwnershipRange()[0]
+        scale = gather(self.D, cols) / self.D.getArray(readonly=True)[rows - first]
+        return rows, cols, weights * scale
 
     def _update(self, y: PETSc.Vec) -> None:
         x = self.w.x.petsc_vec

@@ -77,13 +77,8 @@ def _column_values(J: PETSc.Mat, owned: np.ndarray, columns: np.ndarray):
     remote = np.unique(columns[(columns < first) | (columns >= last)])
     source = J.createVecRight()
     source.setArray(owned)
-    gathered = PETSc.Vec().createSeq(remote.size, comm=PETSc.COMM_SELF)
-    index = PETSc.IS().createGeneral(remote.astype(PETSc.IntType), comm=PETSc.COMM_SELF)
-    scatter = PETSc.Scatter().create(source, index, gathered, None)
-    scatter.scatter(source, gathered, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
-    remote_values = gathered.getArray(readonly=True).copy()
-    for obj in (source, gathered, index, scatter):
-        obj.destroy()
+    remote_values = gather(source, remote)
+    source.destroy()
 
     def lookup(cols: np.ndarray) -> np.ndarray:
         local = (cols >= first) & (cols < last)
@@ -94,3 +89,17 @@ def _column_values(J: PETSc.Mat, owned: np.ndarray, columns: np.ndarray):
         return out
 
     return lookup
+
+
+def gather(vector: PETSc.Vec, indices: np.ndarray) -> np.ndarray:
+    """The entries of a distributed vector at global ``indices`` (owned here or not).
+    Collective."""
+    wanted = np.unique(indices)
+    gathered = PETSc.Vec().createSeq(wanted.size, comm=PETSc.COMM_SELF)
+    index = PETSc.IS().createGeneral(wanted.astype(PETSc.IntType), comm=PETSc.COMM_SELF)
+    scatter = PETSc.Scatter().create(vector, index, gathered, None)
+    scatter.scatter(vector, gathered, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD)
+    values = gathered.getArray(readonly=True)[np.searchsorted(wanted, indices)].copy()
+    for obj in (gathered, index, scatter):
+        obj.destroy()
+    return values

@@ -1,0 +1,264 @@
+"""A preconditioner for the reduced contact Jacobians: p-multigrid plus an interface band.
+
+One application to a residual ``r`` (a petsc4py Python PC, ``pc_type = python``):
+
+1. ``x_u = MG(A_uu) r_u``, zero elsewhere: the displacement block by one V-cycle of a
+   two-level multigrid, degree 2 on degree 1 (the interpolation from each field's
+   vertex values, :func:`xfem_contact.mechanics.splits.vertex_interpolation`), one
+   forward SOR sweep before and one backward sweep after, the coarse level
+   ``P^T A_uu P`` by LU; for degree 1, GAMG on ``A_uu`` with the rigid modes;
+2. ``x_b += J_bb^-1 (r - J x)_b``: an exact (LU) solve on the band ``b``, the
+   displacements of the cut cells and their facet neighbours (where the ghost penalty
+   acts) and every multiplier.
+
+Algebraic multigrid alone (GAMG on ``A_uu``, with the multipliers by a Schur field
+split) took 151, 209 and 415 Krylov iterations for case 2 at N = 40, 80, 160: the
+ghost-penalty rows make the degree-2 operator hard to aggregate, and the multipliers
+couple only through the band. With the band solved exactly and the bulk by the
+p-multigrid, GMRES takes 12 or 13 iterations from N = 40 to 320, tiny cuts too
+(``bench/iterative.py``). The band has O(N) unknowns and the coarse level a quarter
+of the displacements'.
+
+Sub-solver options live under the PC's prefix plus ``bmg_u_`` (the PCMG, or GAMG for
+degree 1) and ``bmg_band_`` (the band's LU); :data:`U_OPTIONS` and
+:data:`BAND_OPTIONS` are the defaults, which options in the database override.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from petsc4py import PETSc
+
+from xfem_contact.solvers.options import OptionValue
+from xfem_contact.solvers.scaling import gather
+
+#: Defaults of the displacement solve, degree 2 (PCMG, 2 levels, interpolation set here)
+U_OPTIONS: dict[str, OptionValue] = {
+    "ksp_type": "preonly",
+    "mg_levels_ksp_type": "richardson",
+    "mg_levels_pc_type": "sor",
+    "mg_levels_ksp_max_it": 1,
+    "mg_levels_pc_sor_local_forward": "",
+    "mg_distinct_smoothup": "",
+    "mg_levels_up_ksp_type": "richardson",
+    "mg_levels_up_pc_type": "sor",
+    "mg_levels_up_ksp_max_it": 1,
+    "mg_levels_up_pc_sor_local_backward": "",
+    "mg_coarse_ksp_type": "preonly",
+    "mg_coarse_pc_type": "lu",
+    "mg_coarse_pc_factor_mat_solver_type": "mumps",
+    "mg_coarse_mat_mumps_icntl_7": 4,
+}
+#: Defaults of the displacement solve, degree 1 (algebraic multigrid)
+U_OPTIONS_DEGREE1: dict[str, OptionValue] = {
+    "ksp_type": "preonly",
+    "pc_type": "gamg",
+    "mg_levels_pc_type": "sor",
+    "mg_levels_ksp_max_it": 2,
+}
+#: Defaults of the band solve
+BAND_OPTIONS: dict[str, OptionValue] = {
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+    "mat_mumps_icntl_7": 4,
+}
+
+
+class BandMultigrid:
+    """The Python context of the PC (see the module docstring).
+
+    PETSc creates it from ``pc_python_type``; :meth:`configure` then gives it the
+    index sets, the near null space and the interpolation, in the unknowns of the
+    operator (the reduced, scaled numbering of
+    :class:`~xfem_contact.solvers.newton.RestrictedNewton`). Collective methods.
+    """
+
+    def __init__(self):
+        self.u = self.band = None
+        self._interpolation = None
+        self._modes: list[PETSc.Vec] = []
+        self._objects: list = []
+        self._built = False
+
+    def configure(self, u: PETSc.IS, band: PETSc.IS, modes: list[PETSc.Vec], interpolation):
+        """Give the splits. Collective.
+
+        Args:
+            u: The displacement unknowns (owned, global indices of the operator).
+            band: The band's unknowns (owned, global indices).
+            modes: Near null space of ``A_uu`` (vectors laid out as ``u``).
+            interpolation: ``None`` (degree 1), or ``(rows, cols, weights)``: global
+                unknowns of the operator, rows owned, each a displacement unknown, cols
+                the vertex unknowns it interpolates from (the coarse unknowns).
+        """
+        self.u, self.band, self._modes = u, band, list(modes)
+        self._interpolation = interpolation
+
+    # -- PETSc's callbacks ---------------------------------------------------------
+    def setUp(self, pc: PETSc.PC) -> None:
+        if self.u is None:
+            raise RuntimeError("BandMultigrid: configure() was not called before the solve")
+        J = pc.getOperators()[1]
+        prefix = (pc.getOptionsPrefix() or "") + "bmg_"
+        if not self._built:
+            self._build(J, prefix)
+        else:
+            J.createSubMatrix(self.u, self.u, submat=self.A)
+            J.createSubMatrix(self.band, self.band, submat=self.J_bb)
+            J.createSubMatrix(self.band, self.all_columns, submat=self.J_b)
+            if self.P is not None:
+                self.A.PtAP(self.P, result=self.A_c)
+        for ksp, options in ((self.ksp_band, BAND_OPTIONS), (self.ksp_u, self.u_options)):
+            with _defaults(ksp.getOptionsPrefix(), options):
+                ksp.setFromOptions()
+                ksp.setUp()
+
+    def apply(self, pc: PETSc.PC, r: PETSc.Vec, x: PETSc.Vec) -> None:
+        x.set(0.0)
+        r_u, x_u = r.getSubVector(self.u), x.getSubVector(self.u)
+        self.ksp_u.solve(r_u, x_u)
+        r.restoreSubVector(self.u, r_u)
+        x.restoreSubVector(self.u, x_u)
+        self.J_b.mult(x, self.r_b)  # (J x)_b: the band rows only
+        r_b = r.getSubVector(self.band)
+        self.r_b.aypx(-1.0, r_b)
+        r.restoreSubVector(self.band, r_b)
+        self.ksp_band.solve(self.r_b, self.x_b)
+        x_b = x.getSubVector(self.band)
+        x_b.axpy(1.0, self.x_b)
+        x.restoreSubVector(self.band, x_b)
+
+    def view(self, pc: PETSc.PC, viewer: PETSc.Viewer | None = None) -> None:
+        if viewer is not None and self._built:
+            levels = "degree 2 on degree 1, coarse LU" if self.P is not None else "GAMG"
+            viewer.printfASCII(
+                f"  band multigrid: {self.band.getSize()} band unknowns (LU), "
+                f"{self.u.getSize()} displacements ({levels})\n"
+            )
+
+    def destroy(self, pc: PETSc.PC | None = None) -> None:
+        for obj in self._objects:
+            obj.destroy()
+        self._objects = []
+        self._built = False
+
+    # -- construction --------------------------------------------------------------
+    def _build(self, J: PETSc.Mat, prefix: str) -> None:
+        comm = J.getComm()
+        first, last = J.getOwnershipRange()
+        self.all_columns = PETSc.IS().createStride(last - first, first, 1, comm=comm)
+        self.A = J.createSubMatrix(self.u, self.u)
+        self.A.setBlockSize(2)
+        self.J_bb = J.createSubMatrix(self.band, self.band)
+        self.J_b = J.createSubMatrix(self.band, self.all_columns)
+        self.r_b, self.x_b = self.J_bb.createVecLeft(), self.J_bb.createVecRight()
+        self.ksp_band = PETSc.KSP().create(comm)
+        self.ksp_band.setOptionsPrefix(prefix + "band_")
+        self.ksp_band.setOperators(self.J_bb)
+        self.ksp_u = PETSc.KSP().create(comm)
+        self.ksp_u.setOptionsPrefix(prefix + "u_")
+        self.ksp_u.setOperators(self.A)
+        space = PETSc.NullSpace().create(vectors=self._modes, comm=comm)
+        self.P = self.A_c = None
+        self._objects = [self.all_columns, self.A, self.J_bb, self.J_b, self.r_b, self.x_b]
+        self._objects += [self.ksp_band, self.ksp_u, space]
+        if self._interpolation is None:
+            self.u_options = U_OPTIONS_DEGREE1
+            self.A.setNearNullSpace(space)
+        else:
+            self.u_options = U_OPTIONS
+            self.P, coarse = _prolongation(J, self.u, *self._interpolation)
+            #: Local positions in ``u`` of the owned coarse (vertex) unknowns
+            self.coarse_positions = coarse
+            self.A_c = self.A.PtAP(self.P)
+            self.A_c.setBlockSize(2)
+            coarse_modes = _orthonormal([_restricted(m, coarse) for m in self._modes])
+            coarse_space = PETSc.NullSpace().create(vectors=coarse_modes, comm=comm)
+            self.A_c.setNearNullSpace(coarse_space)
+            mg = self.ksp_u.getPC()
+            mg.setType(PETSc.PC.Type.MG)
+            mg.setMGLevels(2)
+            mg.setMGInterpolation(1, self.P)
+            mg.getMGCoarseSolve().setOperators(self.A_c, self.A_c)
+            mg.getMGSmoother(1).setOperators(self.A, self.A)
+            self._objects += [self.P, self.A_c, coarse_space, *coarse_modes]
+        self._built = True
+
+
+def _prolongation(J: PETSc.Mat, u: PETSc.IS, rows, cols, weights) -> tuple[PETSc.Mat, np.ndarray]:
+    """``P`` from the coarse unknowns (the distinct ``cols``, numbered process by
+    process in the order of their global index) to the unknowns of ``u``, and the
+    positions in ``u``'s local part of the owned coarse unknowns. Collective."""
+    comm = u.getComm()
+    owned_u = u.getIndices()
+    first, last = J.getOwnershipRange()
+    coarse = np.unique(cols[(cols >= first) & (cols < last)])  # owned, by global index
+    offset = comm.tompi4py().exscan(coarse.size) or 0
+    # the coarse number of every column, from its owner
+    number = J.createVecRight()
+    values = np.full(last - first, -1.0)
+    values[coarse - first] = offset + np.arange(coarse.size)  # exact below 2^53
+    number.setArray(values)
+    coarse_cols = np.rint(gather(number, cols)).astype(np.int64)
+    number.destroy()
+    if np.any(coarse_cols < 0) or not np.all(np.isin(rows, owned_u)):
+        raise RuntimeError("BandMultigrid: the interpolation does not fit the splits")
+    by_index = np.argsort(owned_u)  # u need not be sorted (side -1's nodes, then +1's)
+
+    def position(indices):  # local position in u of owned unknowns
+        return by_index[np.searchsorted(owned_u, indices, sorter=by_index)]
+
+    local_rows = position(rows)
+    order = np.lexsort((coarse_cols, local_rows))
+    local_rows, coarse_cols, weights = local_rows[order], coarse_cols[order], weights[order]
+    indptr = np.searchsorted(local_rows, np.arange(owned_u.size + 1)).astype(PETSc.IntType)
+    P = PETSc.Mat().createAIJ(
+        ((owned_u.size, PETSc.DETERMINE), (coarse.size, PETSc.DETERMINE)), comm=comm
+    )
+    P.setPreallocationCSR((indptr, coarse_cols.astype(PETSc.IntType), weights))
+    P.assemble()
+    return P, position(coarse)
+
+
+def _restricted(mode: PETSc.Vec, positions: np.ndarray) -> PETSc.Vec:
+    """The entries of ``mode`` (laid out as ``u``) at the owned coarse unknowns."""
+    values = mode.getArray(readonly=True)[positions].copy()
+    return PETSc.Vec().createWithArray(values, comm=mode.getComm())
+
+
+def _orthonormal(vectors: list[PETSc.Vec]) -> list[PETSc.Vec]:
+    """Gram-Schmidt; vectors that vanish are dropped."""
+    kept = []
+    for v in vectors:
+        for q in kept:
+            v.axpy(-v.dot(q), q)
+        norm = v.norm()
+        if norm > 1e-12:
+            v.scale(1.0 / norm)
+            kept.append(v)
+        else:
+            v.destroy()
+    return kept
+
+
+class _defaults:
+    """Write default options under a prefix for a ``setFromOptions`` unless the
+    database has them already; remove what was written afterwards."""
+
+    def __init__(self, prefix: str, options: dict):
+        self.prefix, self.options, self.written = prefix, options, []
+
+    def __enter__(self):
+        database = PETSc.Options()
+        for key, value in self.options.items():
+            name = self.prefix + key
+            if not database.hasName(name):
+                database[name] = value
+                self.written.append(name)
+
+    def __exit__(self, *exc):
+        database = PETSc.Options()
+        for name in self.written:
+            database.delValue(name)
+        return False
