@@ -1,14 +1,14 @@
 """Krylov iterations and memory of the iterative Newton solve against the direct one.
 
-Paper case 2 (P2-P1, sticking, quadrilaterals) for N = 40, 80, 160 cells per side, and
+Paper case 2 (P2-P1, sticking, quadrilaterals) for N = 40 ... 320 cells per side, and
 with a radius that leaves cut cells with tiny parts (``--tiny``: r = 0.2 + 1e-7 h,
 so the circle passes a hair's breadth from mesh nodes), each case a process of its
-own solved with ``LINEAR_PRESETS["direct"]`` (MUMPS LU) and ``["iterative"]`` (FGMRES +
-Schur field split, GAMG on the displacements): Newton steps, Krylov iterations per
+own solved with ``LINEAR_PRESETS["direct"]`` (MUMPS LU) and ``["iterative"]`` (GMRES +
+band multigrid, :mod:`xfem_contact.solvers.band_multigrid`): Newton steps, Krylov iterations per
 step, wall time of the solve, peak resident memory and the contact-pressure error.
 Writes ``bench/results/iterative.{json,md}``.
 
-Run: ``python bench/iterative.py [--sizes 40 80 160] [--tiny]`` (``make bench``).
+Run: ``python bench/iterative.py [--sizes 40 80 160 320 640] [--tiny]`` (``make bench``).
 """
 
 import argparse
@@ -65,7 +65,7 @@ def run(n: int, solver: str, tiny: bool) -> dict:
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sizes", type=int, nargs="+", default=[40, 80, 160])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[40, 80, 160, 320])
     parser.add_argument("--tiny", action="store_true", help="also the tiny-cut radius")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--case", nargs=3, help=argparse.SUPPRESS)

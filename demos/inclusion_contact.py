@@ -59,7 +59,7 @@ def main():
         "--solver",
         default="direct",
         choices=sorted(LINEAR_PRESETS),
-        help="linear solver of the Newton steps: MUMPS LU, or FGMRES + Schur field split",
+        help="linear solver of the Newton steps: MUMPS LU, or GMRES + band multigrid",
     )
     parser.add_argument("--out", default="results/inclusion_contact")
     parser.add_argument("--json", default=None)
