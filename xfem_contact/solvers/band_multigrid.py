@@ -137,11 +137,17 @@ class BandMultigrid:
                 f"{self.u.getSize()} displacements ({levels})\n"
             )
 
-    def destroy(self, pc: PETSc.PC | None = None) -> None:
+    def reset(self, pc: PETSc.PC | None = None) -> None:
+        """Forget the operators' blocks (PETSc calls it when the operator's pattern
+        changed, e.g. a large-sliding coupling grew it): the next set-up extracts them
+        afresh."""
         for obj in self._objects:
             obj.destroy()
         self._objects = []
         self._built = False
+
+    def destroy(self, pc: PETSc.PC | None = None) -> None:
+        self.reset(pc)
 
     # -- construction --------------------------------------------------------------
     def _build(self, J: PETSc.Mat, prefix: str) -> None:
