@@ -126,11 +126,18 @@ def test_lips_grid_carries_each_sides_field(tmp_path_factory, cell):
         ]
     import pyvista
 
-    back = pyvista.read(path)
-    assert back.n_cells == grid.n_cells
-    assert np.allclose(back.point_data["u"], grid.point_data["u"])
-    assert pyvista.read(paths[0]).n_cells == grid.n_cells
-    assert pyvista.read(paths[1]).n_cells == cut.geometry.seg.shape[0]
+    back = pyvista.read(path)  # written by VTK directly: the same grid as pyvista's
+    assert np.array_equal(back.points, grid.points)
+    assert np.array_equal(back.cells, grid.cells)
+    assert np.array_equal(back.celltypes, grid.celltypes)
+    for name in ("side", "cut", "cell"):
+        assert np.array_equal(back.cell_data[name], grid.cell_data[name])
+    assert np.array_equal(back.point_data["u"], grid.point_data["u"])
+    subcells, interface = (pyvista.read(p) for p in paths)
+    assert np.array_equal(subcells.cells, grid.cells)
+    assert "u" not in subcells.point_data
+    assert interface.n_cells == cut.geometry.seg.shape[0]
+    assert set(interface.cell_data.keys()) == {"cell"}
 
 
 def test_pngs_are_written_and_not_blank(tmp_path):

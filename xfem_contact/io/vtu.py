@@ -1,0 +1,215 @@
+"""VTK grids of cut meshes and results as arrays, and ``.vtu`` files written from them.
+
+Every grid is local to its process (each rank builds its own owned cells) and
+has no shared points: each cell carries its own nodes, so fields may jump
+between cells (the two lips of the interface). Coordinates are physical (the
+mesh's units, m in the paper's cases), padded with ``z = 0``.
+
+- Uncut cells are quadratic VTK cells (6-node triangles, 9-node biquadratic
+  quadrilaterals) whose nodes are the parent cell's P2/Q2 reference lattice
+  pushed through the cell map: exact for affine and Q2 geometry.
+- Sub-triangles of cut cells are 6-node VTK triangles: the nodes of
+  ``cut.geometry.tri_minus`` / ``tri_plus`` (parent reference coordinates)
+  pushed through the cell map. On affine parents this is the exact curved
+  sub-triangle used by the quadrature; on curved parents its P2 interpolant.
+- Interface pieces are 3-node VTK quadratic edges (``cut.geometry.seg``).
+
+Cell data: ``side`` (-1 for ``phi < 0``, +1), ``cut`` (1 on sub-triangles, 0 on
+uncut cells), ``cell`` (local index of the parent cell).
+
+This module needs VTK's own Python modules only (no pyvista import, a third of a
+second): :mod:`xfem_contact.io.vtk_grids` makes pyvista objects of the same arrays.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.evaluation import evaluate_lattice, evaluate_reference
+
+#: VTK cell types (``vtkCellType.h``)
+QUADRATIC_EDGE, QUADRATIC_TRIANGLE, BIQUADRATIC_QUAD = 21, 22, 28
+_NODES = {QUADRATIC_EDGE: 3, QUADRATIC_TRIANGLE: 6, BIQUADRATIC_QUAD: 9}
+
+# Reference nodes of the uncut cells' quadratic lattice, in VTK node order
+_LATTICE = {
+    "triangle": (
+        np.array([[0, 0], [1, 0], [0, 1], [0.5, 0], [0.5, 0.5], [0, 0.5]], dtype=np.float64),
+        QUADRATIC_TRIANGLE,
+    ),
+    "quadrilateral": (
+        np.array(
+            [[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0], [1, 0.5], [0.5, 1], [0, 0.5], [0.5, 0.5]],
+            dtype=np.float64,
+        ),
+        BIQUADRATIC_QUAD,
+    ),
+}
+# Basix P2 triangle (vertices, then mid-nodes of edges (1,2), (0,2), (0,1)) -> VTK
+# (vertices, then mid-nodes of edges (0,1), (1,2), (2,0))
+P2_TO_VTK = np.array([0, 1, 2, 5, 3, 4])
+
+
+class _Block(NamedTuple):
+    """Cells of one kind: parent cells ``(n,)``, reference nodes ``(n, k, tdim)`` in VTK order."""
+
+    side: int
+    cut: int
+    cells: npt.NDArray[np.int32]
+    X: npt.NDArray[np.float64]
+    vtk_type: int
+
+
+def _blocks(cut: CutMesh) -> list[_Block]:
+    """Uncut cells and sub-triangles of both sides (owned cells of this process)."""
+    lattice, vtk_type = _LATTICE[cut.mesh.topology.cell_name()]
+    g = cut.geometry
+    blocks = []
+    for side, tri, rows in ((-1, g.tri_minus, g.tri_minus_cell), (1, g.tri_plus, g.tri_plus_cell)):
+        cells = np.flatnonzero(cut.cell_sides == side).astype(np.int32)
+        X = np.broadcast_to(lattice, (cells.size, *lattice.shape))
+        blocks.append(_Block(side, 0, cells, X, vtk_type))
+        blocks.append(
+            _Block(
+                side,
+                1,
+                cut.cut_cells[rows].astype(np.int32),
+                tri[:, P2_TO_VTK],
+                QUADRATIC_TRIANGLE,
+            )
+        )
+    return blocks
+
+
+def _pad3(a: np.ndarray) -> np.ndarray:
+    """``(m, d)`` -> ``(m, 3)`` with zero columns."""
+    return np.c_[a, np.zeros((a.shape[0], 3 - a.shape[1]))]
+
+
+class GridArrays(NamedTuple):
+    """A grid as arrays: ``points`` (m, 3) (m), ``cells`` in VTK's legacy layout (for
+    each cell its number of nodes, then their indices), ``types`` (VTK cell types,
+    uint8), ``cell_data`` and ``point_data`` (name to array)."""
+
+    points: np.ndarray
+    cells: np.ndarray
+    types: np.ndarray
+    cell_data: dict
+    point_data: dict
+
+
+def grid_arrays(cut: CutMesh, blocks: list[_Block], fields: dict | None = None) -> GridArrays:
+    """Arrays of ``blocks`` with unshared nodes; ``fields[side]``: Function evaluated as
+    point data ``u``."""
+    tdim = cut.mesh.topology.dim
+    points, connectivity, types, data = [], [], [], {"side": [], "cut": [], "cell": []}
+    values = []
+    start = 0
+    for b in blocks:
+        n, k = b.X.shape[:2]
+        if n == 0:
+            continue
+        if b.X.strides[0] == 0:  # the same lattice in every cell: tabulate it once
+            lattice = np.ascontiguousarray(b.X[0])
+            points.append(_pad3(cut.maps.push_forward_lattice(b.cells, lattice)))
+            if fields is not None:
+                values.append(_pad3(evaluate_lattice(fields[b.side], b.cells, lattice)))
+        else:
+            cells = np.repeat(b.cells, k)
+            X = np.ascontiguousarray(b.X.reshape(-1, tdim))
+            points.append(_pad3(cut.maps.push_forward(cells, X)))
+            if fields is not None:
+                values.append(_pad3(evaluate_reference(fields[b.side], cells, X)))
+        ids = start + np.arange(n * k).reshape(n, k)
+        connectivity.append(np.c_[np.full(n, k), ids].ravel())
+        types.append(np.full(n, b.vtk_type, dtype=np.uint8))
+        data["side"].append(np.full(n, b.side, dtype=np.int8))
+        data["cut"].append(np.full(n, b.cut, dtype=np.int8))
+        data["cell"].append(b.cells.astype(np.int32))
+        start += n * k
+    if not points:
+        empty = {"side": np.int8, "cut": np.int8, "cell": np.int32}
+        return GridArrays(
+            np.zeros((0, 3)),
+            np.zeros(0, dtype=np.int64),
+            np.zeros(0, dtype=np.uint8),
+            {name: np.zeros(0, dtype=dtype) for name, dtype in empty.items()},
+            {},
+        )
+    point_data = {} if fields is None else {"u": np.concatenate(values)}
+    return GridArrays(
+        np.concatenate(points),
+        np.concatenate(connectivity),
+        np.concatenate(types),
+        {name: np.concatenate(parts) for name, parts in data.items()},
+        point_data,
+    )
+
+
+def lips_arrays(cut: CutMesh, u_minus, u_plus) -> GridArrays:
+    """Uncut cells and sub-triangles with point data ``u`` (m), each side's own."""
+    return grid_arrays(cut, _blocks(cut), {-1: u_minus, 1: u_plus})
+
+
+def subcell_arrays(cut: CutMesh) -> GridArrays:
+    """Uncut cells and curved sub-triangles of the cut cells (this process's cells)."""
+    return grid_arrays(cut, _blocks(cut))
+
+
+def interface_arrays(cut: CutMesh) -> GridArrays:
+    """The curved interface pieces as 3-node quadratic edges, cell data ``cell``."""
+    g = cut.geometry
+    cells = cut.cut_cells[g.seg_cell].astype(np.int32)
+    arrays = grid_arrays(cut, [_Block(0, 1, cells, g.seg, QUADRATIC_EDGE)])
+    return arrays._replace(cell_data={"cell": arrays.cell_data["cell"]})
+
+
+def write_vtu(path, arrays: GridArrays, compression: str = "lz4") -> None:
+    """Write ``arrays`` as a VTK XML unstructured grid (binary, compressed with
+    ``compression``: ``"lz4"``, ``"zlib"`` or ``"none"``). Not collective."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+    from vtkmodules.vtkCommonCore import VTK_UNSIGNED_CHAR, vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkUnstructuredGrid
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridWriter
+
+    grid = vtkUnstructuredGrid()
+    points = vtkPoints()
+    points.SetData(numpy_to_vtk(np.ascontiguousarray(arrays.points, dtype=np.float64), deep=True))
+    grid.SetPoints(points)
+    table = np.zeros(max(_NODES) + 1, dtype=np.int64)
+    table[list(_NODES)] = list(_NODES.values())
+    nodes = table[arrays.types]  # nodes per cell
+    offsets = np.zeros(nodes.size + 1, dtype=np.int64)
+    np.cumsum(nodes, out=offsets[1:])
+    keep = np.ones(arrays.cells.size, dtype=bool)
+    keep[offsets[:-1] + np.arange(nodes.size)] = False  # the legacy counts
+    cells = vtkCellArray()
+    connectivity = np.ascontiguousarray(arrays.cells[keep], dtype=np.int64)
+    cells.SetData(
+        numpy_to_vtkIdTypeArray(offsets, deep=True),
+        numpy_to_vtkIdTypeArray(connectivity, deep=True),
+    )
+    types = numpy_to_vtk(arrays.types, deep=True, array_type=VTK_UNSIGNED_CHAR)
+    grid.SetCells(types, cells)
+    parts = ((grid.GetCellData(), arrays.cell_data), (grid.GetPointData(), arrays.point_data))
+    for target, data in parts:
+        for name, values in data.items():
+            array = numpy_to_vtk(np.ascontiguousarray(values), deep=True)
+            array.SetName(name)
+            target.AddArray(array)
+    writer = vtkXMLUnstructuredGridWriter()
+    writer.SetFileName(str(path))
+    writer.SetInputData(grid)
+    writer.SetDataModeToBinary()
+    compressors = {
+        "lz4": writer.SetCompressorTypeToLZ4,
+        "zlib": writer.SetCompressorTypeToZLib,
+        "none": writer.SetCompressorTypeToNone,
+    }
+    compressors[compression]()
+    if not writer.Write():
+        raise OSError(f"could not write {path}")
