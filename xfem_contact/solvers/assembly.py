@@ -148,17 +148,29 @@ def reduced_matrix(a: dolfinx.fem.Form, chosen: Selection, blocks: bool = True) 
     block = chosen.local // bs if bs > 1 else chosen.local  # -1 stays negative
     for row in _rows(block[dofmap[cells]]):
         pattern.insert(row, row)
-    for c0, c1 in pairs:
-        row = np.unique(np.concatenate([block[dofmap[c0]], block[dofmap[c1]]]))
-        row = row[row >= 0]
-        pattern.insert(row, row)
+    W = a.function_spaces[0]
+    fields = [W.sub([i]).dofmap.map() for i in range(W.element.num_sub_elements)] or [dofmap]
+    for field in fields:  # facet pairs couple a field with itself (the ghost penalty)
+        for row in _rows(np.c_[block[field[pairs[:, 0]]], block[field[pairs[:, 1]]]]):
+            pattern.insert(row, row)
     pattern.insert_diagonal(np.arange(index_map.size_local, dtype=np.int32))
     pattern.finalize()
     A = dolfinx.cpp.la.petsc.create_matrix(comm, pattern)
     lgmap = PETSc.LGMap().create(chosen.columns.astype(PETSc.IntType), comm=comm)
     A.setLGMap(lgmap, lgmap)
     lgmap.destroy()
+    _zeros_outside_the_pattern(A)
     return A
+
+
+def _zeros_outside_the_pattern(A: PETSc.Mat) -> None:
+    """The facet kernels fill every field's block with explicit zeros: skipped. A nonzero
+    outside the pattern (a facet term coupling two fields) is inserted, slowly, never
+    dropped: the per-field pattern is an optimisation, not an assumption. Set before each
+    assembly: a merge that grows the pattern (``MatAXPY``) makes new storage without
+    these options."""
+    A.setOption(PETSc.Mat.Option.IGNORE_ZERO_ENTRIES, True)
+    A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
 
 
 def _rows(cell_rows: np.ndarray):
@@ -169,7 +181,7 @@ def _rows(cell_rows: np.ndarray):
     distinct[:, 1:] = cell_rows[:, 1:] != cell_rows[:, :-1]
     distinct &= cell_rows >= 0
     counts = distinct.sum(axis=1)
-    for k in np.unique(counts):
+    for k in np.unique(counts[counts > 0]):
         group = cell_rows[counts == k][distinct[counts == k]].reshape(-1, k)
         yield from np.ascontiguousarray(group, dtype=np.int32)
 
@@ -219,6 +231,7 @@ class ReducedMatrix:
         return it; the object keeps it. Collective."""
         if self.direct:
             self.mat.zeroEntries()
+            _zeros_outside_the_pattern(self.mat)
             _assemble_unrolled(self.mat, self.a, self.bcs)
             self.mat.assemble()
             return self.mat
