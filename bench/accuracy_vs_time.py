@@ -5,7 +5,7 @@ Cases: the geometry (disc area and circle length), paper case 1, case 2
 (quadrilaterals and triangles), case 3 at alpha = 0 and turned by pi/2 (large
 sliding). Swept: displacement degree 1 and 2, five or more mesh sizes, the level
 set as a callable or a P2 Function, the quadrature degree, the LBB treatment
-(stabilised, restriction), the linear solver (direct LU, iterative field split).
+(stabilised, restriction), the linear solver (direct LU, iterative band multigrid).
 Body-fitted baseline (:mod:`xfem_contact.cases.body_fitted`): gmsh meshes following
 the interface, curved P2 cells for degree 2, standard DOLFINx elasticity, meshing
 time included. Moving interface: the inclusion resized over 10 positions, X-FEM
