@@ -101,3 +101,27 @@ def test_large_sliding_iterative_equals_direct():
         solutions.append(problem.w.x.array.copy())
     scale = np.abs(solutions[0]).max()
     assert np.allclose(solutions[1], solutions[0], rtol=0.0, atol=1e-9 * scale)
+
+
+def test_a_bonded_interface_beside_a_contact_one():
+    """Bonded (a pure multiplier: each side floats in the displacement block) next to
+    Coulomb: the preconditioner's augmented block couples the sides (without it GMRES
+    stalled at 1e-1 after 500 iterations); a linear problem is refused in one line."""
+    import pathlib
+    import tomllib
+
+    import xfem_contact.scenes
+    from xfem_contact.scenes.builder import build
+
+    path = pathlib.Path(xfem_contact.scenes.__file__).parent / "two_inclusions.toml"
+    data = tomllib.loads(path.read_text())
+    data["solver"] = data.get("solver", {}) | {"linear": "iterative"}
+    scene = load_scene(data)
+    problem = build(scene)
+    problem = problem[0] if isinstance(problem, tuple) else problem
+    assert {law.name for law in problem.laws.values()} == {"bonded", "coulomb"}
+    problem.load_factor.set(0.5)
+    report = problem.solve(scene.petsc_options)
+    assert max(report.linear_iterations) <= 20
+    with pytest.raises(ValueError, match="linear problem"):
+        inclusion_problem(6, 2, "bonded").solve(preset("iterative"))

@@ -92,6 +92,12 @@ def solve_restricted(
         RuntimeError: The KSP diverged (converged reason < 0).
     """
     own_R = R is None
+    if (petsc_options or {}).get("pc_type") == "python":
+        raise ValueError(
+            "solver.linear = 'iterative' (the band multigrid) preconditions the Newton "
+            "steps of contact problems; a linear problem (interfaces 'bonded' or 'free' "
+            "only) takes 'direct'"
+        )
     if own_R:
         R = restriction_matrix(space)
     A, b = assemble_restricted(a, L, bcs, R)
