@@ -10,7 +10,8 @@ One application to a residual ``r`` (a petsc4py Python PC, ``pc_type = python``)
    two-level multigrid, degree 2 on degree 1 (the interpolation from each field's
    vertex values, :func:`xfem_contact.mechanics.splits.vertex_interpolation`), one
    forward SOR sweep before and one backward sweep after, the coarse level
-   ``P^T A_uu P`` by LU; for degree 1, GAMG on ``A_uu`` with the rigid modes;
+   ``P^T A P`` (of the augmented block) by LU; for degree 1, GAMG on it with the rigid
+   modes;
 2. ``x_b += J_bb^-1 (r - J x)_b``: an exact (LU) solve on the band ``b``, the
    displacements of the cut cells and their facet neighbours (where the ghost penalty
    acts) and every multiplier.
@@ -19,7 +20,7 @@ Algebraic multigrid alone (GAMG on ``A_uu``, with the multipliers by a Schur fie
 split) took 151, 209 and 415 Krylov iterations for case 2 at N = 40, 80, 160: the
 ghost-penalty rows make the degree-2 operator hard to aggregate, and the multipliers
 couple only through the band. With the band solved exactly and the bulk by the
-p-multigrid, GMRES takes 12 or 13 iterations from N = 40 to 320, tiny cuts too
+p-multigrid, GMRES takes 8 to 10 iterations from N = 40 to 640, tiny cuts too
 (``bench/iterative.py``). The band has O(N) unknowns and the coarse level a quarter
 of the displacements'.
 
