@@ -76,11 +76,11 @@ def vertex_interpolation(space: EnrichedSpace):
     table = coarse.tabulate(0, fine.points)[0, :, :, 0]  # (fine nodes, vertices)
     n_owned = W.dofmap.index_map.size_local * W.dofmap.index_map_bs
     gdim = W.mesh.geometry.dim
+    node, vertex = np.nonzero(np.abs(table) > 1e-14)  # the nonzero weights
     rows, cols, weights = [], [], []
     for field in SIDE_FIELDS:
         dofs = W.sub(field).dofmap.list  # (cells, nodes * gdim), a node's components together
         dofs = dofs[np.all(active[dofs], axis=1)]
-        node, vertex = np.nonzero(np.abs(table) > 1e-14)
         for c in range(gdim):
             rows.append(dofs[:, gdim * node + c].ravel())
             cols.append(dofs[:, gdim * vertex + c].ravel())

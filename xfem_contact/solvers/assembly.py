@@ -101,10 +101,10 @@ def _coupled_cells(a: dolfinx.fem.Form) -> tuple[npt.NDArray, npt.NDArray]:
     return np.unique(np.concatenate(cells)), np.unique(np.concatenate(pairs), axis=0)
 
 
-def _pairs(chosen: Selection, W, comm) -> dolfinx.cpp.common.IndexMap | None:
-    # W: the (C++) mixed space of the form
+def _pairs(chosen: Selection, fields: list, comm) -> dolfinx.cpp.common.IndexMap | None:
     """The index map of the reduced unknowns taken two by two (the two components of a
-    node), if every field of ``W`` has two components and the unknowns pair up on
+    node), if every field (``fields``: the cell dofmaps of the fields of the mixed
+    space ``W``) has two components and the unknowns pair up on
     every process (owned and ghost ones alike: even counts, ghost pairs ``2m, 2m + 1``),
     else ``None`` (e.g. a scalar multiplier: frictionless contact). Collective.
 
@@ -113,7 +113,6 @@ def _pairs(chosen: Selection, W, comm) -> dolfinx.cpp.common.IndexMap | None:
     imap = chosen.index_map
     ghosts, owners = imap.ghosts, imap.owners
     first = imap.local_range[0]
-    fields = [W.sub([i]).dofmap.map() for i in range(W.element.num_sub_elements)]
     paired = (
         all(d.shape[1] % 2 == 0 and np.all(d[:, 1::2] == d[:, 0::2] + 1) for d in fields)
         and imap.size_local % 2 == 0
@@ -139,17 +138,17 @@ def reduced_matrix(a: dolfinx.fem.Form, chosen: Selection, blocks: bool = True) 
     at 320 x 320 its finalisation took 0.2 s instead of 0.8 s), and the matrix has
     block size 2."""
     comm = a.mesh.comm  # lives as long as the mesh (the index map's own does not)
-    pairs_map = _pairs(chosen, a.function_spaces[0], comm) if blocks else None
+    W = a.function_spaces[0]
+    dofmap = W.dofmap.map()  # (num_cells, dofs per cell)
+    fields = [W.sub([i]).dofmap.map() for i in range(W.element.num_sub_elements)] or [dofmap]
+    pairs_map = _pairs(chosen, fields, comm) if blocks else None
     bs = 1 if pairs_map is None else 2
     index_map = chosen.index_map if pairs_map is None else pairs_map
     pattern = dolfinx.cpp.la.SparsityPattern(comm, [index_map] * 2, [bs, bs])
-    dofmap = a.function_spaces[0].dofmap.map()  # (num_cells, dofs per cell)
     cells, pairs = _coupled_cells(a)
     block = chosen.local // bs if bs > 1 else chosen.local  # -1 stays negative
     for row in _rows(block[dofmap[cells]]):
         pattern.insert(row, row)
-    W = a.function_spaces[0]
-    fields = [W.sub([i]).dofmap.map() for i in range(W.element.num_sub_elements)] or [dofmap]
     for field in fields:  # facet pairs couple a field with itself (the ghost penalty)
         for row in _rows(np.c_[block[field[pairs[:, 0]]], block[field[pairs[:, 1]]]]):
             pattern.insert(row, row)

@@ -24,10 +24,9 @@ from petsc4py import PETSc
 
 from xfem_contact.fem.forms import form
 from xfem_contact.solvers.assembly import ReducedMatrix
-from xfem_contact.solvers.band_multigrid import gather
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.report import NewtonFailure, NewtonReport
-from xfem_contact.solvers.scaling import saddle_point_scaling
+from xfem_contact.solvers.scaling import gather, saddle_point_scaling
 
 
 class RestrictedNewton:
