@@ -8,8 +8,8 @@ pressure is n.sigma.n = -3/2 + cos(2 theta)/2 and the tangential traction
 element) by default; generalized Newton (PETSc SNES) on the augmented Lagrangian.
 
 Writes in ``--out``: VTX files of the displacement of each side and of the
-multipliers, ``result.vtu`` (the lips), ``subcells.vtu``/``interface.vtu`` (the
-cut), a PNG of the contact pressure against the angle with the exact curve, and a
+multipliers, ``result.vtu`` (the lips: uncut cells and sub-triangles, each side's
+displacement), ``subcells.vtu``/``interface.vtu`` (the cut region), a PNG of the contact pressure against the angle with the exact curve, and a
 JSON summary (``--json``, default OUT/summary.json); ``xfem-contact show OUT``
 renders the folder.
 
@@ -149,8 +149,8 @@ def plot(path, theta, pressure, args):
     line_plot(
         path,
         [
-            Series(np.degrees(theta), pressure, ".", "X-FEM multiplier $\\lambda_n$"),
-            Series(np.degrees(t), -1.5 + 0.5 * np.cos(2 * t), "k--", "exact $n\\cdot\\sigma n$"),
+            Series(np.degrees(theta), pressure, ".", "X-FEM multiplier λₙ"),
+            Series(np.degrees(t), -1.5 + 0.5 * np.cos(2 * t), "k--", "exact n·σn"),
         ],
         "angle (degrees)",
         "contact pressure (Pa)",

@@ -109,7 +109,17 @@ def test_lips_grid_carries_each_sides_field(tmp_path_factory, cell):
     u_plus.interpolate(lambda x: np.stack([np.ones_like(x[0]), -x[0]]))
     grid = pictures.deformed_lips_grid(cut, u_minus, u_plus)
     x, y = grid.points[:, 0], grid.points[:, 1]
-    side = np.repeat(np.asarray(grid.cell_data["side"]), np.diff(grid.cell_offsets))
+    side = np.zeros(grid.n_points, dtype=np.int8)  # each point belongs to one side
+    cell_side = np.repeat(np.asarray(grid.cell_data["side"]), np.diff(grid.cell_offsets))
+    side[grid.cell_connectivity] = cell_side
+    assert np.all(side[grid.cell_connectivity] == cell_side)
+    # the uncut cells of a side share their nodes: one point per vertex, edge, centre
+    nodes_per_cell = np.diff(grid.cell_offsets)
+    for s in (-1, 1):
+        cells = (np.asarray(grid.cell_data["cut"]) == 0) & (grid.cell_data["side"] == s)
+        nodes = np.unique(grid.cell_connectivity[np.repeat(cells, nodes_per_cell)])
+        assert nodes.size <= nodes_per_cell[cells].sum()
+        assert np.unique(grid.points[nodes].round(12), axis=0).shape[0] == nodes.size
     exact = np.where(side[:, None] == -1, np.c_[x * y, y**2], np.c_[np.ones_like(x), -x])
     assert np.abs(grid.point_data["u"][:, :2] - exact).max() < 1e-12
     assert np.all(grid.point_data["u"][:, 2] == 0)
@@ -133,8 +143,10 @@ def test_lips_grid_carries_each_sides_field(tmp_path_factory, cell):
     for name in ("side", "cut", "cell"):
         assert np.array_equal(back.cell_data[name], grid.cell_data[name])
     assert np.array_equal(back.point_data["u"], grid.point_data["u"])
-    subcells, interface = (pyvista.read(p) for p in paths)
-    assert np.array_equal(subcells.cells, grid.cells)
+    subcells, interface = (pyvista.read(p) for p in paths)  # the cut region only
+    is_cut = np.asarray(grid.cell_data["cut"]) == 1
+    assert subcells.n_cells == is_cut.sum() and np.all(subcells.cell_data["cut"] == 1)
+    assert np.allclose(subcells.points, grid.extract_cells(np.flatnonzero(is_cut)).points)
     assert "u" not in subcells.point_data
     assert interface.n_cells == cut.geometry.seg.shape[0]
     assert set(interface.cell_data.keys()) == {"cell"}
@@ -190,7 +202,7 @@ def test_show_renders_a_run_folder(tmp_path, capsys):
         assert not_blank(out / name)
 
     # Optional files missing: those pictures are skipped with a line saying so
-    for path in out.glob("subcells*.vtu"):
+    for path in out.glob("interface*.vtu"):
         path.unlink()
     summary.pop("interface_samples", None)
     (out / "summary.json").write_text(json.dumps(summary))

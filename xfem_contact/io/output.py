@@ -73,15 +73,20 @@ def write_lips(path: str | pathlib.Path, cut: CutMesh, u_minus, u_plus) -> pathl
 
 
 def write_cut_geometry(directory: str | pathlib.Path, cut: CutMesh) -> list[pathlib.Path]:
-    """Write ``subcells.vtu`` (uncut cells and curved sub-triangles, cell data ``side``,
-    ``cut``, ``cell``) and ``interface.vtu`` (curved interface pieces) into ``directory``.
+    """Write ``subcells.vtu`` (the curved sub-triangles of the cut cells, cell data
+    ``side``, ``cut``, ``cell``) and ``interface.vtu`` (curved interface pieces) into
+    ``directory``: the cut region only, the uncut cells are in ``result.vtu``
+    (:func:`write_lips`).
 
     Local to each process (not collective): in parallel rank ``r`` writes
     ``subcells_r{r}.vtu`` and ``interface_r{r}.vtu``. See :mod:`xfem_contact.io.pictures`.
     """
     directory, comm = pathlib.Path(directory), cut.mesh.comm
     paths = []
-    for name, arrays in (("subcells", subcell_arrays(cut)), ("interface", interface_arrays(cut))):
+    for name, arrays in (
+        ("subcells", subcell_arrays(cut, uncut=False)),
+        ("interface", interface_arrays(cut)),
+    ):
         path = _rank_path(directory / f"{name}.vtu", comm)
         write_vtu(path, arrays, VTU_COMPRESSION)
         paths.append(path)

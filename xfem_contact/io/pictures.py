@@ -214,8 +214,8 @@ def render_folder(
     """Render the results of a scene run folder to PNG (serial; reads the files).
 
     Writes ``result.png`` (deformed configuration, from ``result*.vtu``),
-    ``cut.png`` (sub-triangles and interface, from ``subcells*.vtu`` and
-    ``interface*.vtu``) and ``pressure.png`` (``lambda_n`` of the
+    ``cut.png`` (uncut cells and sub-triangles from ``result*.vtu``, the interface
+    from ``interface*.vtu``) and ``pressure.png`` (``lambda_n`` of the
     ``interface_samples`` of ``summary.json``); a picture whose data is missing is
     skipped with a ``log`` line.
 
@@ -244,20 +244,19 @@ def render_folder(
             grid, folder / "result.png", title=f"{name}: deformed", scale=1.0 if large else None
         )
     )
-    subcells = sorted(folder.glob("subcells*.vtu"))
-    if subcells:
-        pieces = [pyvista.read(p) for p in sorted(folder.glob("interface*.vtu"))]
-        pieces = [g for g in pieces if g.n_cells]
+    interface_files = sorted(folder.glob("interface*.vtu"))
+    if interface_files and "cut" in grid.cell_data:
+        pieces = [g for g in (pyvista.read(p) for p in interface_files) if g.n_cells]
         written.append(
             render_cut(
-                merge_grids([pyvista.read(p) for p in subcells]),
+                grid,
                 merge_grids(pieces) if pieces else None,
                 folder / "cut.png",
                 title=f"{name}: cut cells and interface",
             )
         )
     else:
-        say(f"skipped cut.png: no subcells*.vtu in {folder}")
+        say(f"skipped cut.png: no interface*.vtu of a cut run in {folder}")
     interfaces = summary.get("interfaces") or {}
     if len(interfaces) > 1:  # one plot per interface
         plots = {f"pressure_{k}.png": (k, v.get("samples")) for k, v in interfaces.items()}

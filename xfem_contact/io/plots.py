@@ -23,7 +23,8 @@ def line_plot(
     """Write a PNG of several curves (e.g. computed points and the exact curve).
 
     Draws on a :class:`matplotlib.figure.Figure` of its own with the Agg canvas: no
-    pyplot, so neither the process's backend nor pyplot's figure list is touched."""
+    pyplot, so neither the process's backend nor pyplot's figure list is touched.
+    Labels in Unicode (``λₙ``), not mathtext: its parser takes 0.07 s to build."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -87,7 +88,7 @@ def plot_pressure(
     """
     s, p = np.asarray(abscissa, dtype=np.float64), np.asarray(values, dtype=np.float64)
     order = np.argsort(s)
-    series = [Series(s[order], p[order], ".", "X-FEM multiplier $\\lambda_n$")]
+    series = [Series(s[order], p[order], ".", "X-FEM multiplier λₙ")]
     if applied is not None:
         a = np.asarray(applied, dtype=np.float64)[order]
         series.append(Series(s[order], a, "x", "applied $P_n = \\min(0, \\lambda_n + r g_n)$"))
@@ -95,4 +96,4 @@ def plot_pressure(
         t = np.linspace(s.min(), s.max(), 400) if s.size else np.zeros(0)
         e = np.full_like(t, exact) if np.isscalar(exact) else np.asarray(exact(t), dtype=float)
         series.append(Series(t, e, "k--", "exact"))
-    return line_plot(path, series, xlabel, "contact pressure $\\lambda_n$ (Pa)", title)
+    return line_plot(path, series, xlabel, "contact pressure λₙ (Pa)", title)

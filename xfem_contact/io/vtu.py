@@ -1,13 +1,17 @@
 """VTK grids of cut meshes and results as arrays, and ``.vtu`` files written from them.
 
-Every grid is local to its process (each rank builds its own owned cells) and
-has no shared points: each cell carries its own nodes, so fields may jump
-between cells (the two lips of the interface). Coordinates are physical (the
-mesh's units, m in the paper's cases), padded with ``z = 0``.
+Every grid is local to its process (each rank builds its own owned cells).
+Points are shared only among the uncut cells of one side; each sub-triangle
+carries its own nodes, and no point is shared between the sides, so fields may
+jump across the interface (the two lips). Coordinates are physical (the mesh's
+units, m in the paper's cases), padded with ``z = 0``.
 
 - Uncut cells are quadratic VTK cells (6-node triangles, 9-node biquadratic
   quadrilaterals) whose nodes are the parent cell's P2/Q2 reference lattice
-  pushed through the cell map: exact for affine and Q2 geometry.
+  pushed through the cell map: exact for affine and Q2 geometry. A lattice node
+  is a vertex, an edge midpoint or the cell centre, numbered once per side (a
+  quarter of the points of one node set per cell on quadrilaterals), and a field
+  is evaluated there once.
 - Sub-triangles of cut cells are 6-node VTK triangles: the nodes of
   ``cut.geometry.tri_minus`` / ``tri_plus`` (parent reference coordinates)
   pushed through the cell map. On affine parents this is the exact curved
@@ -25,6 +29,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import basix
 import numpy as np
 import numpy.typing as npt
 
@@ -64,15 +69,17 @@ class _Block(NamedTuple):
     vtk_type: int
 
 
-def _blocks(cut: CutMesh) -> list[_Block]:
-    """Uncut cells and sub-triangles of both sides (owned cells of this process)."""
+def _blocks(cut: CutMesh, uncut: bool = True) -> list[_Block]:
+    """Sub-triangles of both sides, and (``uncut``) the uncut cells (owned cells of
+    this process)."""
     lattice, vtk_type = _LATTICE[cut.mesh.topology.cell_name()]
     g = cut.geometry
     blocks = []
     for side, tri, rows in ((-1, g.tri_minus, g.tri_minus_cell), (1, g.tri_plus, g.tri_plus_cell)):
-        cells = np.flatnonzero(cut.cell_sides == side).astype(np.int32)
-        X = np.broadcast_to(lattice, (cells.size, *lattice.shape))
-        blocks.append(_Block(side, 0, cells, X, vtk_type))
+        if uncut:
+            cells = np.flatnonzero(cut.cell_sides == side).astype(np.int32)
+            X = np.broadcast_to(lattice, (cells.size, *lattice.shape))
+            blocks.append(_Block(side, 0, cells, X, vtk_type))
         blocks.append(
             _Block(
                 side,
@@ -83,6 +90,49 @@ def _blocks(cut: CutMesh) -> list[_Block]:
             )
         )
     return blocks
+
+
+def _lattice_keys(cut: CutMesh, cells: npt.NDArray[np.int32], lattice: np.ndarray) -> np.ndarray:
+    """A key per lattice node of each cell, ``(len(cells), k)`` int64, equal for the
+    nodes that coincide in neighbouring cells: a vertex is keyed by its vertex, an
+    edge midpoint by the edge's two vertices, any other node by its cell (local
+    numbering of this process)."""
+    mesh = cut.mesh
+    celltype = mesh.basix_cell()
+    ref, edges = basix.geometry(celltype), basix.topology(celltype)[1]
+    vertices = mesh.topology.connectivity(mesh.topology.dim, 0).array
+    vertices = vertices.reshape(-1, ref.shape[0])[cells].astype(np.int64)
+    nv = np.int64(mesh.topology.index_map(0).size_local + mesh.topology.index_map(0).num_ghosts)
+    keys = np.empty((cells.size, lattice.shape[0]), dtype=np.int64)
+    for j, X in enumerate(lattice):
+        at_vertex = np.flatnonzero(np.all(np.isclose(ref, X), axis=1))
+        at_edge = [e for e in edges if np.allclose(ref[e].mean(axis=0), X)]
+        if at_vertex.size:
+            keys[:, j] = vertices[:, at_vertex[0]]
+        elif at_edge:
+            a, b = vertices[:, at_edge[0][0]], vertices[:, at_edge[0][1]]
+            keys[:, j] = nv + np.minimum(a, b) * nv + np.maximum(a, b)
+        else:
+            keys[:, j] = nv + nv * nv + cells
+    return keys
+
+
+def _shared_lattice(cut: CutMesh, b: _Block, field) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Points ``(m, 3)``, node indices per cell ``(n, k)`` and values ``(m, 3)`` (or
+    ``None``) of the lattice nodes of ``b``'s cells, each node once."""
+    lattice = np.ascontiguousarray(b.X[0])
+    keys = _lattice_keys(cut, b.cells, lattice)
+    _, first, ids = np.unique(keys.ravel(), return_index=True, return_inverse=True)
+    cell_of, node_of = b.cells[first // lattice.shape[0]], first % lattice.shape[0]
+    points = np.zeros((first.size, 3))
+    values = None if field is None else np.zeros((first.size, 3))
+    for j in range(lattice.shape[0]):  # the nodes first met as lattice node j
+        rows = np.flatnonzero(node_of == j)
+        X = lattice[j : j + 1]
+        points[rows] = _pad3(cut.maps.push_forward_lattice(cell_of[rows], X))
+        if field is not None:
+            values[rows] = _pad3(evaluate_lattice(field, cell_of[rows], X))
+    return points, ids.reshape(keys.shape), values
 
 
 def _pad3(a: np.ndarray) -> np.ndarray:
@@ -103,8 +153,8 @@ class GridArrays(NamedTuple):
 
 
 def grid_arrays(cut: CutMesh, blocks: list[_Block], fields: dict | None = None) -> GridArrays:
-    """Arrays of ``blocks`` with unshared nodes; ``fields[side]``: Function evaluated as
-    point data ``u``."""
+    """Arrays of ``blocks`` (nodes shared within a block of uncut cells only);
+    ``fields[side]``: Function evaluated as point data ``u``."""
     tdim = cut.mesh.topology.dim
     points, connectivity, types, data = [], [], [], {"side": [], "cut": [], "cell": []}
     values = []
@@ -113,24 +163,24 @@ def grid_arrays(cut: CutMesh, blocks: list[_Block], fields: dict | None = None) 
         n, k = b.X.shape[:2]
         if n == 0:
             continue
-        if b.X.strides[0] == 0:  # the same lattice in every cell: tabulate it once
-            lattice = np.ascontiguousarray(b.X[0])
-            points.append(_pad3(cut.maps.push_forward_lattice(b.cells, lattice)))
+        if b.X.strides[0] == 0:  # the same lattice in every cell: nodes shared
+            xs, ids, us = _shared_lattice(cut, b, None if fields is None else fields[b.side])
+            points.append(xs)
             if fields is not None:
-                values.append(_pad3(evaluate_lattice(fields[b.side], b.cells, lattice)))
+                values.append(us)
         else:
             cells = np.repeat(b.cells, k)
             X = np.ascontiguousarray(b.X.reshape(-1, tdim))
             points.append(_pad3(cut.maps.push_forward(cells, X)))
             if fields is not None:
                 values.append(_pad3(evaluate_reference(fields[b.side], cells, X)))
-        ids = start + np.arange(n * k).reshape(n, k)
-        connectivity.append(np.c_[np.full(n, k), ids].ravel())
+            ids = np.arange(n * k).reshape(n, k)
+        connectivity.append(np.c_[np.full(n, k), start + ids].ravel())
         types.append(np.full(n, b.vtk_type, dtype=np.uint8))
         data["side"].append(np.full(n, b.side, dtype=np.int8))
         data["cut"].append(np.full(n, b.cut, dtype=np.int8))
         data["cell"].append(b.cells.astype(np.int32))
-        start += n * k
+        start += points[-1].shape[0]
     if not points:
         empty = {"side": np.int8, "cut": np.int8, "cell": np.int32}
         return GridArrays(
@@ -155,9 +205,10 @@ def lips_arrays(cut: CutMesh, u_minus, u_plus) -> GridArrays:
     return grid_arrays(cut, _blocks(cut), {-1: u_minus, 1: u_plus})
 
 
-def subcell_arrays(cut: CutMesh) -> GridArrays:
-    """Uncut cells and curved sub-triangles of the cut cells (this process's cells)."""
-    return grid_arrays(cut, _blocks(cut))
+def subcell_arrays(cut: CutMesh, uncut: bool = True) -> GridArrays:
+    """Curved sub-triangles of the cut cells and (``uncut``) the uncut cells (this
+    process's cells)."""
+    return grid_arrays(cut, _blocks(cut, uncut))
 
 
 def interface_arrays(cut: CutMesh) -> GridArrays:
