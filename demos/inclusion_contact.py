@@ -9,9 +9,9 @@ element) by default; generalized Newton (PETSc SNES) on the augmented Lagrangian
 
 Writes in ``--out``: VTX files of the displacement of each side and of the
 multipliers, ``result.vtu`` (the lips: uncut cells and sub-triangles, each side's
-displacement), ``subcells.vtu``/``interface.vtu`` (the cut region), a PNG of the contact pressure against the angle with the exact curve, and a
-JSON summary (``--json``, default OUT/summary.json); ``xfem-contact show OUT``
-renders the folder.
+displacement), ``subcells.vtu``/``interface.vtu`` (the cut region), a PNG of the
+contact pressure against the angle with the exact curve, and a JSON summary
+(``--json``, default OUT/summary.json); ``xfem-contact show OUT`` renders the folder.
 
 Run: ``python demos/inclusion_contact.py [--n 40] [--degree 2] [--law sticking]``,
 also under ``mpiexec -n 2``.

@@ -4,6 +4,10 @@
 - a form assembled straight into the reduced numbering (on 2 x 2 blocks where the
   unknowns pair up) equals ``R^T A R`` by PtAP,
   bit for bit, and a prolongation in ``R`` takes the PtAP path;
+- the uncut cells assembled field by field on the fields' own spaces
+  (:func:`xfem_contact.fem.field_blocks.split_uncut`) give the same matrix, a term
+  coupling two fields there included, and so do the Newton residuals where the
+  Dirichlet data are not met (the lifting);
 - the runtime-table layouts read back from disk equal the ones FFCx's IR gives;
 - the first Newton iterate reuses the Jacobian assembled for the scaling only when
   it sits at that state.
@@ -19,9 +23,11 @@ from petsc4py import PETSc
 from xfem_contact.cases.paper import inclusion_problem
 from xfem_contact.codegen import kernel_store
 from xfem_contact.fem import forms
+from xfem_contact.fem.field_blocks import split_uncut
 from xfem_contact.fem.forms import form
 from xfem_contact.fem.subspaces import collapse
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
+from xfem_contact.solvers.newton import RestrictedNewton
 
 
 @pytest.fixture(scope="module", params=["quadrilateral", "triangle"])
@@ -121,6 +127,74 @@ def test_a_facet_term_coupling_two_fields_is_kept():
     for mat in (full, reference, R):
         mat.destroy()
     reduced.destroy()
+
+
+@pytest.mark.parametrize(
+    "law, cell, blocked, coupled",
+    [
+        ("coulomb", "quadrilateral", True, False),
+        ("coulomb", "triangle", True, False),
+        ("frictionless", "quadrilateral", False, True),
+    ],
+)
+def test_uncut_cells_on_the_fields_own_spaces(law, cell, blocked, coupled):
+    """The Jacobian split into the uncut cells' field blocks (inserted 2 x 2 where the
+    unknowns pair up; the single-component pins of case 2 among the Dirichlet dofs)
+    and the rest: PtAP's matrix. A term coupling two fields on uncut cells stays."""
+    options = {"friction": 0.3} if law == "coulomb" else {}
+    problem = inclusion_problem(8, 2, law, cell, **options)
+    W = problem.space.W
+    J = ufl.derivative(problem.residual(), problem.w, ufl.TrialFunction(W))
+    if coupled:  # u_- tested with v_+ on the uncut cells of side -1 (inactive dofs aside)
+        u_minus, v_plus = ufl.split(ufl.TrialFunction(W))[0], ufl.split(ufl.TestFunction(W))[1]
+        J = J + 1e6 * ufl.inner(u_minus, v_plus) * problem.cut.dx(-1)
+    split = split_uncut(J, problem.space.field_space)
+    assert [b.field for b in split.blocks] == [0, 1]  # the multipliers have no bulk
+    R = problem.restriction()
+    blocks = [(form(b.form), b.parent) for b in split.blocks]
+    reduced = ReducedMatrix(form(split.rest), problem._bcs, R, field_blocks=blocks)
+    assert [b[2] for b in reduced._blocks] == [blocked, blocked]
+    A = reduced.assemble()
+    assert A.getInfo()["mallocs"] == 0
+    full = dolfinx.fem.petsc.assemble_matrix(form(J), bcs=problem._bcs)
+    full.assemble()
+    reference = full.PtAP(R)
+    scale = reference.norm()
+    reference.axpy(-1.0, A, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    assert reference.norm() <= 1e-14 * scale
+    for mat in (full, reference, R):
+        mat.destroy()
+    reduced.destroy()
+
+
+def test_split_newton_lifts_unmet_dirichlet_data():
+    """Where w misses its Dirichlet data the residual is lifted with the whole
+    Jacobian (compiled then): DOLFINx's lifted residual; and the solution is the
+    one without the split."""
+    problem = inclusion_problem(8, 2, "sticking")
+    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 1e-4)  # not met by w = 0
+    R, bcs = problem.restriction(), problem._bcs
+    solutions = []
+    for field_space in (problem.space.field_space, None):
+        problem.w.x.array[:] = 0.0
+        newton = RestrictedNewton(problem.residual(), problem.w, bcs, R, field_space=field_space)
+        assert (newton.jacobian_forms._whole is None) == (field_space is not None)
+        newton._residual(None, newton.y, newton.F_r)  # at w = R y = 0
+        x = problem.w.x.petsc_vec
+        b = dolfinx.fem.petsc.assemble_vector(form(problem.residual()))
+        dolfinx.fem.petsc.apply_lifting(b, [_jacobian(problem)], bcs=[bcs], x0=[x], alpha=-1.0)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        dolfinx.fem.petsc.set_bc(b, bcs, x, -1.0)
+        reference = newton.F_r.duplicate()
+        newton.R.multTranspose(b, reference)  # (R D)^T b
+        reference.axpy(-1.0, newton.F_r)
+        assert reference.norm() <= 1e-12 * newton.F_r.norm()
+        newton.solve()
+        solutions.append(problem.w.x.array.copy())
+        for obj in (newton, b, reference):
+            obj.destroy()
+    assert np.allclose(solutions[0], solutions[1], rtol=0, atol=1e-12 * np.abs(solutions[1]).max())
+    R.destroy()
 
 
 def test_prolongation_takes_the_ptap_path():

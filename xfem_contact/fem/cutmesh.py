@@ -23,13 +23,14 @@ from xfem_contact.geometry.levelset import (
     LevelSet,
     LevelSetCallable,
     interpolate,
-    union,
+    named_interfaces,
 )
 from xfem_contact.quadrature import boundary
 from xfem_contact.quadrature import rules as quadrature
 from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart, marker_space
 
 _SIDE_MINUS, _SIDE_PLUS, _INTERFACE = 1, 2, 3
+_SPLIT = {_SIDE_MINUS: (4, 6), _SIDE_PLUS: (5, 7)}  # side measure: uncut, cut cells parts
 _INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + index
 _BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
 _CUT_CELLS0 = 50  # measure ids of cut.dx_cut(name): _CUT_CELLS0 + index, _CUT_CELLS0 - 1 all
@@ -95,25 +96,8 @@ class CutMesh:
         tdim = mesh.topology.dim
         cell_name = mesh.topology.cell_name()
         start = time.perf_counter()
-        components = None
-        if isinstance(levelset, Mapping):
-            components = dict(levelset)
-            names = tuple(components)
-            if not names:
-                raise ValueError("Give at least one interface level set")
-            known = getattr(self, "interface_names", names)
-            if names != known:
-                raise ValueError(f"update() needs the interfaces {list(known)}, got {list(names)}")
-            levelset = (
-                components[names[0]] if len(names) == 1 else union(mesh, components, self.degree)
-            )
-        elif getattr(self, "interface_names", ("interface",)) != ("interface",):
-            raise ValueError(
-                f"This CutMesh has the interfaces {list(self.interface_names)}: "
-                "update() takes a mapping of their level sets"
-            )
-        else:
-            names = ("interface",)
+        known = getattr(self, "interface_names", None)
+        names, components, levelset = named_interfaces(mesh, levelset, self.degree, known)
         #: Names of the interfaces, in the order of their measure ids
         self.interface_names: tuple[str, ...] = names
         self._components = components
@@ -267,6 +251,12 @@ class CutMesh:
             "dx", domain=self.mesh, subdomain_data=self, subdomain_id=sid, metadata=metadata or {}
         )
 
+    def split_side_measure(self, subdomain_id: int) -> tuple[int, int] | None:
+        """For the id of a side measure (:meth:`dx`): the ids of its two parts, the
+        uncut cells (standard rule) and the cut cells (runtime rules), whose sum it is;
+        ``None`` for other ids. For :func:`xfem_contact.fem.field_blocks.split_uncut`."""
+        return _SPLIT.get(subdomain_id)
+
     @property
     def dGamma(self) -> ufl.Measure:
         """Measure of the interface (arc length in physical units): ``expr * cut.dGamma``."""
@@ -388,6 +378,11 @@ class CutMesh:
                 r = self.interface_rules_of(self.interface_names[k])
                 self._cell_rules[k + _INTERFACE0] = self._rules(self.cut_cells, r)
             return [IntegrationPart("cell", rules=self._cell_rules[subdomain_id])]
+        for side, (uncut, cut_part) in _SPLIT.items():  # a part of a side measure
+            if subdomain_id == uncut:
+                return [IntegrationPart("cell", entities=self._standard[side])]
+            if subdomain_id == cut_part:
+                return [IntegrationPart("cell", rules=self._cell_rules[side])]
         if subdomain_id not in self._cell_rules:
             raise ValueError(f"Unknown CutMesh measure id {subdomain_id}")
         parts = []

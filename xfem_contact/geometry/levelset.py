@@ -5,7 +5,7 @@ reference and physical coordinates evaluated per point (vectorised over cells).
 from __future__ import annotations
 
 import typing
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import basix
 import dolfinx.fem
@@ -217,3 +217,32 @@ def union(
         return np.minimum.reduce([np.asarray(f(x), dtype=np.float64) for f in functions])
 
     return phi
+
+
+def named_interfaces(
+    mesh: dolfinx.mesh.Mesh, levelset, degree: int, known: tuple[str, ...] | None = None
+) -> tuple[tuple[str, ...], dict | None, typing.Any]:
+    """The interfaces of a level set given to a cut: one (named ``"interface"``) for a
+    callable or a Function, or those of a mapping ``{name: callable}``, cut as their
+    :func:`union` (collective then). ``known``: the names of an earlier cut of the same
+    mesh, which the new level set must repeat.
+
+    Returns:
+        ``(names, components, levelset)``: the names, the mapping (``None`` for a single
+        level set) and the level set to interpolate.
+    """
+    if not isinstance(levelset, Mapping):
+        if known not in (None, ("interface",)):
+            raise ValueError(
+                f"This CutMesh has the interfaces {list(known)}: "
+                "update() takes a mapping of their level sets"
+            )
+        return ("interface",), None, levelset
+    components = dict(levelset)
+    names = tuple(components)
+    if not names:
+        raise ValueError("Give at least one interface level set")
+    if known is not None and names != known:
+        raise ValueError(f"update() needs the interfaces {list(known)}, got {list(names)}")
+    one = components[names[0]] if len(names) == 1 else union(mesh, components, degree)
+    return names, components, one

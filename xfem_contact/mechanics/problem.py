@@ -5,8 +5,7 @@ field per law that needs one), the bulk model of each side, the loads and the
 Dirichlet data, and composes the interface laws (:mod:`xfem_contact.mechanics.laws`):
 the residual is the bulk's plus each law's terms minus the loads. Linear laws only:
 one KSP solve; any contact law: generalized Newton (SNES). Both solve on the active
-dofs through the one restriction operator ``R`` (:mod:`xfem_contact.fem.restriction`).
-SI units (Pa, m).
+dofs of the restriction ``R`` (:mod:`xfem_contact.fem.restriction`). SI units (Pa, m).
 """
 
 from __future__ import annotations
@@ -288,6 +287,7 @@ class Problem(Loads):
                 near_nullspace=rigid_modes(self.space) if split else None,
                 interpolation=vertex_interpolation(self.space) if split else None,
                 couplings=list(self.couplings.values()),
+                field_space=self.space.field_space,
             )
             self._newton_key = key
         self._newton.log = log

@@ -128,10 +128,17 @@ def _pairs(chosen: Selection, fields: list, comm) -> dolfinx.cpp.common.IndexMap
     )
 
 
-def reduced_matrix(a: dolfinx.fem.Form, chosen: Selection, blocks: bool = True) -> PETSc.Mat:
-    """An AIJ matrix with the sparsity of ``a`` on the selected dofs, laid out as the
-    reduced space, whose local-to-global map takes ``W``'s local dof numbers (the
-    numbering :func:`dolfinx.fem.petsc.assemble_matrix` inserts with). Collective.
+def reduced_matrix(
+    a: dolfinx.fem.Form,
+    chosen: Selection,
+    blocks: bool = True,
+    field_blocks: list[tuple[dolfinx.fem.Form, np.ndarray]] = (),
+) -> PETSc.Mat:
+    """An AIJ matrix with the sparsity of ``a`` (and of the ``field_blocks``: forms on
+    a field's own space, with the parent dof in ``W`` of each of its local dofs) on
+    the selected dofs, laid out as the reduced space, whose local-to-global map takes
+    ``W``'s local dof numbers (the numbering :func:`dolfinx.fem.petsc.assemble_matrix`
+    inserts with). Collective.
 
     With ``blocks`` and unknowns that pair up (:func:`_pairs`) the pattern is built on
     the pairs, as DOLFINx builds a vector space's (a quarter of the entries to sort:
@@ -152,6 +159,9 @@ def reduced_matrix(a: dolfinx.fem.Form, chosen: Selection, blocks: bool = True) 
     for field in fields:  # facet pairs couple a field with itself (the ghost penalty)
         for row in _rows(np.c_[block[field[pairs[:, 0]]], block[field[pairs[:, 1]]]]):
             pattern.insert(row, row)
+    for form, parent in field_blocks:
+        for row in _rows(block[parent[_unrolled_dofs(form, _coupled_cells(form)[0])]]):
+            pattern.insert(row, row)
     pattern.insert_diagonal(np.arange(index_map.size_local, dtype=np.int32))
     pattern.finalize()
     A = dolfinx.cpp.la.petsc.create_matrix(comm, pattern)
@@ -160,6 +170,31 @@ def reduced_matrix(a: dolfinx.fem.Form, chosen: Selection, blocks: bool = True) 
     lgmap.destroy()
     _zeros_outside_the_pattern(A)
     return A
+
+
+def _unrolled_dofs(a: dolfinx.fem.Form, cells: npt.NDArray[np.int32]) -> np.ndarray:
+    """The local dofs (unrolled) of ``cells`` in the space of ``a``, ``(n, dofs per cell)``."""
+    dofmap = a.function_spaces[0].dofmap
+    cell_dofs, bs = dofmap.map(), dofmap.bs
+    dofs = cell_dofs[cells][:, :, None] * bs + np.arange(bs)
+    return dofs.reshape(len(cells), cell_dofs.shape[1] * bs)
+
+
+def _block_lgmap(
+    columns: np.ndarray, parent: np.ndarray, bs: int, comm
+) -> tuple[PETSc.LGMap, bool]:
+    """The local-to-global map of a field's own space into the reduced matrix (block
+    size ``bs``): its dofs' reduced columns (``columns`` of their ``parent`` dofs), -1
+    for inactive dofs. Made of 2 x 2 blocks when the field and the matrix pair up at
+    every node (then ``True``), else dof by dof. Local."""
+    cols = columns[parent]
+    if bs == 2 and cols.size % 2 == 0:
+        first, second = cols[0::2], cols[1::2]
+        idle = (first < 0) & (second < 0)
+        if np.all(idle | ((first >= 0) & (first % 2 == 0) & (second == first + 1))):
+            blocks = np.where(idle, -1, first // 2).astype(PETSc.IntType)
+            return PETSc.LGMap().create(blocks, bsize=2, comm=comm), True
+    return PETSc.LGMap().create(cols.astype(PETSc.IntType), comm=comm), False
 
 
 def _zeros_outside_the_pattern(A: PETSc.Mat) -> None:
@@ -208,22 +243,48 @@ class ReducedMatrix:
             as :func:`dolfinx.fem.petsc.assemble_matrix` applies them).
         R: Restriction operator, global shape ``(dim W, n_reduced)``. Not modified;
             kept for the ``PtAP`` path.
-
         blocks: Allow a pattern (and matrix) of 2 x 2 blocks (:func:`reduced_matrix`);
             off for matrices that others add to with a scalar pattern (``MatAXPY``).
+        field_blocks: Forms on a field's own space to add, each with the parent dof
+            in ``W`` of every local dof of that space (the uncut cells' blocks of
+            :func:`xfem_contact.fem.field_blocks.split_uncut`): the matrix is
+            ``R^T (A + sum_i P_i A_i P_i^T) R``. Only for an ``R`` that selects.
+        chosen: :func:`selection` of ``R``, if the caller has it.
 
     Construction is collective (sparsity, or the full matrix for ``PtAP``).
     """
 
-    def __init__(self, a: dolfinx.fem.Form, bcs: list, R: PETSc.Mat, blocks: bool = True):
+    def __init__(
+        self,
+        a: dolfinx.fem.Form,
+        bcs: list,
+        R: PETSc.Mat,
+        blocks: bool = True,
+        field_blocks: list[tuple[dolfinx.fem.Form, np.ndarray]] = (),
+        chosen: Selection | None = None,
+    ):
         self.a, self.bcs, self.R = a, bcs, R
-        chosen = selection(R, a.function_spaces[0])
+        W = a.function_spaces[0]
+        chosen = chosen or selection(R, W)
         #: Whether the form is assembled straight into the reduced numbering
         self.direct = chosen is not None
+        if field_blocks and not self.direct:
+            raise ValueError("field blocks need a restriction that selects dofs")
         #: The reduced column of every dof (:class:`Selection`; None for ``PtAP``)
         self.selection = chosen
         self._full = None if self.direct else dolfinx.fem.petsc.create_matrix(a)
-        self.mat: PETSc.Mat | None = reduced_matrix(a, chosen, blocks) if self.direct else None
+        self.mat: PETSc.Mat | None = None
+        self._blocks = []
+        if self.direct:
+            self.mat = reduced_matrix(a, chosen, blocks, field_blocks)
+            fixed = np.zeros(chosen.columns.size, dtype=np.int8)  # Dirichlet dofs of W
+            for bc in bcs:
+                fixed[bc.dof_indices()[0]] = 1
+            bs, comm = self.mat.getBlockSize(), a.mesh.comm
+            for form, parent in field_blocks:
+                lgmap, blocked = _block_lgmap(chosen.columns, parent, bs, comm)
+                self._blocks.append((form, lgmap, blocked, fixed[parent]))
+            self._lgmap = self.mat.getLGMap()[0]
 
     def assemble(self) -> PETSc.Mat:
         """Assemble ``R^T A R`` (with the Dirichlet conditions) into :attr:`mat` and
@@ -231,6 +292,14 @@ class ReducedMatrix:
         if self.direct:
             self.mat.zeroEntries()
             _zeros_outside_the_pattern(self.mat)
+            for form, lgmap, blocked, fixed in self._blocks:  # in the field's own numbering
+                self.mat.setLGMap(lgmap, lgmap)
+                constants = dolfinx.fem.pack_constants(form)
+                coefficients = dolfinx.fem.pack_coefficients(form)
+                dolfinx.cpp.fem.petsc.assemble_matrix(
+                    self.mat, form._cpp_object, constants, coefficients, fixed, fixed, not blocked
+                )
+            self.mat.setLGMap(self._lgmap, self._lgmap)
             _assemble_unrolled(self.mat, self.a, self.bcs)
             self.mat.assemble()
             return self.mat
@@ -251,7 +320,10 @@ class ReducedMatrix:
         return mat
 
     def destroy(self) -> None:
-        """Destroy the PETSc matrices made here (not ``R``). Collective."""
+        """Destroy the PETSc objects made here (not ``R``). Collective."""
         for mat in (self._full, self.mat):
             if mat is not None:
                 mat.destroy()
+        for _, lgmap, _, _ in self._blocks:
+            lgmap.destroy()
+        self._blocks = []

@@ -23,7 +23,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from xfem_contact.fem.forms import form
-from xfem_contact.solvers.assembly import ReducedMatrix
+from xfem_contact.solvers.assembly import ReducedMatrix, selection
+from xfem_contact.solvers.jacobian import JacobianForms
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import gather, saddle_point_scaling
@@ -74,6 +75,11 @@ class RestrictedNewton:
         interpolation: For the band multigrid (the ``"iterative"`` preset): ``(rows,
             cols, weights)`` on local dofs of ``W``
             (:func:`xfem_contact.mechanics.splits.vertex_interpolation`), or ``None``.
+        field_space: ``field_space(i)``: field ``i``'s own space and the parent dofs
+            (:meth:`EnrichedSpace.field_space
+            <xfem_contact.fem.enrichment.EnrichedSpace.field_space>`). With a selecting
+            ``R`` the Jacobian's uncut cells are then assembled field by field on those
+            spaces (:func:`xfem_contact.fem.field_blocks.split_uncut`).
     """
 
     def __init__(
@@ -90,12 +96,18 @@ class RestrictedNewton:
         near_nullspace: list[dolfinx.fem.Function] | None = None,
         couplings: list | None = None,
         interpolation=None,
+        field_space: Callable | None = None,
     ):
         self.w, self.bcs, self.R = w, bcs, R
         self.couplings = list(couplings or [])
         start = time.perf_counter()
+        chosen = selection(R, w.function_space)
+        selecting = time.perf_counter() - start
+        start = time.perf_counter()
         self.F = form(residual)
-        self.J = form(ufl.derivative(residual, w, ufl.TrialFunction(w.function_space)))
+        #: The Jacobian's forms (the uncut cells' field blocks apart when possible)
+        self.jacobian_forms = JacobianForms(residual, w, None if chosen is None else field_space)
+        self.J = self.jacobian_forms.rest
         #: Wall time (s) of the set-up steps: forms (JIT included on a cold cache),
         #: sparsity, first Jacobian, scaling
         self.timings = {"forms": time.perf_counter() - start}
@@ -104,8 +116,15 @@ class RestrictedNewton:
         self.F_r = R.createVecRight()
         self.status, self.log = status, log
         start = time.perf_counter()
-        self.jacobian = ReducedMatrix(self.J, bcs, R, blocks=not self.couplings)
-        self.timings["sparsity"] = time.perf_counter() - start
+        self.jacobian = ReducedMatrix(
+            self.J,
+            bcs,
+            R,
+            blocks=not self.couplings,
+            field_blocks=self.jacobian_forms.blocks,
+            chosen=chosen,
+        )
+        self.timings["sparsity"] = time.perf_counter() - start + selecting
         if self.couplings and not self.jacobian.direct:
             raise ValueError(
                 "Couplings assembled outside UFL (large sliding) need a restriction that "
@@ -228,7 +247,7 @@ class RestrictedNewton:
         with self.b.localForm() as local:
             local.set(0.0)
         dolfinx.fem.petsc.assemble_vector(self.b, self.F)
-        dolfinx.fem.petsc.apply_lifting(self.b, [self.J], bcs=[self.bcs], x0=[x], alpha=-1.0)
+        self.jacobian_forms.lift(self.b, self.bcs, x)
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         for coupling in self.couplings:
             coupling.add_residual(self.w, self.b)
@@ -343,6 +362,7 @@ class RestrictedNewton:
             coupling.destroy()
         for obj in (self.snes, self.b, self.y, self.F_r, self.R, self.D, *self._split_objects):
             obj.destroy()
+        self.jacobian_forms.destroy()
         if self._projection is not None:
             self._projection.destroy()
 
