@@ -197,6 +197,21 @@ def test_split_newton_lifts_unmet_dirichlet_data():
     R.destroy()
 
 
+def test_the_jacobian_keeps_its_structure_through_newton():
+    """The pattern is stored whole (explicit zeros where the first Jacobian, of an open
+    contact, has none): the later iterates' nonzeros land in it, and the LU
+    factorisation analyses the matrix once for the whole solve."""
+    problem = inclusion_problem(16, 2, "coulomb", friction=0.3)
+    PETSc.Log.begin()
+    event = PETSc.Log.Event("MatLUFactorSym")
+    before = event.getPerfInfo()["count"]
+    report = problem.solve()
+    assert report.iterations > 2
+    J_r = problem._newton.J_r
+    assert J_r.getInfo()["mallocs"] == 0
+    assert event.getPerfInfo()["count"] - before == 1
+
+
 def test_prolongation_takes_the_ptap_path():
     """lbb = restriction combines multiplier dofs: R is no selection."""
     problem = inclusion_problem(8, 2, "sticking", lbb="restriction")

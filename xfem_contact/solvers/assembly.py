@@ -165,11 +165,32 @@ def reduced_matrix(
     pattern.insert_diagonal(np.arange(index_map.size_local, dtype=np.int32))
     pattern.finalize()
     A = dolfinx.cpp.la.petsc.create_matrix(comm, pattern)
+    _fill_pattern(A, pattern, bs)
     lgmap = PETSc.LGMap().create(chosen.columns.astype(PETSc.IntType), comm=comm)
     A.setLGMap(lgmap, lgmap)
     lgmap.destroy()
     _zeros_outside_the_pattern(A)
     return A
+
+
+def _fill_pattern(A: PETSc.Mat, pattern, bs: int) -> None:
+    """Store an explicit zero at every entry of ``pattern`` (block size ``bs``), so
+    that the matrix keeps the whole pattern: skipping the zeros a kernel inserts
+    (:func:`_zeros_outside_the_pattern`) must not shrink it to the first assembly's
+    nonzeros (an open contact's, say), or every later nonzero would be inserted
+    slowly and change the structure, and the LU factorisation would analyse the
+    matrix again at each Newton step. Collective."""
+    columns, offsets = pattern.graph
+    owned = pattern.index_map(0).size_local  # the graph also lists the ghost rows
+    offsets = offsets[: owned + 1]
+    columns = pattern.index_map(1).local_to_global(columns[: offsets[-1]])
+    zeros = np.zeros(columns.size * bs * bs)
+    rows, cols = offsets.astype(PETSc.IntType), columns.astype(PETSc.IntType)
+    if bs == 1:
+        A.setValuesCSR(rows, cols, zeros)
+    else:
+        A.setValuesBlockedCSR(rows, cols, zeros)
+    A.assemble()
 
 
 def _unrolled_dofs(a: dolfinx.fem.Form, cells: npt.NDArray[np.int32]) -> np.ndarray:
@@ -198,11 +219,11 @@ def _block_lgmap(
 
 
 def _zeros_outside_the_pattern(A: PETSc.Mat) -> None:
-    """The facet kernels fill every field's block with explicit zeros: skipped. A nonzero
-    outside the pattern (a facet term coupling two fields) is inserted, slowly, never
-    dropped: the per-field pattern is an optimisation, not an assumption. Set before each
-    assembly: a merge that grows the pattern (``MatAXPY``) makes new storage without
-    these options."""
+    """The facet kernels fill every field's block with explicit zeros: skipped (the
+    pattern itself is stored whole, :func:`_fill_pattern`). A nonzero outside the
+    pattern (a facet term coupling two fields) is inserted, slowly, never dropped: the
+    per-field pattern is an optimisation, not an assumption. Set before each assembly: a
+    merge that grows the pattern (``MatAXPY``) makes new storage without these options."""
     A.setOption(PETSc.Mat.Option.IGNORE_ZERO_ENTRIES, True)
     A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
 
