@@ -267,9 +267,12 @@ class ReducedMatrix:
         blocks: Allow a pattern (and matrix) of 2 x 2 blocks (:func:`reduced_matrix`);
             off for matrices that others add to with a scalar pattern (``MatAXPY``).
         field_blocks: Forms on a field's own space to add, each with the parent dof
-            in ``W`` of every local dof of that space (the uncut cells' blocks of
-            :func:`xfem_contact.fem.field_blocks.split_uncut`): the matrix is
-            ``R^T (A + sum_i P_i A_i P_i^T) R``. Only for an ``R`` that selects.
+            in ``W`` of every local dof of that space and whether it is constant (no
+            coefficient that changes in a solve, e.g. a linear bulk) (the uncut cells'
+            blocks of :func:`xfem_contact.fem.field_blocks.split_uncut`): the matrix is
+            ``R^T (A + sum_i P_i A_i P_i^T) R``. Only for an ``R`` that selects. After
+            :meth:`keep_constant_blocks` the constant ones are assembled once more and
+            then added from a copy.
         chosen: :func:`selection` of ``R``, if the caller has it.
 
     Construction is collective (sparsity, or the full matrix for ``PtAP``).
@@ -281,7 +284,7 @@ class ReducedMatrix:
         bcs: list,
         R: PETSc.Mat,
         blocks: bool = True,
-        field_blocks: list[tuple[dolfinx.fem.Form, np.ndarray]] = (),
+        field_blocks: list[tuple[dolfinx.fem.Form, np.ndarray, bool]] = (),
         chosen: Selection | None = None,
     ):
         self.a, self.bcs, self.R = a, bcs, R
@@ -296,16 +299,40 @@ class ReducedMatrix:
         self._full = None if self.direct else dolfinx.fem.petsc.create_matrix(a)
         self.mat: PETSc.Mat | None = None
         self._blocks = []
+        self._kept: PETSc.Mat | None = None  # the constant blocks' sum
+        self._keep = False  # copy them at the next assembly
         if self.direct:
-            self.mat = reduced_matrix(a, chosen, blocks, field_blocks)
+            self.mat = reduced_matrix(a, chosen, blocks, [b[:2] for b in field_blocks])
             fixed = np.zeros(chosen.columns.size, dtype=np.int8)  # Dirichlet dofs of W
             for bc in bcs:
                 fixed[bc.dof_indices()[0]] = 1
             bs, comm = self.mat.getBlockSize(), a.mesh.comm
-            for form, parent in field_blocks:
+            for form, parent, constant in field_blocks:
                 lgmap, blocked = _block_lgmap(chosen.columns, parent, bs, comm)
-                self._blocks.append((form, lgmap, blocked, fixed[parent]))
+                self._blocks.append((form, lgmap, blocked, fixed[parent], constant))
             self._lgmap = self.mat.getLGMap()[0]
+
+    def keep_constant_blocks(self) -> None:
+        """From the next assembly on, assemble the constant field blocks only once:
+        the next assembly keeps a copy of their sum (a matrix), the later ones add
+        it. For the iterates of one Newton solve; call again at the next (the copy
+        is made anew). Not collective."""
+        if self._kept is not None:
+            self._kept.destroy()
+            self._kept = None
+        self._keep = any(b[4] for b in self._blocks)
+
+    def _assemble_blocks(self, constant: bool) -> None:
+        for form, lgmap, blocked, fixed, is_constant in self._blocks:
+            if is_constant != constant:
+                continue
+            self.mat.setLGMap(lgmap, lgmap)  # in the field's own numbering
+            constants = dolfinx.fem.pack_constants(form)
+            coefficients = dolfinx.fem.pack_coefficients(form)
+            dolfinx.cpp.fem.petsc.assemble_matrix(
+                self.mat, form._cpp_object, constants, coefficients, fixed, fixed, not blocked
+            )
+        self.mat.setLGMap(self._lgmap, self._lgmap)
 
     def assemble(self) -> PETSc.Mat:
         """Assemble ``R^T A R`` (with the Dirichlet conditions) into :attr:`mat` and
@@ -313,14 +340,19 @@ class ReducedMatrix:
         if self.direct:
             self.mat.zeroEntries()
             _zeros_outside_the_pattern(self.mat)
-            for form, lgmap, blocked, fixed in self._blocks:  # in the field's own numbering
-                self.mat.setLGMap(lgmap, lgmap)
-                constants = dolfinx.fem.pack_constants(form)
-                coefficients = dolfinx.fem.pack_coefficients(form)
-                dolfinx.cpp.fem.petsc.assemble_matrix(
-                    self.mat, form._cpp_object, constants, coefficients, fixed, fixed, not blocked
-                )
-            self.mat.setLGMap(self._lgmap, self._lgmap)
+            info = PETSc.Mat.InfoType.LOCAL
+            if self._kept is not None and (
+                self._kept.getInfo(info)["nz_allocated"] != self.mat.getInfo(info)["nz_allocated"]
+            ):  # the matrix has new storage (a merge): the copy no longer fits it
+                self.keep_constant_blocks()
+            if self._kept is not None:  # same structure: values added, rank by rank
+                self.mat.axpy(1.0, self._kept, PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            else:
+                self._assemble_blocks(constant=True)
+                if self._keep:
+                    self.mat.assemble()
+                    self._kept, self._keep = self.mat.duplicate(copy=True), False
+            self._assemble_blocks(constant=False)
             _assemble_unrolled(self.mat, self.a, self.bcs)
             self.mat.assemble()
             return self.mat
@@ -345,6 +377,9 @@ class ReducedMatrix:
         for mat in (self._full, self.mat):
             if mat is not None:
                 mat.destroy()
-        for _, lgmap, _, _ in self._blocks:
+        for _, lgmap, *_ in self._blocks:
             lgmap.destroy()
         self._blocks = []
+        if self._kept is not None:
+            self._kept.destroy()
+            self._kept = None

@@ -33,14 +33,18 @@ class JacobianForms:
     Attributes:
         rest: The form :class:`~xfem_contact.solvers.assembly.ReducedMatrix` assembles
             on ``W`` (the whole Jacobian without a split).
-        blocks: ``(form, parent)`` of each field block, on the field's own space.
+        blocks: ``(form, parent, constant)`` of each field block, on the field's own
+            space; ``constant`` when it does not depend on ``w`` (a linear bulk).
     """
 
     def __init__(self, residual: ufl.Form, w: dolfinx.fem.Function, field_space: Callable | None):
         jacobian = ufl.derivative(residual, w, ufl.TrialFunction(w.function_space))
         split = None if field_space is None else split_uncut(jacobian, field_space)
         self.rest = form(jacobian if split is None else split.rest)
-        self.blocks = [] if split is None else [(form(b.form), b.parent) for b in split.blocks]
+        self.blocks = [
+            (form(b.form), b.parent, w not in b.form.coefficients())
+            for b in ([] if split is None else split.blocks)
+        ]
         self._ufl, self._whole = (None, self.rest) if split is None else (jacobian, None)
         self._gap: PETSc.Vec | None = None
 

@@ -327,6 +327,7 @@ class RestrictedNewton:
         self.report = NewtonReport()
         start = time.perf_counter()
         self._start_from_w()
+        self.jacobian.keep_constant_blocks()  # the uncut cells' linear bulk: once a solve
         for coupling in self.couplings:
             coupling.begin_step(self.w)
         with applied_options(self._prefix, self._options):
