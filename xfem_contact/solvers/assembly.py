@@ -14,6 +14,8 @@ multiplier prolongation in ``R`` it assembles the full matrix and reduces it by
 
 from __future__ import annotations
 
+import itertools
+
 import dolfinx.cpp
 import dolfinx.fem
 import dolfinx.fem.petsc
@@ -133,6 +135,7 @@ def reduced_matrix(
     chosen: Selection,
     blocks: bool = True,
     field_blocks: list[tuple[dolfinx.fem.Form, np.ndarray]] = (),
+    fill: bool = True,
 ) -> PETSc.Mat:
     """An AIJ matrix with the sparsity of ``a`` (and of the ``field_blocks``: forms on
     a field's own space, with the parent dof in ``W`` of each of its local dofs) on
@@ -143,7 +146,7 @@ def reduced_matrix(
     With ``blocks`` and unknowns that pair up (:func:`_pairs`) the pattern is built on
     the pairs, as DOLFINx builds a vector space's (a quarter of the entries to sort:
     at 320 x 320 its finalisation took 0.2 s instead of 0.8 s), and the matrix has
-    block size 2."""
+    block size 2. With ``fill`` the whole pattern is stored (:func:`_fill_pattern`)."""
     comm = a.mesh.comm  # lives as long as the mesh (the index map's own does not)
     W = a.function_spaces[0]
     dofmap = W.dofmap.map()  # (num_cells, dofs per cell)
@@ -159,17 +162,21 @@ def reduced_matrix(
     for field in fields:  # facet pairs couple a field with itself (the ghost penalty)
         for row in _rows(np.c_[block[field[pairs[:, 0]]], block[field[pairs[:, 1]]]]):
             pattern.insert(row, row)
-    for form, parent in field_blocks:
-        for row in _rows(block[parent[_unrolled_dofs(form, _coupled_cells(form)[0])]]):
+    for form, parent in field_blocks:  # their cells, and their facets' cell pairs
+        cells_i, pairs_i = _coupled_cells(form)
+        rows = block[parent[_unrolled_dofs(form, cells_i)]]
+        both = [block[parent[_unrolled_dofs(form, pairs_i[:, k])]] for k in (0, 1)]
+        for row in itertools.chain(_rows(rows), _rows(np.hstack(both))):
             pattern.insert(row, row)
     pattern.insert_diagonal(np.arange(index_map.size_local, dtype=np.int32))
     pattern.finalize()
     A = dolfinx.cpp.la.petsc.create_matrix(comm, pattern)
-    _fill_pattern(A, pattern, bs)
+    if fill:
+        _fill_pattern(A, pattern, bs)
     lgmap = PETSc.LGMap().create(chosen.columns.astype(PETSc.IntType), comm=comm)
     A.setLGMap(lgmap, lgmap)
     lgmap.destroy()
-    _zeros_outside_the_pattern(A)
+    _zeros_outside_the_pattern(A, fill)
     return A
 
 
@@ -218,13 +225,16 @@ def _block_lgmap(
     return PETSc.LGMap().create(cols.astype(PETSc.IntType), comm=comm), False
 
 
-def _zeros_outside_the_pattern(A: PETSc.Mat) -> None:
-    """The facet kernels fill every field's block with explicit zeros: skipped (the
-    pattern itself is stored whole, :func:`_fill_pattern`). A nonzero outside the
-    pattern (a facet term coupling two fields) is inserted, slowly, never dropped: the
-    per-field pattern is an optimisation, not an assumption. Set before each assembly: a
-    merge that grows the pattern (``MatAXPY``) makes new storage without these options."""
-    A.setOption(PETSc.Mat.Option.IGNORE_ZERO_ENTRIES, True)
+def _zeros_outside_the_pattern(A: PETSc.Mat, skip: bool) -> None:
+    """Facet kernels on ``W`` fill every field's block with explicit zeros: with
+    ``skip`` these are skipped (and the pattern itself is stored whole,
+    :func:`_fill_pattern`); without facet integrals on ``W`` (the ghost penalty split
+    by field) every insertion lies in the pattern and zeros are stored. A nonzero
+    outside the pattern (a facet term coupling two fields) is inserted, slowly, never
+    dropped: the per-field pattern is an optimisation, not an assumption. Set before
+    each assembly: a merge that grows the pattern (``MatAXPY``) makes new storage
+    without these options."""
+    A.setOption(PETSc.Mat.Option.IGNORE_ZERO_ENTRIES, skip)
     A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
 
 
@@ -301,8 +311,11 @@ class ReducedMatrix:
         self._blocks = []
         self._kept: PETSc.Mat | None = None  # the constant blocks' sum
         self._keep = False  # copy them at the next assembly
+        #: Whether facet kernels on ``W`` insert zeros to skip (:func:`_zeros_outside_the_pattern`)
+        self.skip_zeros = a.mesh.comm.allreduce(_coupled_cells(a)[1].size > 0, op=MPI.LOR)
         if self.direct:
-            self.mat = reduced_matrix(a, chosen, blocks, [b[:2] for b in field_blocks])
+            pairs = [b[:2] for b in field_blocks]
+            self.mat = reduced_matrix(a, chosen, blocks, pairs, fill=self.skip_zeros)
             fixed = np.zeros(chosen.columns.size, dtype=np.int8)  # Dirichlet dofs of W
             for bc in bcs:
                 fixed[bc.dof_indices()[0]] = 1
@@ -339,7 +352,7 @@ class ReducedMatrix:
         return it; the object keeps it. Collective."""
         if self.direct:
             self.mat.zeroEntries()
-            _zeros_outside_the_pattern(self.mat)
+            _zeros_outside_the_pattern(self.mat, self.skip_zeros)
             info = PETSc.Mat.InfoType.LOCAL
             if self._kept is not None and (
                 self._kept.getInfo(info)["nz_allocated"] != self.mat.getInfo(info)["nz_allocated"]
