@@ -1,4 +1,4 @@
-"""The uncut cells' part of a bilinear form on a mixed space, field by field.
+"""The uncut cells' and interior facets' part of a bilinear form on a mixed space, field by field.
 
 On the uncut cells of side ``s`` a Jacobian on ``W = (u_-, u_+, lambda, ...)`` is the
 bulk of side ``s`` alone, yet assembled on ``W`` every one of those cells' element

@@ -353,11 +353,13 @@ class ReducedMatrix:
         if self.direct:
             self.mat.zeroEntries()
             _zeros_outside_the_pattern(self.mat, self.skip_zeros)
-            info = PETSc.Mat.InfoType.LOCAL
-            if self._kept is not None and (
-                self._kept.getInfo(info)["nz_allocated"] != self.mat.getInfo(info)["nz_allocated"]
-            ):  # the matrix has new storage (a merge): the copy no longer fits it
-                self.keep_constant_blocks()
+            if self._kept is not None:
+                info = PETSc.Mat.InfoType.LOCAL
+                sizes = (m.getInfo(info)["nz_allocated"] for m in (self._kept, self.mat))
+                # new storage (a merge) on any rank: the copy no longer fits; decided
+                # together, since keeping a new copy assembles (collectively)
+                if self.mat.getComm().tompi4py().allreduce(len(set(sizes)) > 1, op=MPI.LOR):
+                    self.keep_constant_blocks()
             if self._kept is not None:  # same structure: values added, rank by rank
                 self.mat.axpy(1.0, self._kept, PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
             else:

@@ -1,7 +1,8 @@
 """The Jacobian of a residual on a mixed space, as the forms the Newton solver uses.
 
 :class:`JacobianForms` compiles ``dF/dw``: with the fields' own spaces (and a
-restriction that selects dofs) the uncut cells' field blocks apart from the rest
+restriction that selects dofs) the field blocks of the uncut cells and interior
+facets apart from the rest
 (:func:`xfem_contact.fem.field_blocks.split_uncut`), for
 :class:`~xfem_contact.solvers.assembly.ReducedMatrix`; and lifts a residual with the
 whole Jacobian where the iterate misses its Dirichlet data, compiling the whole
@@ -28,7 +29,8 @@ class JacobianForms:
         residual: UFL residual on the mixed space of ``w``.
         w: The unknown.
         field_space: ``field_space(i)``: field ``i``'s own space and parent dofs, to
-            split the uncut cells' field blocks off; ``None``: no split.
+            split the field blocks of the uncut cells and interior facets off;
+            ``None``: no split.
 
     Attributes:
         rest: The form :class:`~xfem_contact.solvers.assembly.ReducedMatrix` assembles

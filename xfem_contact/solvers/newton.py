@@ -78,8 +78,8 @@ class RestrictedNewton:
         field_space: ``field_space(i)``: field ``i``'s own space and the parent dofs
             (:meth:`EnrichedSpace.field_space
             <xfem_contact.fem.enrichment.EnrichedSpace.field_space>`). With a selecting
-            ``R`` the Jacobian's uncut cells are then assembled field by field on those
-            spaces (:func:`xfem_contact.fem.field_blocks.split_uncut`).
+            ``R`` the Jacobian's uncut cells and ghost penalty are then assembled field
+            by field on those spaces (:func:`xfem_contact.fem.field_blocks.split_uncut`).
     """
 
     def __init__(
