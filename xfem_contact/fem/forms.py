@@ -209,12 +209,57 @@ def form(
         if isinstance(ufl_form, collections.abc.Iterable):
             return [form(f, form_compiler_options, jit_options) for f in ufl_form]
         return ufl_form
+    return _build(_rewrite(ufl_form), ufl_form.ufl_domain(), form_compiler_options, jit_options)
+
+
+def form_parts(
+    ufl_form: ufl.Form,
+    form_compiler_options: dict | None = None,
+    jit_options: dict | None = None,
+) -> list:
+    """:func:`form` as a sum of DOLFINx forms: the integrals with standard rules, and
+    the runtime integrals (the cut cells' per-cell rules) apart.
+
+    Collective. Assembling every part into one tensor gives what ``form(ufl_form)``
+    assembles. The point is the coefficient packing: DOLFINx packs every
+    coefficient of a form on every entity of each of its integrals, so in one form
+    the uncut cells would carry the markers of all runtime rules (13 values per
+    rule set, about 250 of the 300 packed values per cell of a contact residual).
+    Parts without integrals are left out.
+
+    Args:
+        ufl_form: A UFL form that may use cut-cell measures.
+        form_compiler_options: As for :func:`form`.
+        jit_options: As for :func:`form`.
+
+    Returns:
+        A list of one or two :class:`dolfinx.fem.Form` (standard part first).
+    """
+    if not isinstance(ufl_form, ufl.Form) or isinstance(ufl_form, ufl.ZeroBaseForm):
+        return [form(ufl_form, form_compiler_options, jit_options)]
+    rewrite = _rewrite(ufl_form)
+    parts = []
+    for runtime in (False, True):
+        integrals = [
+            i for i in rewrite.form.integrals() if (i.subdomain_id() in rewrite.rules) == runtime
+        ]
+        if integrals:
+            kept = {i.subdomain_id() for i in integrals}
+            rules = {sid: r for sid, r in rewrite.rules.items() if sid in kept}
+            domains = {
+                t: [(sid, e) for sid, e in d if sid in kept] for t, d in rewrite.domains.items()
+            }
+            part = _Rewrite(ufl.Form(integrals), domains, rules)
+            parts.append(_build(part, ufl_form.ufl_domain(), form_compiler_options, jit_options))
+    return parts
+
+
+def _build(rewrite: _Rewrite, domain, form_compiler_options: dict | None, jit_options: dict | None):
+    """Compile (once per signature) and create the DOLFINx form of a rewritten form."""
     options = {"scalar_type": dolfinx.default_scalar_type, **(form_compiler_options or {})}
     options["language"] = LANGUAGE
     # In the JIT module's signature: a new layout never loads a cached kernel of an old one
     options[runtime_abi.LAYOUT_OPTION] = runtime_abi.LAYOUT_VERSION
-    rewrite = _rewrite(ufl_form)
-    domain = ufl_form.ufl_domain()
     mesh = dolfinx.mesh.Mesh(domain.ufl_cargo(), domain)
     compiled, compiled_form = _compile(mesh.comm, rewrite.form, options, jit_options)
 

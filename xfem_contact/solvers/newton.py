@@ -22,7 +22,7 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from xfem_contact.fem.forms import form
+from xfem_contact.fem.forms import form_parts
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
 from xfem_contact.solvers.jacobian import JacobianForms
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
@@ -104,14 +104,14 @@ class RestrictedNewton:
         chosen = selection(R, w.function_space)
         selecting = time.perf_counter() - start
         start = time.perf_counter()
-        self.F = form(residual)
+        self.F = form_parts(residual)  # the residual: standard and runtime integrals apart
         #: The Jacobian's forms (the uncut cells' field blocks apart when possible)
         self.jacobian_forms = JacobianForms(residual, w, None if chosen is None else field_space)
         self.J = self.jacobian_forms.rest
         #: Wall time (s) of the set-up steps: forms (JIT included on a cold cache),
         #: sparsity, first Jacobian, scaling
         self.timings = {"forms": time.perf_counter() - start}
-        self.b = dolfinx.fem.petsc.create_vector(self.F.function_spaces[0])
+        self.b = dolfinx.fem.petsc.create_vector(self.F[0].function_spaces[0])
         self.y = R.createVecRight()
         self.F_r = R.createVecRight()
         self.status, self.log = status, log
@@ -246,7 +246,8 @@ class RestrictedNewton:
         x = self.w.x.petsc_vec
         with self.b.localForm() as local:
             local.set(0.0)
-        dolfinx.fem.petsc.assemble_vector(self.b, self.F)
+        for part in self.F:
+            dolfinx.fem.petsc.assemble_vector(self.b, part)
         self.jacobian_forms.lift(self.b, self.bcs, x)
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         for coupling in self.couplings:
