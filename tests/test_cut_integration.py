@@ -138,6 +138,12 @@ def test_boundary_pieces_exact(cell, degree):
     assert integrate(c * cut.ds(1, tags, 7)) == pytest.approx(0.39, abs=1e-13)
     with pytest.raises(ValueError, match="No facet carries"):
         cut.ds(1, tags, 8)
+    # Runtime rules only for the reference facets some cut cell has on the set (the
+    # line crosses the left and the right side: one facet each), on any process
+    bottom = dolfinx.mesh.locate_entities_boundary(mesh, fdim, lambda x: np.isclose(x[1], 0.0))
+    for facets, count in ((left, 1), (bottom, 0)):
+        compiled = xfem_contact.form(c * cut.ds(1, facets))
+        assert len(compiled._xfem_rules) == count
 
 
 @pytest.mark.mpi

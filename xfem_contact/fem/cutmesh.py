@@ -345,8 +345,12 @@ class CutMesh:
         rows, local, ends = rows[in_set], local[in_set], ends[in_set]
         _, ref_normals = boundary.reference_facets(cell_name)
         J = ufl.Jacobian(mesh)
+        # A reference facet no cut cell has on the set, on any rank, gets no integral
+        pieces = mesh.comm.allreduce(np.bincount(local, minlength=len(ref_normals)))
         for f, n_ref in enumerate(ref_normals):
             mine = local == f
+            if not pieces[f]:
+                continue
             cells_rows = np.unique(rows[mine])
             rule = boundary.facet_rules(
                 np.searchsorted(cells_rows, rows[mine]),
