@@ -16,7 +16,7 @@ from xfem_contact.solvers.options import LINEAR_PRESETS, preset
 
 
 @pytest.mark.mpi
-@pytest.mark.filterwarnings("ignore::xfem_contact.mechanics.problem.RigidModeWarning")
+@pytest.mark.filterwarnings("ignore::xfem_contact.mechanics.rigid_modes.RigidModeWarning")
 @pytest.mark.parametrize("law", ["sticking", "frictionless"])
 def test_iterative_equals_direct(law):
     direct = inclusion_problem(10, 2, law)

@@ -197,7 +197,7 @@ def test_solve_refuses_a_body_without_support():
 def test_solve_warns_of_a_free_spin():
     """A frictionless circle carries no torque: the solve warns, names the point
     constraints that would remove the spin, and goes on."""
-    from xfem_contact.mechanics.problem import RigidModeWarning
+    from xfem_contact.mechanics.rigid_modes import RigidModeWarning
 
     problem = case2("frictionless", outer_fixed=True)
     with pytest.warns(RigidModeWarning, match="rotation.*add_point_displacement"):

@@ -11,7 +11,6 @@ dofs of the restriction ``R`` (:mod:`xfem_contact.fem.restriction`). SI units (P
 from __future__ import annotations
 
 import dataclasses
-import warnings
 import weakref
 from collections.abc import Callable, Mapping
 
@@ -30,14 +29,11 @@ from xfem_contact.mechanics.composition import Materials, interface_laws, side_a
 from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw, large_sliding
 from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loading import Loads
-from xfem_contact.mechanics.rigid_modes import free_bodies
+from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
 from xfem_contact.solvers.linear import solve_restricted
 from xfem_contact.solvers.newton import NewtonFailure, NewtonReport, RestrictedNewton
-
-
-class RigidModeWarning(UserWarning):
-    """A body may spin freely (a frictionless circular interface): fine without torque."""
+from xfem_contact.solvers.symmetry import symmetric_options
 
 
 @dataclasses.dataclass
@@ -182,6 +178,13 @@ class Problem(Loads):
         solve instead of Newton)."""
         return self.kinematics == "small" and all(law.linear for law in self.laws.values())
 
+    @property
+    def symmetric(self) -> bool:
+        """Whether the Jacobian is symmetric (small kinematics, symmetric laws): the
+        solves then factor LDL^T (:mod:`xfem_contact.solvers.symmetry`)."""
+        small = self.kinematics == "small" and not self.couplings
+        return small and all(law.symmetric for law in self.laws.values())
+
     def law(self, name: str | None = None) -> InterfaceLaw:
         """The law of interface ``name`` (of the only interface for ``None``)."""
         return self.laws[self._name(name)]
@@ -263,7 +266,10 @@ class Problem(Loads):
                 f"space, rules and forms follow the old interface (cut revision "
                 f"{self._cut_revision}, now {self.cut.revision}); build a new Problem"
             )
-        self._check_support(log)
+        if self._checked_loads != self.loads_revision:  # again only when the loads changed
+            check_support(self, log)
+            self._checked_loads = self.loads_revision
+        petsc_options = symmetric_options(petsc_options, self.symmetric)
         if self.linear:
             a, L = form(self.bilinear_form()), form(self.linear_form())
             w, _ = solve_restricted(a, L, self._bcs, self.space, petsc_options)
@@ -305,24 +311,6 @@ class Problem(Loads):
                 f"{str(failure).splitlines()[0]}; w restored to the state before this solve",
                 failure.report,
             ) from None
-
-    def _check_support(self, log: Callable[[str], None] | None) -> None:
-        """Free rigid modes (:mod:`xfem_contact.mechanics.rigid_modes`): a body without
-        support is an error naming the modes and the constraints that remove them; a
-        spin only a frictionless interface leaves free is a warning (a point constraint
-        for it carries a spurious reaction: hydrostatic case 2, pressure error 1.2e-2
-        instead of 1.9e-4). Runs again only when the loads changed. Collective."""
-        if self._checked_loads == self.loads_revision:
-            return
-        free = free_bodies(self)
-        if errors := [body.message() for body in free if not body.spin_only]:
-            raise ValueError("Free rigid modes: " + " | ".join(errors))
-        for body in free:
-            message = f"{body.message()} if the loads carry a torque"
-            warnings.warn(message, RigidModeWarning, stacklevel=3)
-            if log is not None and self.mesh.comm.rank == 0:
-                log(f"warning: {message}")
-        self._checked_loads = self.loads_revision
 
     @property
     def solver_timings(self) -> dict[str, float]:

@@ -19,6 +19,7 @@ from xfem_contact.fem.restriction import restriction_matrix
 from xfem_contact.solvers.assembly import ReducedMatrix
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.scaling import saddle_point_scaling
+from xfem_contact.solvers.symmetry import mark_symmetric
 
 
 def assemble_restricted(
@@ -109,6 +110,8 @@ def solve_restricted(
     prefix = unique_prefix(petsc_options_prefix)
     ksp.setOptionsPrefix(prefix)
     options = merged_options("linear", petsc_options)
+    if options.get("pc_type") == "cholesky":
+        mark_symmetric(A)  # checked: an LDL^T reads one triangle only
     with applied_options(prefix, options):
         ksp.setFromOptions()
     y = R.createVecRight()

@@ -27,7 +27,9 @@ from xfem_contact.solvers.assembly import ReducedMatrix, selection
 from xfem_contact.solvers.jacobian import JacobianForms
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.report import NewtonFailure, NewtonReport
-from xfem_contact.solvers.scaling import gather, saddle_point_scaling
+from xfem_contact.solvers.scaling import saddle_point_scaling
+from xfem_contact.solvers.split_sets import split_sets
+from xfem_contact.solvers.symmetry import mark_symmetric
 
 
 class RestrictedNewton:
@@ -38,10 +40,11 @@ class RestrictedNewton:
     Jacobian once for the scaling ``D`` of :mod:`xfem_contact.solvers.scaling` (the
     first iterate reuses it when it sits at the same state), and creates the SNES
     under a unique options prefix, removing its options from the PETSc database
-    afterwards). SNES iterates on
-    the scaled unknowns ``y`` with ``w = R D y``, so the residual norms it reports are
-    those of ``D R^T F``. Each :meth:`solve` starts from the current ``w`` (projected
-    on the range of ``R D``) and checks the final residual against the tolerances.
+    afterwards). SNES iterates on the scaled unknowns ``y`` with ``w = R D y``, so the
+    residual norms it reports are those of ``D R^T F``. Each :meth:`solve` starts from
+    the current ``w`` (projected on the range of ``R D``) and checks the final residual
+    against the tolerances. With ``pc_type = "cholesky"`` every Jacobian is checked to
+    be symmetric first (:func:`~xfem_contact.solvers.symmetry.mark_symmetric`).
 
     Args:
         residual: UFL residual form, linear in the test function, on the full
@@ -141,6 +144,10 @@ class RestrictedNewton:
         self.D = saddle_point_scaling(self.J_r)
         self.J_r.diagonalScale(self.D, self.D)
         self.timings["scaling"] = time.perf_counter() - start
+        self._options = merged_options("newton", petsc_options)
+        self._symmetric = self._options.get("pc_type") == "cholesky"
+        if self._symmetric:
+            mark_symmetric(self.J_r)
         self.R = R.copy()
         self.R.diagonalScale(None, self.D)
         # The first Newton iterate usually sits where this Jacobian was assembled
@@ -149,11 +156,19 @@ class RestrictedNewton:
         # Options live in the PETSc database only while PETSc may read them (here and
         # during each solve, when the factorisation reads e.g. mat_mumps_* options)
         self._prefix = unique_prefix(petsc_options_prefix)
-        self._options = merged_options("newton", petsc_options)
         self.snes.setOptionsPrefix(self._prefix)
         with applied_options(self._prefix, self._options):
             self.snes.setFromOptions()
-        self._split_objects = self._field_splits(splits or {}, near_nullspace or [], interpolation)
+        self._split_objects = split_sets(
+            self.snes.getKSP().getPC(),
+            self.R,
+            self.D,
+            self.w,
+            self.jacobian.selection,
+            splits or {},
+            near_nullspace or [],
+            interpolation,
+        )
         # PETSc keeps its callbacks alive, and the garbage collector cannot see through
         # PETSc objects: callbacks hold this object weakly, or it would never be freed.
         this = weakref.ref(self)
@@ -162,78 +177,6 @@ class RestrictedNewton:
         self.snes.setMonitor(lambda snes, it, norm: this()._monitor(snes, it, norm))
         self.report = NewtonReport()
         self._projection: PETSc.KSP | None = None
-
-    def _field_splits(self, splits: dict, near_nullspace: list, interpolation=None) -> list:
-        """Give a fieldsplit preconditioner its index sets ``"u"`` and ``"lambda"`` (and
-        ``"u"`` its near null space), or a Python one with a ``configure`` method
-        (:class:`~xfem_contact.solvers.band_multigrid.BandMultigrid`) the sets ``"u"``
-        and ``"band"``, the near null space and the ``interpolation`` in the reduced
-        unknowns; returns the PETSc objects to destroy. Collective."""
-        pc = self.snes.getKSP().getPC()
-        kind = pc.getType()
-        if kind not in (PETSc.PC.Type.FIELDSPLIT, PETSc.PC.Type.PYTHON) or not splits:
-            return []
-        comm = self.R.getComm()
-        first = self.R.getOwnershipRangeColumn()[0]
-        n_owned = self.w.x.index_map.size_local * self.w.x.block_size
-        marker, reduced = self.R.createVecLeft(), self.R.createVecRight()
-        indptr, columns, _ = self.R.getValuesCSR()
-        single = np.diff(indptr) == 1  # a dof that is one reduced unknown (scaled)
-        column = np.full(n_owned, -1, dtype=np.int64)
-        column[single] = columns[indptr[:-1][single]]
-        objects, sets = [], []
-        for name, dofs in splits.items():
-            dofs = np.asarray(dofs)
-            if dofs.ndim == 2:  # blocks (a node's components), kept in order and together
-                blocks = dofs[np.all(dofs < n_owned, axis=1)]
-                blocks = column[blocks][np.all(column[blocks] >= 0, axis=1)]
-                index = PETSc.IS().createGeneral(blocks.ravel().astype(PETSc.IntType), comm=comm)
-                index.setBlockSize(dofs.shape[1])
-            else:  # any reduced unknown touching the dofs
-                marker.set(0.0)
-                marker.getArray()[dofs[dofs < n_owned]] = 1.0
-                self.R.multTranspose(marker, reduced)
-                local = np.flatnonzero(reduced.getArray(readonly=True) > 0.0)
-                index = PETSc.IS().createGeneral((first + local).astype(PETSc.IntType), comm=comm)
-            sets.append((name, index))
-            objects.append(index)
-        if kind == PETSc.PC.Type.FIELDSPLIT:
-            pc.setFieldSplitIS(*[(name, index) for name, index in sets if name != "band"])
-        index, vectors = dict(sets).get("u"), []
-        if index is not None and near_nullspace:
-            squared = self.D.copy()
-            squared.pointwiseMult(self.D, self.D)
-            vectors = []
-            for mode in near_nullspace:  # z = D^-1 R^T x, x = R D z on the active dofs
-                self.R.multTranspose(mode.x.petsc_vec, reduced)
-                reduced.pointwiseDivide(reduced, squared)
-                part = reduced.getSubVector(index)
-                vectors.append(part.copy())
-                reduced.restoreSubVector(index, part)
-            vectors = _orthonormalise(vectors)
-            space = PETSc.NullSpace().create(vectors=vectors, comm=comm)
-            index.compose("nearnullspace", space)
-            objects += [space, squared, *vectors]
-        marker.destroy()
-        reduced.destroy()
-        context = pc.getPythonContext() if kind == PETSc.PC.Type.PYTHON else None
-        if hasattr(context, "configure"):
-            reduced_interpolation = self._reduced(interpolation)
-            context.configure(dict(sets)["u"], dict(sets)["band"], vectors, reduced_interpolation)
-        return objects
-
-    def _reduced(self, interpolation):
-        """``(rows, cols, weights)`` on local dofs of ``W`` in the reduced, scaled
-        unknowns (``y = D^-1 x``: ``w D_col / D_row``); ``None`` without a selecting
-        ``R`` (a multiplier prolongation). Collective."""
-        chosen = self.jacobian.selection
-        if interpolation is None or chosen is None:
-            return None
-        rows, cols, weights = interpolation
-        rows, cols = chosen.columns[rows], chosen.columns[cols]
-        first = self.D.getOwnershipRange()[0]
-        scale = gather(self.D, cols) / self.D.getArray(readonly=True)[rows - first]
-        return rows, cols, weights * scale
 
     def _update(self, y: PETSc.Vec) -> None:
         x = self.w.x.petsc_vec
@@ -265,6 +208,8 @@ class RestrictedNewton:
             if self.couplings:
                 self._add_couplings(J_r)
             J_r.diagonalScale(self.D, self.D)
+            if self._symmetric:
+                mark_symmetric(J_r)
         self.report.assembly_time += time.perf_counter() - start
 
     def _add_couplings(self, J_r) -> None:
@@ -332,7 +277,12 @@ class RestrictedNewton:
         for coupling in self.couplings:
             coupling.begin_step(self.w)
         with applied_options(self._prefix, self._options):
-            self.snes.solve(None, self.y)
+            try:
+                self.snes.solve(None, self.y)
+            except PETSc.Error as error:  # a callback's own error (e.g. an unsymmetric
+                if isinstance(error.__cause__, ValueError):  # Jacobian for LDL^T) is clearer
+                    raise error.__cause__ from None
+                raise
         self.report.total_time = time.perf_counter() - start
         self._update(self.y)
         self.report.reason = self.snes.getConvergedReason()
@@ -380,21 +330,3 @@ def _same_state(x: np.ndarray, x0: np.ndarray, comm: MPI.Comm) -> bool:
     bound = 1e-14 * comm.allreduce(np.abs(x0).max(initial=0.0), op=MPI.MAX)
     close = x.shape == x0.shape and bool(np.all(np.abs(x - x0) <= bound))
     return comm.allreduce(close, op=MPI.LAND)
-
-
-def _orthonormalise(vectors: list[PETSc.Vec]) -> list[PETSc.Vec]:
-    """Modified Gram-Schmidt (a near null space must be orthonormal): the orthonormal
-    vectors kept, the ones that vanish on the split (e.g. the rigid modes of a body
-    that lies in the interface layer) destroyed. Collective."""
-    kept = []
-    for v in vectors:
-        size = v.norm()
-        for u in kept:
-            v.axpy(-v.dot(u), u)
-        norm = v.norm()
-        if norm > 1e-10 * size:
-            v.scale(1.0 / norm)
-            kept.append(v)
-        else:
-            v.destroy()
-    return kept

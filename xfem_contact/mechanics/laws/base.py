@@ -146,6 +146,10 @@ class InterfaceLaw(abc.ABC):
     linear: typing.ClassVar[bool]
     #: Whether the law acts on the increment since the last accepted state
     incremental: typing.ClassVar[bool] = False
+    #: Whether the law's Jacobian is symmetric in every state, so that the Newton
+    #: steps may factor LDL^T (:mod:`xfem_contact.solvers.symmetry`); checked on
+    #: every matrix factored so
+    symmetric: typing.ClassVar[bool] = False
 
     def multiplier_components(self, gdim: int) -> int:
         """Number of components of the law's multiplier field (0: none)."""

@@ -21,6 +21,7 @@ class Free(InterfaceLaw):
 
     name = "free"
     linear = True
+    symmetric = True
 
 
 class Bonded(MultiplierLaw):
@@ -28,6 +29,7 @@ class Bonded(MultiplierLaw):
 
     name = "bonded"
     linear = True
+    symmetric = True
 
     def multiplier_components(self, gdim: int) -> int:
         return gdim

@@ -180,12 +180,14 @@ class Frictionless(ContactLaw):
 
     name = "frictionless"
     tangential = False
+    symmetric = True
 
 
 class Sticking(ContactLaw):
     """Contact with no slip: the tangential jump is held at zero while in contact."""
 
     name = "sticking"
+    symmetric = True
 
 
 class Coulomb(ContactLaw):

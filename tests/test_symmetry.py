@@ -1,0 +1,85 @@
+"""Symmetric Jacobians are factored LDL^T, and only they.
+
+- the laws that declare a symmetric Jacobian (sticking, frictionless, bonded) get
+  ``pc_type = "cholesky"`` by default and the solution of the LU, to round-off; each
+  of their Jacobians passes the guard (:func:`xfem_contact.solvers.symmetry.mark_symmetric`);
+- Coulomb friction keeps the LU; asking it for ``cholesky`` is refused, and the guard
+  catches its unsymmetric Jacobian when the problem's check is bypassed;
+- the guard passes a symmetric matrix and refuses one with a small unsymmetric part.
+"""
+
+import warnings
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from xfem_contact.cases.paper import inclusion_errors, inclusion_problem
+from xfem_contact.solvers.newton import RestrictedNewton
+from xfem_contact.solvers.symmetry import mark_symmetric
+
+
+def _solved(law, pc_type, **options):
+    problem = inclusion_problem(12, 2, law, "quadrilateral", **options)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # frictionless: the free spin of the inclusion
+        problem.solve({} if pc_type is None else {"pc_type": pc_type})
+    return problem
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("law", ["sticking", "frictionless", "bonded"])
+def test_symmetric_laws_factor_ldlt_to_the_lu_solution(law):
+    default, lu = _solved(law, None), _solved(law, "lu")
+    assert default.symmetric
+    if not default.linear:
+        assert default._newton._options["pc_type"] == "cholesky"
+    scale = np.abs(lu.w.x.array).max()
+    assert np.abs(default.w.x.array - lu.w.x.array).max() <= 1e-9 * scale
+    if law != "bonded":
+        errors = inclusion_errors(default, default.w), inclusion_errors(lu, lu.w)
+        assert errors[0].pressure == pytest.approx(errors[1].pressure, rel=1e-8)
+
+
+@pytest.mark.mpi
+def test_coulomb_keeps_lu_and_its_jacobian_fails_the_guard():
+    problem = inclusion_problem(12, 2, "coulomb", "quadrilateral", friction=0.3)
+    assert not problem.symmetric
+    with pytest.raises(ValueError, match="needs a symmetric Jacobian"):
+        problem.solve({"pc_type": "cholesky"})
+    newton = RestrictedNewton(
+        problem.residual(),
+        problem.w,
+        problem._bcs,
+        problem.restriction(),
+        {"pc_type": "cholesky"},
+        field_space=problem.space.field_space,
+    )
+    with pytest.raises(ValueError, match="is not symmetric"):
+        newton.solve()
+    newton.destroy()
+
+
+def _matrix(values: np.ndarray) -> PETSc.Mat:
+    n = values.shape[0]
+    A = PETSc.Mat().createAIJ((n, n), comm=MPI.COMM_SELF)
+    A.setUp()
+    A.setValues(range(n), range(n), values)
+    A.assemble()
+    return A
+
+
+def test_guard_passes_symmetric_and_refuses_a_small_unsymmetric_part():
+    rng = np.random.default_rng(0)
+    M = rng.standard_normal((30, 30))
+    symmetric = _matrix(M + M.T)
+    mark_symmetric(symmetric)
+    assert symmetric.isSymmetricKnown() == (True, True)
+    skew = np.zeros_like(M)
+    skew[3, 7], skew[7, 3] = 1e-6, -1e-6  # 1e-6 of entries of size ~1
+    unsymmetric = _matrix(M + M.T + skew)
+    with pytest.raises(ValueError, match="is not symmetric"):
+        mark_symmetric(unsymmetric)
+    for A in (symmetric, unsymmetric):
+        A.destroy()
