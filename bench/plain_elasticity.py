@@ -3,8 +3,9 @@
 No cut, no enrichment, no xfem_contact import: unit square, ``--n`` x ``--n`` cells,
 Lagrange ``--degree`` displacement, E = 100 MPa, nu = 0, the case-2 tractions (-1 Pa
 lateral, -2 Pa top and bottom) and the same three point constraints, one direct solve
-(MUMPS LU; ``--mumps icntl_7=4`` sets a MUMPS control, so that ``bench/scaling.py`` gives it
-the ones xfem-contact's solver options set) and
+(MUMPS LU, or with ``--factor cholesky`` its Cholesky, the matrix flagged symmetric
+positive definite; ``--mumps icntl_7=4`` sets a MUMPS control, so that
+``bench/scaling.py`` gives it the factorisation and controls xfem-contact's solver uses) and
 the displacement written as VTX, as the demo does. Prints one JSON line
 of dofs and wall times per phase (s); ``bench/scaling.py`` runs it as a process of its
 own next to the demo. Run: ``python bench/plain_elasticity.py --n 160 [--degree 2]``,
@@ -34,7 +35,9 @@ E, NU = 100e6, 0.0
 OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 
 
-def solve(n: int, degree: int, cell: str, out: pathlib.Path, mumps: dict[str, int]) -> dict:
+def solve(
+    n: int, degree: int, cell: str, out: pathlib.Path, mumps: dict[str, int], factor: str = "lu"
+) -> dict:
     """Solve and write; returns the dofs and the wall time of each phase (s). Collective."""
     comm = MPI.COMM_WORLD
     times = {}
@@ -85,11 +88,14 @@ def solve(n: int, degree: int, cell: str, out: pathlib.Path, mumps: dict[str, in
     dolfinx.fem.petsc.set_bc(b, bcs)
     times["assembly"] = time.perf_counter() - t
     t = time.perf_counter()
+    if factor == "cholesky":
+        A.setOption(PETSc.Mat.Option.SPD, True)
     ksp = PETSc.KSP().create(comm)
     ksp.setOperators(A)
     ksp.setOptionsPrefix("plain_")
     opts = PETSc.Options()
-    options = OPTIONS | {f"mat_mumps_{key}": value for key, value in mumps.items()}
+    options = OPTIONS | {"pc_type": factor}
+    options |= {f"mat_mumps_{key}": value for key, value in mumps.items()}
     for key, value in options.items():
         opts[f"plain_{key}"] = value
     ksp.setFromOptions()
@@ -120,9 +126,10 @@ def main():
         metavar="icntl_K=V",
         help="MUMPS controls, e.g. icntl_7=4 (default: MUMPS's own choices)",
     )
+    parser.add_argument("--factor", default="lu", choices=["lu", "cholesky"])
     args = parser.parse_args()
     mumps = dict(item.split("=", 1) for item in args.mumps)
-    result = solve(args.n, args.degree, args.cell, pathlib.Path(args.out), mumps)
+    result = solve(args.n, args.degree, args.cell, pathlib.Path(args.out), mumps, args.factor)
     if MPI.COMM_WORLD.rank == 0:
         print(json.dumps(result))
 

@@ -2,8 +2,9 @@
 
 Paper case 2 (the main demo: circular inclusion, sticking, quadrilaterals) for P1 and
 P2 at N = 20 ... 320 cells per side, each run as a process of its own, next to
-``bench/plain_elasticity.py`` (no cut, the same mesh, loads and LU solver options) in
-the same session: dofs, whole-process wall time, peak resident memory, and the demo's
+``bench/plain_elasticity.py`` (no cut; the same mesh, loads, MUMPS controls and
+factorisation: Cholesky where the demo's Jacobian is symmetric, else LU) in the same
+session: dofs, whole-process wall time, peak resident memory, and the demo's
 own split into phases (its ``summary.json``). The ratio cut / plain is printed per N;
 the JIT (cold FFCx cache) is measured apart, once per degree at the smallest N, in an
 empty cache directory. ``--ranks 2`` adds the largest P2 case on 2 MPI ranks (speed-up
@@ -94,6 +95,7 @@ def demo(n, degree, work, env=None, ranks=1, samples=False) -> dict:
         "timings": data["timings"],
         "error": data["contact_pressure_rel_L2_error"],
         "newton_iterations": data["newton_iterations"],
+        "factorisation": data["factorisation"],
     } | ({"_samples": data["interface_samples"]} if samples else {})
 
 
@@ -112,10 +114,10 @@ def max_difference(a: dict, b: dict) -> float:
     return float(np.abs(la - lb).max() / np.abs(la).max())
 
 
-def plain(n, degree, work, mumps, env=None, ranks=1) -> dict:
+def plain(n, degree, work, mumps, env=None, ranks=1, factor="lu") -> dict:
     command = [sys.executable, str(ROOT / "bench" / "plain_elasticity.py")]
     command += ["--n", str(n), "--degree", str(degree), "--out", str(work / "plain")]
-    command += ["--mumps", *mumps]
+    command += ["--mumps", *mumps, "--factor", factor]
     if ranks > 1:
         command = [str(pathlib.Path(sys.executable).parent / "mpiexec"), "-n", str(ranks)] + command
     wall, rss, text = run(command, env)
@@ -232,15 +234,16 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         work = pathlib.Path(tmp)
         for degree in args.degrees:
-            demo(args.sizes[0], degree, work)  # warm the caches of this degree
-            plain(args.sizes[0], degree, work, mumps)
+            # warm the caches of this degree; the plain solve factors as the demo does
+            factor = demo(args.sizes[0], degree, work)["factorisation"]
+            plain(args.sizes[0], degree, work, mumps, factor=factor)
             for n in progress(args.sizes, f"P{degree} sizes", not args.no_progress):
                 last = degree == 2 and n == args.sizes[-1]
                 runs = {
                     "cut": functools.partial(
                         demo, n, degree, work, samples=last and args.ranks > 1
                     ),
-                    "plain": functools.partial(plain, n, degree, work, mumps),
+                    "plain": functools.partial(plain, n, degree, work, mumps, factor=factor),
                 }
                 repeat = args.repeat if n >= args.repeat_from else 1
                 rows.append({"degree": degree, "n": n} | medians(runs, repeat))
@@ -263,7 +266,9 @@ def main():
             serial = row["cut"]
             runs = {
                 "cut": functools.partial(demo, n, 2, work, ranks=args.ranks, samples=True),
-                "plain": functools.partial(plain, n, 2, work, mumps, ranks=args.ranks),
+                "plain": functools.partial(
+                    plain, n, 2, work, mumps, ranks=args.ranks, factor=serial["factorisation"]
+                ),
             }
             ran = medians(runs, args.repeat if n >= args.repeat_from else 1)
             distributed = ran["cut"]

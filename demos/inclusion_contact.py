@@ -127,6 +127,7 @@ def main():
             "tangential_traction_rel_L2_error": errors.tangential,
             "newton_iterations": report.iterations,
             "solver": args.solver,
+            "factorisation": problem.solver_options(preset(args.solver))["pc_type"],
             "krylov_iterations": report.linear_iterations,
             "newton_residuals": report.residuals,
             "contact_status": report.status[-1],

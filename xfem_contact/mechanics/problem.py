@@ -33,6 +33,7 @@ from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
 from xfem_contact.solvers.linear import solve_restricted
 from xfem_contact.solvers.newton import NewtonFailure, NewtonReport, RestrictedNewton
+from xfem_contact.solvers.options import merged_options
 from xfem_contact.solvers.symmetry import symmetric_options
 
 
@@ -184,6 +185,12 @@ class Problem(Loads):
         solves then factor LDL^T (:mod:`xfem_contact.solvers.symmetry`)."""
         small = self.kinematics == "small" and not self.couplings
         return small and all(law.symmetric for law in self.laws.values())
+
+    def solver_options(self, petsc_options: dict | None = None) -> dict:
+        """The PETSc options (without prefix) :meth:`solve` uses: ``petsc_options``
+        over the defaults, the LDL^T of a symmetric problem included. Not collective."""
+        solver = "linear" if self.linear else "newton"
+        return merged_options(solver, symmetric_options(petsc_options, self.symmetric))
 
     def law(self, name: str | None = None) -> InterfaceLaw:
         """The law of interface ``name`` (of the only interface for ``None``)."""

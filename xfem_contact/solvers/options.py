@@ -45,7 +45,15 @@ SOLVER_OPTIONS: dict[str, Option] = {
     "ksp_type": Option(
         str, "preonly", "Krylov method; preonly applies the preconditioner once", None, _BOTH
     ),
-    "pc_type": Option(str, "lu", "preconditioner; lu is a direct solve", None, _BOTH),
+    "pc_type": Option(
+        str,
+        "lu",
+        "preconditioner; lu is a direct solve, and a problem with a symmetric Jacobian "
+        "(sticking, frictionless, bonded) factors LDL^T instead (cholesky, "
+        "xfem_contact.solvers.symmetry) unless pc_type is given",
+        None,
+        _BOTH,
+    ),
     "pc_factor_mat_solver_type": Option(
         str, "mumps", "package of the LU factorisation (MUMPS: also in parallel)", None, _BOTH
     ),
