@@ -59,7 +59,8 @@ def main():
         "--solver",
         default="direct",
         choices=sorted(LINEAR_PRESETS),
-        help="linear solver of the Newton steps: MUMPS LU, or GMRES + band multigrid",
+        help="linear solver of the Newton steps: MUMPS (LDL^T of a symmetric Jacobian, "
+        "else LU), or GMRES + band multigrid",
     )
     parser.add_argument("--out", default="results/inclusion_contact")
     parser.add_argument("--json", default=None)
