@@ -20,7 +20,7 @@ calls :func:`load_dolfinx_solver` as well, for interpreters started without the
 hook (``python -S``, a checkout on ``PYTHONPATH``).
 
 So this module runs at every interpreter start: it imports nothing but ``sys``
-and only inserts the finder; it never imports ``dolfinx_solver`` (0.2 s and an
+and only inserts the finder; it never imports ``dolfinx_solver`` (slow, and an
 ``MPI_Init``) unless DOLFINx is imported.
 """
 

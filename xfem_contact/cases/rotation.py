@@ -94,7 +94,7 @@ def svk_annulus_pressure(
     case 3 with the Saint Venant-Kirchhoff bulk: the axisymmetric radial problem
     (frictionless contact closed, one material: a continuous ring, the inner ring's
     rigid rotation irrelevant by objectivity) solved by shooting on ``u'(R_i)`` with
-    RK4 (``steps`` per ring; 500 agree with 2000 to 1e-14). Not collective."""
+    RK4 (``steps`` per ring; the default is converged to round-off). Not collective."""
     mu = E / (2.0 * (1.0 + nu))
     lmbda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
     slopes = [0.0, -pressure / E]
@@ -134,12 +134,11 @@ def rotating_annulus_problem(
             along ``r = 20``, a spring of 1000 E / h).
         quadrature_degree: Of the cut's rules (the cut's default 6). The master feet of
             a slave piece's points cross master-piece ends, where the master field's
-            derivative jumps, and Gauss points over such a kink lose accuracy: at
-            0.3 rad (n = 40, P2) 12 brings the pressure error from 1.19e-4 to 5.64e-5 and
-            the oscillation from 3.1e-4 to 2e-5, but more points then sit near kinks,
-            where the pairing is not smooth, and Newton can stall (n = 10, pi/4: at
-            3e-5 of the first residual). Segment-to-segment integration would remove
-            both; not built.
+            derivative jumps, and Gauss points over such a kink lose accuracy; a
+            higher degree reduces the error, but more points then sit near kinks,
+            where the pairing is not smooth, and Newton can stall (see the docs'
+            large-sliding page). Segment-to-segment integration would remove both;
+            not built.
         options: Passed to :class:`~xfem_contact.mechanics.problem.Problem` (e.g.
             ``pairing``, ``slave``, ``ghost_penalty``) or to the law (``lbb``, ...).
     """

@@ -2,8 +2,8 @@
 
 FFCx caches a form's compiled module on disk, but the layout of its runtime
 kernels (:class:`~xfem_contact.codegen.tables.RuntimeIntegral`) comes from FFCx's
-intermediate representation, which takes 0.3-0.5 s per form to build: 2.9 s of
-every start-up of the case-2 demo. :func:`save` writes the layouts as JSON next to
+intermediate representation, which is slow to build (a large part of a warm
+start-up). :func:`save` writes the layouts as JSON next to
 the module (same name, suffix ``.xfem-tables.json``); :func:`load` reads them back
 for a form with the same signature, finding each table's element again among the
 form's own elements by its ``repr``. A missing, unreadable or foreign file just

@@ -2,15 +2,14 @@
 
 On the uncut cells of side ``s`` a Jacobian on ``W = (u_-, u_+, lambda, ...)`` is the
 bulk of side ``s`` alone, yet assembled on ``W`` every one of those cells' element
-matrices spans all the fields (44 x 44 on a Q2/Q1 cell around an 18 x 18 nonzero
-block), each entry sent through the mixed space's dof map. :func:`split_uncut` takes
-the uncut-cell integrals of the side measures (:meth:`CutMesh.dx
-<xfem_contact.fem.cutmesh.CutMesh.dx>`) out of the form: the diagonal block of each
-field, ``a(P_i u, P_i v)``, becomes a form on that field's own space ``V_i``, which
-DOLFINx assembles as a plain vector form (2 x 2 blocks inserted at once); what
-couples two fields on those cells (nothing, for the bulk models here) stays on ``W``
-with the cut cells. Interior-facet integrals (the ghost penalty, 88 x 88 per facet on
-``W``) are split the same way. The sum of the pieces is the form.
+matrices spans all the fields around a much smaller nonzero block, each entry sent
+through the mixed space's dof map. :func:`split_uncut` takes the uncut-cell integrals
+of the side measures (:meth:`CutMesh.dx <xfem_contact.fem.cutmesh.CutMesh.dx>`) out of
+the form: the diagonal block of each field, ``a(P_i u, P_i v)``, becomes a form on that
+field's own space ``V_i``, which DOLFINx assembles as a plain vector form (2 x 2 blocks
+inserted at once); what couples two fields on those cells (nothing, for the bulk models
+here) stays on ``W`` with the cut cells. Interior-facet integrals (the ghost penalty)
+are split the same way. The sum of the pieces is the form.
 """
 
 from __future__ import annotations

@@ -223,9 +223,8 @@ def form_parts(
     Collective. Assembling every part into one tensor gives what ``form(ufl_form)``
     assembles. The point is the coefficient packing: DOLFINx packs every
     coefficient of a form on every entity of each of its integrals, so in one form
-    the uncut cells would carry the markers of all runtime rules (13 values per
-    rule set, about 250 of the 300 packed values per cell of a contact residual).
-    Parts without integrals are left out.
+    the uncut cells would carry the markers of all runtime rules (most of the packed
+    values per cell of a contact residual). Parts without integrals are left out.
 
     Args:
         ufl_form: A UFL form that may use cut-cell measures.

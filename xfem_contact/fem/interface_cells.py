@@ -50,8 +50,8 @@ def without_slivers(
 ) -> quadrature.RuleSet:
     """The interface rules without the cells whose interface length is round-off
     (below ``SLIVER_TOLERANCE`` times the cell size): a cell touched by the interface
-    at a node got a piece of length 3e-17 or none depending on the order of the
-    cell's vertices, i.e. on the number of processes, and with it multiplier dofs."""
+    at a node can get a round-off piece or none depending on the order of the cell's
+    vertices, i.e. on the number of processes, and with it multiplier dofs."""
     if rules.weights.size == 0:
         return rules
     J = maps.jacobian(cut_cells[rules.point_rows], rules.points)

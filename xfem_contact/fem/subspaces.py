@@ -1,9 +1,8 @@
 """Sub-spaces of mixed spaces as spaces of their own, built cell by cell.
 
 DOLFINx's ``FunctionSpace.collapse`` of a blocked (vector) sub-space of a mixed
-space on quadrilaterals is slow: 1.8 s for the Q2 displacement of a 160 x 160 mesh,
-against 0.03 s on triangles of the same size and 0.004 s to create the same space
-afresh (DOLFINx 0.11). :func:`collapse` creates the space afresh and reads the map to
+space on quadrilaterals is slow (DOLFINx 0.11; see the docs' performance notes).
+:func:`collapse` creates the space afresh and reads the map to
 the parent's dofs off the two cell dofmaps, which list a cell's dofs in the same
 order (node by node, components inside a node).
 """

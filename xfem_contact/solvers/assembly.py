@@ -1,10 +1,9 @@
 """Bilinear forms assembled on the reduced space ``R^T A R`` of a restriction ``R``.
 
 A form on the mixed space ``W = (u_-, u_+, lambda, ...)`` couples every field on
-every cell it integrates (44 x 44 blocks per Q2/Q1 cell), and more than half of
-``W``'s dofs are inactive; assembled in full and reduced by ``PtAP`` the case-2 matrix
-at 160 x 160 has 38.5 M stored entries on 464 k rows for 7.8 M on the 210 k reduced
-ones. When ``R`` only *selects* dofs (identity columns: every LBB treatment but the
+every cell it integrates, and more than half of ``W``'s dofs are inactive, so a
+matrix assembled in full and reduced by ``PtAP`` stores several times the entries of
+the reduced one. When ``R`` only *selects* dofs (identity columns: every LBB treatment but the
 restriction), :class:`ReducedMatrix` builds the sparsity of the active dofs alone and
 assembles straight into it through a local-to-global map that sends each dof of
 ``W`` to its reduced column and each inactive dof to -1, which PETSc drops. With a
@@ -144,9 +143,9 @@ def reduced_matrix(
     inserts with). Collective.
 
     With ``blocks`` and unknowns that pair up (:func:`_pairs`) the pattern is built on
-    the pairs, as DOLFINx builds a vector space's (a quarter of the entries to sort:
-    at 320 x 320 its finalisation took 0.2 s instead of 0.8 s), and the matrix has
-    block size 2. With ``fill`` the whole pattern is stored (:func:`_fill_pattern`)."""
+    the pairs, as DOLFINx builds a vector space's (a quarter of the entries to sort),
+    and the matrix has block size 2. With ``fill`` the whole pattern is stored
+    (:func:`_fill_pattern`)."""
     comm = a.mesh.comm  # lives as long as the mesh (the index map's own does not)
     W = a.function_spaces[0]
     dofmap = W.dofmap.map()  # (num_cells, dofs per cell)

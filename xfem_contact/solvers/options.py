@@ -99,8 +99,8 @@ SOLVER_OPTIONS: dict[str, Option] = {
 #: iterative one is GMRES(100) preconditioned by
 #: :class:`~xfem_contact.solvers.band_multigrid.BandMultigrid`: an exact solve on the
 #: band of the interface (cut cells, their neighbours, the multipliers) after a
-#: two-level p-multigrid V-cycle on the displacements. Case 2: 8 to 10 Krylov
-#: iterations per Newton step from N = 40 to 640 (``bench/iterative.py``).
+#: two-level p-multigrid V-cycle on the displacements (iteration counts:
+#: ``bench/iterative.py``).
 LINEAR_PRESETS: dict[str, dict[str, OptionValue]] = {
     "direct": {},
     "iterative": {

@@ -2,9 +2,8 @@
 
 Sticking and frictionless contact (augmented Lagrangian, generalized Newton), bonded
 interfaces and the bulk give symmetric (indefinite) Jacobians: an LDL^T factorisation
-(``pc_type = "cholesky"``: MUMPS with ``SYM = 2``, 2 x 2 pivots) takes half the
-factor entries and flops of an LU. Case 2, P2, N = 320 (830 k dofs), one core: LU
-12.8 s and 198 M factor entries, LDL^T 8.3 s and 100 M. Coulomb friction (slip) and
+(``pc_type = "cholesky"``: MUMPS with ``SYM = 2``, 2 x 2 pivots) takes about half
+the factor entries and flops of an LU. Coulomb friction (slip) and
 large sliding give unsymmetric ones and keep the LU.
 
 Which laws are symmetric is a property of each law
