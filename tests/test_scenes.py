@@ -480,6 +480,20 @@ def test_cli_missing_scene_file_exit_2(capsys):
     assert "'plain_plate'" in err[0]  # the bundled scenes are the choices
 
 
+def test_cli_scenes_show_prints_a_bundled_scene(capsys):
+    """``scenes --show NAME`` prints the bundled TOML as it is; an unknown NAME: exit 2,
+    one line naming every bundled scene."""
+    assert cli.main(["scenes", "--show", "case2_sticking_inclusion"]) == 0
+    out = capsys.readouterr().out
+    path = bundled_scenes()["case2_sticking_inclusion"]
+    assert out == path.read_text(encoding="utf-8") and "law = \"sticking\"" in out
+    assert cli.main(["scenes", "--show", "case9"]) == 2
+    captured = capsys.readouterr()
+    err = captured.err.splitlines()
+    assert captured.out == "" and len(err) == 1 and "'case9'" in err[0]
+    assert all(name in err[0] for name in bundled_scenes())
+
+
 def test_cli_error_at_build_is_one_line_and_leaves_no_stale_summary(tmp_path, capsys):
     """A geometry error found when building: exit 2, and the summary.json of an earlier
     run in the folder is gone (a summary.json is always a finished run's)."""
@@ -739,13 +753,16 @@ def test_materials_differ_by_inclusion():
     """The bundled two-inclusion scene: the stiff material only inside its own inclusion."""
     scene = load_scene(bundled_scenes()["two_inclusions"])
     problem, effects = build(scene)
-    E = problem.materials[-1].E  # a DG0 field: side -1 holds two materials
+    E = problem.bulk.materials[-1].ufl_E  # a DG0 field: side -1 holds two materials
     cut = problem.cut
     x = dolfinx.mesh.compute_midpoints(cut.mesh, 2, np.arange(cut.cell_sides.size, dtype=np.int32))
     inside_a = np.hypot(x[:, 0] - 0.5, x[:, 1] - 0.5) < 0.15
     inside_b = np.hypot(x[:, 0] - 1.5, x[:, 1] - 0.5) < 0.15
     values = E.x.array[E.function_space.dofmap.list[: cut.cell_sides.size, 0]]
     assert np.all(values[inside_a] == 1e9) and np.all(values[inside_b] == 100e6)
+    problem.materials[-1]["bonded_stiff"].E = 2e9  # a Constant-like parameter: refills E
+    values = E.x.array[E.function_space.dofmap.list[: cut.cell_sides.size, 0]]
+    assert np.all(values[inside_a] == 2e9) and np.all(values[inside_b] == 100e6)
     assert effects["interfaces"] == ["bonded_stiff", "coulomb"]
     assert set(effects["laws"]) == {"bonded_stiff", "coulomb"}
 

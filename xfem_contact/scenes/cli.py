@@ -2,7 +2,7 @@
 
 xfem-contact run SCENE.toml --out DIR [--quiet] [--debug]   (also under mpiexec -n 2)
     exit 0 done, 2 bad input (one line ``error: FILE: KEY: message``), 3 Newton failed
-xfem-contact scenes
+xfem-contact scenes [--show NAME]                (list, or print one bundled scene's TOML)
 xfem-contact show DIR
 xfem-contact --version                           (xfem-contact, DOLFINx, Basix, FFCx, UFL, PETSc)
 """
@@ -60,11 +60,24 @@ def _run(args) -> int:
 
 
 def _scenes(args) -> int:
+    """List the bundled scenes, or print one (``--show NAME``): exit 2 and one line
+    naming the bundled scenes for an unknown name."""
     import tomllib
 
     from xfem_contact.scenes.scene import bundled_scenes
 
-    for name, path in bundled_scenes().items():
+    scenes = bundled_scenes()
+    if args.show is not None:
+        if args.show not in scenes:
+            valid = ", ".join(scenes)
+            print(
+                f"error: scenes --show: no bundled scene {args.show!r}; bundled: {valid}",
+                file=sys.stderr,
+            )
+            return 2
+        print(scenes[args.show].read_text(encoding="utf-8"), end="")
+        return 0
+    for name, path in scenes.items():
         with open(path, "rb") as f:
             description = tomllib.load(f).get("scene", {}).get("description", "")
         print(f"{name:28s} {description}")
@@ -110,7 +123,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--no-progress", action="store_true", help="no progress bar over load steps")
     p.add_argument("--debug", action="store_true", help="show the traceback of an error")
     p.set_defaults(func=_run)
-    p = sub.add_parser("scenes", help="list the bundled scenes")
+    p = sub.add_parser("scenes", help="list the bundled scenes, or print one")
+    p.add_argument("--show", metavar="NAME", help="print the TOML of the bundled scene NAME")
     p.set_defaults(func=_scenes)
     p = sub.add_parser("show", help="render the result of a run folder to PNG")
     p.add_argument("dir")
