@@ -59,34 +59,65 @@ def _rank_path(path: pathlib.Path, comm) -> pathlib.Path:
     return path
 
 
-def write_lips(path: str | pathlib.Path, cut: CutMesh, u_minus, u_plus) -> pathlib.Path:
+def write_lips(
+    path: str | pathlib.Path, cut: CutMesh, u_minus, u_plus, fields: dict | None = None
+) -> pathlib.Path:
     """Write a ``.vtu`` grid of uncut cells and sub-triangles with each side's displacement.
 
     The grid is :func:`xfem_contact.io.pictures.deformed_lips_grid` (quadratic cells,
     point data ``u`` in m, cell data ``side``, ``cut``, ``cell``). Local to each
     process: rank ``r`` writes ``path`` with suffix ``_r{r}`` when run in parallel.
-    ``u_minus``, ``u_plus``: displacement Functions of sides -1 and +1.
+    ``u_minus``, ``u_plus``: displacement Functions of sides -1 and +1; ``fields``:
+    more point data, name to ``{-1: Function, 1: Function}`` ((discontinuous)
+    Lagrange, e.g. ``stress`` and ``von_mises`` of
+    :class:`~xfem_contact.mechanics.stress.StressFields`).
     """
     path = _rank_path(pathlib.Path(path), cut.mesh.comm)
-    write_vtu(path, lips_arrays(cut, u_minus, u_plus), VTU_COMPRESSION)
+    write_vtu(path, lips_arrays(cut, u_minus, u_plus, fields), VTU_COMPRESSION)
     return path
 
 
-def write_cut_geometry(directory: str | pathlib.Path, cut: CutMesh) -> list[pathlib.Path]:
+def write_plain(path: str | pathlib.Path, u, fields: dict | None = None) -> pathlib.Path:
+    """Write a ``.vtu`` grid of the mesh at the nodes of ``u``'s Lagrange space with point
+    data ``u`` (m) and ``fields`` (name to Function, e.g. a discontinuous stress, taken
+    at the nodes by interpolation into ``u``'s degree). Local to each process (suffix
+    ``_r{rank}`` in parallel)."""
+    import dolfinx.plot
+    import pyvista
+
+    V = u.function_space
+    path = _rank_path(pathlib.Path(path), V.mesh.comm)
+    topology, cell_types, x = dolfinx.plot.vtk_mesh(V)
+    grid = pyvista.UnstructuredGrid(topology, cell_types, x)
+    values = u.x.array.reshape(-1, 2)
+    grid.point_data["u"] = np.c_[values, np.zeros(values.shape[0])]
+    degree = V.ufl_element().embedded_superdegree
+    for name, f in (fields or {}).items():
+        shape = f.function_space.value_shape
+        nodal = dolfinx.fem.Function(dolfinx.fem.functionspace(V.mesh, ("Lagrange", degree, shape)))
+        nodal.interpolate(f)
+        grid.point_data[name] = nodal.x.array.reshape(values.shape[0], -1)
+    grid.save(path)
+    return path
+
+
+def write_cut_geometry(
+    directory: str | pathlib.Path, cut: CutMesh, interface_data: dict | None = None
+) -> list[pathlib.Path]:
     """Write ``subcells.vtu`` (the curved sub-triangles of the cut cells, cell data
-    ``side``, ``cut``, ``cell``) and ``interface.vtu`` (curved interface pieces) into
-    ``directory``: the cut region only, the uncut cells are in ``result.vtu``
-    (:func:`write_lips`).
+    ``side``, ``cut``, ``cell``) and ``interface.vtu`` (curved interface pieces, point
+    data ``interface_data``: name to an array over its nodes, e.g.
+    :func:`~xfem_contact.io.interface_data.interface_point_data`) into ``directory``:
+    the cut region only, the uncut cells are in ``result.vtu`` (:func:`write_lips`).
 
     Local to each process (not collective): in parallel rank ``r`` writes
     ``subcells_r{r}.vtu`` and ``interface_r{r}.vtu``. See :mod:`xfem_contact.io.pictures`.
     """
     directory, comm = pathlib.Path(directory), cut.mesh.comm
     paths = []
-    for name, arrays in (
-        ("subcells", subcell_arrays(cut, uncut=False)),
-        ("interface", interface_arrays(cut)),
-    ):
+    interface = interface_arrays(cut)
+    interface = interface._replace(point_data=dict(interface_data or {}))
+    for name, arrays in (("subcells", subcell_arrays(cut, uncut=False)), ("interface", interface)):
         path = _rank_path(directory / f"{name}.vtu", comm)
         write_vtu(path, arrays, VTU_COMPRESSION)
         paths.append(path)

@@ -34,7 +34,7 @@ import numpy as np
 import numpy.typing as npt
 
 from xfem_contact.fem.cutmesh import CutMesh
-from xfem_contact.fem.evaluation import evaluate_lattice, evaluate_reference
+from xfem_contact.fem.evaluation import cell_dofs, evaluate_lattice, evaluate_reference
 
 #: VTK cell types (``vtkCellType.h``)
 QUADRATIC_EDGE, QUADRATIC_TRIANGLE, BIQUADRATIC_QUAD = 21, 22, 28
@@ -117,22 +117,39 @@ def _lattice_keys(cut: CutMesh, cells: npt.NDArray[np.int32], lattice: np.ndarra
     return keys
 
 
-def _shared_lattice(cut: CutMesh, b: _Block, field) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Points ``(m, 3)``, node indices per cell ``(n, k)`` and values ``(m, 3)`` (or
-    ``None``) of the lattice nodes of ``b``'s cells, each node once."""
+def _shared_lattice(cut: CutMesh, b: _Block, fields: dict) -> tuple:
+    """Points ``(m, 3)``, node indices per cell ``(n, k)`` and values (name to ``(m, c)``)
+    of ``fields`` (name to Function) at the lattice nodes of ``b``'s cells, each node once
+    (a discontinuous field takes the value of the cell that first meets the node)."""
     lattice = np.ascontiguousarray(b.X[0])
     keys = _lattice_keys(cut, b.cells, lattice)
     _, first, ids = np.unique(keys.ravel(), return_index=True, return_inverse=True)
     cell_of, node_of = b.cells[first // lattice.shape[0]], first % lattice.shape[0]
     points = np.zeros((first.size, 3))
-    values = None if field is None else np.zeros((first.size, 3))
+    values = {name: None for name in fields}
     for j in range(lattice.shape[0]):  # the nodes first met as lattice node j
         rows = np.flatnonzero(node_of == j)
         X = lattice[j : j + 1]
         points[rows] = _pad3(cut.maps.push_forward_lattice(cell_of[rows], X))
-        if field is not None:
-            values[rows] = _pad3(evaluate_lattice(field, cell_of[rows], X))
+        for name, field in fields.items():
+            v = _evaluate(field, cell_of[rows], X, lattice=True)
+            if values[name] is None:
+                values[name] = np.zeros((first.size, v.shape[1]))
+            values[name][rows] = v
     return points, ids.reshape(keys.shape), values
+
+
+def _evaluate(field, cells: np.ndarray, X: np.ndarray, lattice: bool) -> np.ndarray:
+    """Values ``(m, c)`` of a Lagrange or discontinuous Lagrange ``field`` at reference
+    points (``X`` the same in every cell when ``lattice``); vectors padded to 3
+    components. A degree-0 field is its cell value."""
+    if field.function_space.ufl_element().embedded_superdegree == 0:
+        V = field.function_space
+        values = field.x.array[cell_dofs(V, cells)].reshape(cells.size, -1)
+        values = np.repeat(values, 1 if not lattice else X.shape[0], axis=0)
+    else:
+        values = (evaluate_lattice if lattice else evaluate_reference)(field, cells, X)
+    return _pad3(values) if values.shape[1] == 2 else values
 
 
 def _pad3(a: np.ndarray) -> np.ndarray:
@@ -154,26 +171,29 @@ class GridArrays(NamedTuple):
 
 def grid_arrays(cut: CutMesh, blocks: list[_Block], fields: dict | None = None) -> GridArrays:
     """Arrays of ``blocks`` (nodes shared within a block of uncut cells only);
-    ``fields[side]``: Function evaluated as point data ``u``."""
+    ``fields[name][side]``: a (discontinuous) Lagrange Function evaluated as point data
+    ``name`` on the cells of that side (2-vectors padded to 3 components)."""
     tdim = cut.mesh.topology.dim
+    fields = fields or {}
     points, connectivity, types, data = [], [], [], {"side": [], "cut": [], "cell": []}
-    values = []
+    values = {name: [] for name in fields}
     start = 0
     for b in blocks:
         n, k = b.X.shape[:2]
         if n == 0:
             continue
+        here = {name: by_side[b.side] for name, by_side in fields.items()}
         if b.X.strides[0] == 0:  # the same lattice in every cell: nodes shared
-            xs, ids, us = _shared_lattice(cut, b, None if fields is None else fields[b.side])
+            xs, ids, vs = _shared_lattice(cut, b, here)
             points.append(xs)
-            if fields is not None:
-                values.append(us)
+            for name, v in vs.items():
+                values[name].append(v)
         else:
             cells = np.repeat(b.cells, k)
             X = np.ascontiguousarray(b.X.reshape(-1, tdim))
             points.append(_pad3(cut.maps.push_forward(cells, X)))
-            if fields is not None:
-                values.append(_pad3(evaluate_reference(fields[b.side], cells, X)))
+            for name, field in here.items():
+                values[name].append(_evaluate(field, cells, X, lattice=False))
             ids = np.arange(n * k).reshape(n, k)
         connectivity.append(np.c_[np.full(n, k), start + ids].ravel())
         types.append(np.full(n, b.vtk_type, dtype=np.uint8))
@@ -190,19 +210,19 @@ def grid_arrays(cut: CutMesh, blocks: list[_Block], fields: dict | None = None) 
             {name: np.zeros(0, dtype=dtype) for name, dtype in empty.items()},
             {},
         )
-    point_data = {} if fields is None else {"u": np.concatenate(values)}
     return GridArrays(
         np.concatenate(points),
         np.concatenate(connectivity),
         np.concatenate(types),
         {name: np.concatenate(parts) for name, parts in data.items()},
-        point_data,
+        {name: np.concatenate(parts) for name, parts in values.items()},
     )
 
 
-def lips_arrays(cut: CutMesh, u_minus, u_plus) -> GridArrays:
-    """Uncut cells and sub-triangles with point data ``u`` (m), each side's own."""
-    return grid_arrays(cut, _blocks(cut), {-1: u_minus, 1: u_plus})
+def lips_arrays(cut: CutMesh, u_minus, u_plus, fields: dict | None = None) -> GridArrays:
+    """Uncut cells and sub-triangles with point data ``u`` (m), each side's own, and
+    the ``fields`` given (name to ``{-1: Function, 1: Function}``, e.g. ``stress``)."""
+    return grid_arrays(cut, _blocks(cut), {"u": {-1: u_minus, 1: u_plus}} | (fields or {}))
 
 
 def subcell_arrays(cut: CutMesh, uncut: bool = True) -> GridArrays:

@@ -1,0 +1,102 @@
+"""The interface laws' state at the nodes of ``interface.vtu`` (point data per lip node).
+
+The nodes are those of :func:`~xfem_contact.io.vtu.interface_arrays` (three per curved
+piece: end ``a``, end ``b``, mid-node). For a law acting on one cell (small sliding) its
+``state`` is evaluated at these nodes with the same definitions and normal as at its
+rule points; a law that pairs two cells (large sliding) is sampled at the nearest of its
+own points in the same cut cell. Point data (each ``(npoints,)``): ``lambda_n``,
+``lambda_t`` (multipliers, Pa), ``gap``, ``slip`` (m) and ``status`` (0 open, 1 stick,
+2 slip; frictionless contact is slip, a bonded interface stick, a free one open).
+Local to each process.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from xfem_contact.mechanics.laws.base import NUMPY_OPS
+from xfem_contact.quadrature.rules import RuleSet
+
+#: Point data of ``interface.vtu`` and the codes of ``status``
+KEYS = ("lambda_n", "lambda_t", "gap", "slip")
+OPEN, STICK, SLIP = 0, 1, 2
+
+
+def status_codes(law, state: dict[str, np.ndarray], npoints: int) -> np.ndarray:
+    """Per point 0 (open), 1 (stick) or 2 (slip), int8, ``(npoints,)``: in contact where
+    the applied pressure ``P_n < 0``; sticking where the trial tangential traction lies
+    within the law's friction bound (always for ``sticking``, never for frictionless)."""
+    if "P_n" not in state:  # no contact law: bonded sticks, free is open
+        code = STICK if law.name == "bonded" else OPEN
+        return np.full(npoints, code, dtype=np.int8)
+    contact = state["P_n"] < 0.0
+    if not getattr(law, "tangential", False):
+        stick = np.zeros_like(contact)
+    else:
+        bound = law.friction_bound(state["P_n"], NUMPY_OPS)
+        stick = contact if bound is None else contact & (np.abs(state["trial_t"]) <= bound)
+    return np.where(contact, np.where(stick, STICK, SLIP), OPEN).astype(np.int8)
+
+
+def _node_rules(cut, pieces: np.ndarray) -> RuleSet:
+    """Rules (rows ``cut.cut_cells``) whose points are the nodes of the pieces ``pieces``."""
+    g = cut.geometry
+    rows = g.seg_cell[pieces]  # sorted, as g.seg_cell
+    counts = np.bincount(rows, minlength=cut.cut_cells.size) * 3
+    offsets = np.zeros(cut.cut_cells.size + 1, dtype=np.int64)
+    np.cumsum(counts, out=offsets[1:])
+    points = np.ascontiguousarray(g.seg[pieces].reshape(-1, 2))
+    return RuleSet(points, np.zeros(points.shape[0]), offsets)
+
+
+def _nearest(cut, rules: RuleSet, state: dict, pieces: np.ndarray) -> dict:
+    """``state`` (at the points of ``rules``) at the nodes of ``pieces``: the value of
+    the nearest point of the same cut cell (0 where the cell has none)."""
+    g = cut.geometry
+    nodes = g.seg[pieces].reshape(-1, 2)
+    node_rows = np.repeat(g.seg_cell[pieces], 3)
+    out = {k: np.zeros(nodes.shape[0]) for k, v in state.items() if np.ndim(v) == 1}
+    if rules.points.shape[0] == 0:
+        return out
+    rows = rules.point_rows
+    for row in np.unique(node_rows):
+        mine, theirs = np.flatnonzero(node_rows == row), np.flatnonzero(rows == row)
+        if theirs.size == 0:
+            continue
+        d = np.linalg.norm(nodes[mine, None, :] - rules.points[None, theirs, :], axis=2)
+        pick = theirs[np.argmin(d, axis=1)]
+        for k in out:
+            out[k][mine] = np.asarray(state[k])[pick]
+    return out
+
+
+def interface_point_data(problem) -> dict[str, np.ndarray]:
+    """``lambda_n``, ``lambda_t``, ``gap``, ``slip`` and ``status`` at this process's
+    ``interface.vtu`` nodes (all interfaces, in the order of
+    :func:`~xfem_contact.io.vtu.interface_arrays`). Collective (large-sliding laws
+    pair their points across processes)."""
+    cut = problem.cut
+    g = cut.geometry
+    npoints = 3 * g.seg_cell.size
+    data = {k: np.zeros(npoints) for k in KEYS} | {"status": np.zeros(npoints, dtype=np.int8)}
+    interface_of_piece = cut.cell_interface[g.seg_cell] if g.seg_cell.size else g.seg_cell
+    couplings = getattr(problem, "couplings", {}) or {}
+    for name, law in problem.laws.items():
+        ctx = problem.contexts[name]
+        k = list(cut.interface_names).index(name) if len(problem.laws) > 1 else None
+        pieces = (
+            np.flatnonzero(interface_of_piece == k) if k is not None else np.arange(g.seg_cell.size)
+        )
+        if name in couplings:
+            state = _nearest(cut, ctx.rules, law.state(ctx, problem.w), pieces)
+        else:
+            nodes = dataclasses.replace(ctx, rules=_node_rules(cut, pieces), _cache={})
+            state = law.state(nodes, problem.w)
+        rows = (3 * pieces[:, None] + np.arange(3)).ravel()
+        for key in KEYS:
+            if key in state:
+                data[key][rows] = state[key]
+        data["status"][rows] = status_codes(law, state, rows.size)
+    return data
