@@ -1,14 +1,15 @@
 """Progress bars for long loops (load steps, benchmark sweeps), switchable off.
 
 :func:`progress` wraps an iterable in a tqdm bar on the first process: a notebook
-widget in Jupyter when ``ipywidgets`` is there, a text bar on stderr otherwise, none
-when disabled (or on the other processes). :func:`note` prints a line without
-breaking the bar.
+widget in Jupyter when ``ipywidgets`` is there, a text bar when stderr is a terminal,
+none otherwise (a pipe or a file gets the plain log lines only), when disabled, or on
+the other processes. :func:`note` prints a line without breaking the bar.
 """
 
 from __future__ import annotations
 
 import importlib.util
+import sys
 from collections.abc import Iterable
 
 from mpi4py import MPI
@@ -23,6 +24,14 @@ def _in_notebook() -> bool:
     return shell == "ZMQInteractiveShell" and importlib.util.find_spec("ipywidgets") is not None
 
 
+def on_terminal() -> bool:
+    """Whether stderr (where a text bar goes) is an interactive terminal."""
+    try:
+        return sys.stderr.isatty()
+    except (AttributeError, ValueError):  # replaced or closed streams
+        return False
+
+
 def progress(
     iterable: Iterable,
     description: str,
@@ -30,14 +39,19 @@ def progress(
     comm: MPI.Comm = MPI.COMM_WORLD,
     total: int | None = None,
 ):
-    """``iterable`` with a progress bar (tqdm) on rank 0 of ``comm``; a plain pass-through
-    when ``enabled`` is false. Not collective (each process iterates its own copy)."""
-    disable = not enabled or comm.rank != 0
-    if not disable and _in_notebook():
+    """``iterable`` with a progress bar (tqdm) on rank 0 of ``comm``: a widget in a
+    notebook, a text bar on a terminal (:func:`on_terminal`); a plain pass-through when
+    ``enabled`` is false or stderr is a pipe or a file. Not collective (each process
+    iterates its own copy)."""
+    if not enabled or comm.rank != 0:
+        return iter(iterable)
+    if _in_notebook():
         from tqdm import notebook
 
         return notebook.tqdm(iterable, desc=description, total=total)
-    return std.tqdm(iterable, desc=description, total=total, disable=disable, leave=False)
+    if not on_terminal():
+        return iter(iterable)
+    return std.tqdm(iterable, desc=description, total=total, leave=False)
 
 
 def note(message: str) -> None:
