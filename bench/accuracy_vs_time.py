@@ -17,11 +17,10 @@ a second are repeated (up to 3 times) and the fastest kept. Every row: error, do
 Newton iterations, wall time per phase and in total.
 
 Writes ``bench/results/accuracy_vs_time.json``, one Pareto PNG per case (error
-against total time, log-log, the Pareto front circled) and a markdown table that
-is also written into README.md between ``<!-- accuracy:start -->`` and
-``<!-- accuracy:end -->``.
+against total time, log-log, the Pareto front circled) and the markdown table
+``bench/results/accuracy_vs_time.md`` (the documentation includes it).
 
-Run: ``python bench/accuracy_vs_time.py [--quick] [--no-readme]``.
+Run: ``python bench/accuracy_vs_time.py [--quick]``.
 """
 
 import argparse
@@ -42,7 +41,6 @@ from xfem_contact.io.progress import note, progress
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
-MARKERS = ("<!-- accuracy:start -->", "<!-- accuracy:end -->")
 
 #: Mesh sizes of each family of sweeps: (full run, --quick)
 SIZES = {
@@ -425,21 +423,9 @@ def conclusions(rows) -> list[str]:
     return out
 
 
-def write_readme(text: str) -> None:
-    readme = ROOT / "README.md"
-    content = readme.read_text()
-    start, end = MARKERS
-    if start not in content or end not in content:
-        raise SystemExit(f"README.md has no {start} ... {end} section")
-    head, rest = content.split(start, 1)
-    _, tail = rest.split(end, 1)
-    readme.write_text(f"{head}{start}\n{text}\n{end}{tail}")
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="three sizes per sweep")
-    parser.add_argument("--no-readme", action="store_true", help="leave README.md alone")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument(
         "--report-only", action="store_true", help="redo the report from the saved results"
@@ -455,9 +441,9 @@ def main():
         print("ROW " + json.dumps(moving()), flush=True)
         return None
     out = pathlib.Path(args.out)
-    if args.report_only:  # the saved results, the report (table, plots, README) anew
+    if args.report_only:  # the saved results, the report (table, plots) anew
         saved = json.loads(out.read_text())
-        return publish(saved["rows"], saved["moving"], out, not args.no_readme)
+        return publish(saved["rows"], saved["moving"], out)
     rows = []
 
     sweeps = progress(SWEEPS, "accuracy vs time: sweeps", not args.no_progress)
@@ -487,11 +473,11 @@ def main():
     moving_result = moving_rows[0] if moving_rows else None
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps({"rows": rows, "moving": moving_result}, indent=1))
-    publish(rows, moving_result, out, not args.no_readme)
+    publish(rows, moving_result, out)
 
 
-def publish(rows, moving_result, out: pathlib.Path, readme: bool) -> None:
-    """The Pareto PNGs, the markdown report beside ``out`` and (``readme``) README.md."""
+def publish(rows, moving_result, out: pathlib.Path) -> None:
+    """The Pareto PNGs and the markdown report beside ``out``."""
     for case in dict.fromkeys(r["case"] for r in rows):
         chosen = [r for r in rows if r["case"] == case]
         curves = {}
@@ -502,8 +488,6 @@ def publish(rows, moving_result, out: pathlib.Path, readme: bool) -> None:
     text = report(rows, moving_result)
     out.with_suffix(".md").write_text(text + "\n")
     print(text)
-    if readme:
-        write_readme(text)
 
 
 if __name__ == "__main__":

@@ -1,9 +1,10 @@
 """Sphinx configuration of the xfem-contact documentation (``make docs``).
 
 The pages are markdown (MyST); the API reference comes from the docstrings
-(autodoc + napoleon, Google style); the scene file reference and the solver options
-table are generated from the code at every build (:mod:`reference`), so they cannot
-drift from what the package accepts.
+(autodoc + napoleon, Google style); the scene file reference, the solver options
+table, the demo pages and the benchmark pages (from ``bench/results/``) are generated
+at every build (:mod:`reference`), so they cannot drift from what the package accepts
+and measures.
 """
 
 import pathlib
@@ -38,8 +39,6 @@ autodoc_default_options = {"members": True, "show-inheritance": True}
 napoleon_google_docstring = True
 napoleon_numpy_docstring = False
 napoleon_use_ivar = True  # attributes as fields: no second description of tuple fields
-# pages include README sections, whose headings start at ### under the page's #
-suppress_warnings = ["myst.header"]
 
 
 def setup(app):

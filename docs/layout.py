@@ -5,8 +5,7 @@ may import only the ones before it. ``tests/test_layout.py`` checks that by pars
 sources (nothing is imported), together with :data:`MAX_MODULE_LINES` and
 :data:`MAX_ROOT_MODULES`. This script writes the table of modules (package | module |
 what it is: the summary of each module's docstring) between the markers
-``<!-- layout:start -->`` and ``<!-- layout:end -->`` of ``README.md`` and
-``docs/architecture.md``::
+``<!-- layout:start -->`` and ``<!-- layout:end -->`` of ``docs/architecture.md``::
 
     python docs/layout.py          # rewrite the tables
     python docs/layout.py --check  # exit 1 if a table is stale (tests/test_layout.py runs this)
@@ -42,7 +41,7 @@ MAX_ROOT_MODULES = 6
 
 PACKAGE = "xfem_contact"
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-TARGETS = ("README.md", "docs/architecture.md")
+TARGETS = ("docs/architecture.md",)
 START, END = "<!-- layout:start -->", "<!-- layout:end -->"
 
 

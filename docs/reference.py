@@ -1,10 +1,13 @@
 """Pages generated from the code for the documentation: the scene file reference
 (every table and key of :data:`xfem_contact.scenes.schema.FIELDS`: type, allowed
-values, default, meaning) and the solver options
-(:data:`xfem_contact.solvers.options.SOLVER_OPTIONS`).
+values, default, meaning; the built-in boundary parts of each mesh kind; the functions
+of expressions), the solver options (:data:`xfem_contact.solvers.options.SOLVER_OPTIONS`),
+the demos, and one page per benchmark result (``bench/results/NAME.md``, with the
+bench script's docstring and its pictures).
 
 Defaults of scene keys are read from the loader's source (``table.get("key", default)``
-calls), not typed twice.
+calls), not typed twice. A built-in part or an expression function without a line in
+:data:`PART_MEANINGS` / :data:`FUNCTION_MEANINGS` fails the build.
 """
 
 from __future__ import annotations
@@ -12,6 +15,35 @@ from __future__ import annotations
 import ast
 import inspect
 import pathlib
+import re
+
+#: What each built-in boundary part of :data:`xfem_contact.scenes.schema.BUILTIN_PARTS`
+#: selects (``[mesh] corners = [[x0, y0], [x1, y1]]``, ``radii = [r0, r1]``)
+PART_MEANINGS = {
+    "left": "the facets on `x = x0`",
+    "right": "the facets on `x = x1`",
+    "bottom": "the facets on `y = y0`",
+    "top": "the facets on `y = y1`",
+    "inner": "the facets on the circle `r = r0` (centred at the origin)",
+    "outer": "the facets on the circle `r = r1`",
+    "boundary": "every boundary facet",
+}
+#: What each function of scene expressions computes (numpy's meaning; UFL's in loads)
+FUNCTION_MEANINGS = {
+    "sin": "sine (radians)",
+    "cos": "cosine (radians)",
+    "tan": "tangent (radians)",
+    "exp": "exponential",
+    "log": "natural logarithm",
+    "sqrt": "square root",
+    "abs": "absolute value",
+    "hypot": "`hypot(a, b) = sqrt(a**2 + b**2)`",
+    "arctan2": "`arctan2(a, b)`: the angle of the point `(b, a)` in (-pi, pi]",
+    "minimum": "the smaller of two values, point by point",
+    "maximum": "the larger of two values, point by point",
+    "where": "`where(condition, a, b)`: `a` where the condition holds, else `b`",
+    "isclose": "`isclose(a, b)`: `a` equals `b` to numpy's default tolerances",
+}
 
 
 def _defaults() -> dict[str, object]:
@@ -76,6 +108,8 @@ def scene_reference() -> str:
         "here is an error naming the valid keys; a bad value is an error naming the key and",
         "the valid choices (one line, exit status 2 from the command line).",
         "",
+        *builtin_parts(),
+        *expression_functions(),
     ]
     toml = {
         "interface": "[[interfaces]] (each entry)",
@@ -151,8 +185,11 @@ def write(folder: pathlib.Path) -> None:
     """Write the generated pages into ``folder`` (created)."""
     folder.mkdir(parents=True, exist_ok=True)
     pages = {"scene_reference.md": scene_reference(), "solver_options.md": solver_options()}
-    for demo in sorted((folder.parent.parent / "demos").glob("*.py")):
+    root = folder.parent.parent
+    for demo in sorted((root / "demos").glob("*.py")):
         pages[f"demo_{demo.stem}.md"] = demo_page(demo)
+    for result in sorted((root / "bench" / "results").glob("*.md")):
+        pages[f"bench_{result.stem}.md"] = bench_page(result)
     for name, text in pages.items():
         path = folder / name
         if not path.exists() or path.read_text() != text:  # keep Sphinx's cache valid
@@ -174,4 +211,85 @@ def demo_page(path: pathlib.Path) -> str:
             lines += ["\n".join(text).strip(), ""]
         elif code := cell.strip("\n"):
             lines += ["```python", code, "```", ""]
+    return "\n".join(lines)
+
+
+def builtin_parts() -> list[str]:
+    """Markdown lines: the built-in boundary parts of each mesh kind."""
+    from xfem_contact.scenes.schema import BUILTIN_PARTS
+
+    lines = [
+        "## Built-in boundary parts",
+        "",
+        "A load's `part` names a built-in part of the mesh kind, a part of `[parts.NAME]`",
+        "(a boolean expression of `x`, `y`), or, for a gmsh mesh, a named 1-D physical group",
+        "of the file. Any other name is an error listing the known ones.",
+        "",
+        "| mesh kind | part | selects |",
+        "|---|---|---|",
+    ]
+    for kind, names in BUILTIN_PARTS.items():
+        for name in names:
+            lines.append(f"| `{kind}` | `{name}` | {PART_MEANINGS[name]} |")
+        if kind == "gmsh":
+            lines.append("| `gmsh` | any physical curve's name | the facets of that group |")
+    return [*lines, ""]
+
+
+def expression_functions() -> list[str]:
+    """Markdown lines: the functions and names allowed in scene expressions, found by
+    compiling a call of each (the number of arguments, and whether loads take it)."""
+    from xfem_contact.scenes.expressions import ALLOWED_NAMES, MAX_EXPONENT, compile_expression
+
+    def accepts(text: str, loads: bool) -> bool:
+        try:
+            compile_expression(text, loads=loads)
+        except ValueError:
+            return False
+        return True
+
+    lines = [
+        "## Expressions",
+        "",
+        'Level sets (`shape = "expression"`), part locators (`where`), prescribed',
+        "displacements and load values may be expressions of the coordinates `x`, `y` (m):",
+        "Python arithmetic (`+ - * / **`, the exponent of `**` a number of size at most",
+        f"{MAX_EXPONENT}) on numbers, `x`, `y`, the constant `pi` and the functions below.",
+        "Locators also take comparisons and `& | ~`. Loads (pressure, traction, body force",
+        "values) are evaluated by UFL and take only the functions marked so. Anything else",
+        "is an error naming the allowed names.",
+        "",
+        "| function | arguments | in loads | meaning |",
+        "|---|---|---|---|",
+    ]
+    for name in sorted(ALLOWED_NAMES - {"x", "y", "pi"}):
+        arity = next(k for k in (1, 2, 3) if accepts(f"{name}({', '.join(['x'] * k)})", False))
+        in_loads = "yes" if accepts(f"{name}({', '.join(['x'] * arity)})", True) else ""
+        lines.append(f"| `{name}` | {arity} | {in_loads} | {FUNCTION_MEANINGS[name]} |")
+    return [*lines, ""]
+
+
+def bench_page(result: pathlib.Path) -> str:
+    """The page of one benchmark result ``bench/results/NAME.md``: the bench script's
+    docstring (its first paragraph), the command, the table and the pictures."""
+    script = result.parents[1] / f"{result.stem}.py"
+    docstring = ast.get_docstring(ast.parse(script.read_text())) if script.exists() else None
+    text = re.sub(r":\w+:`~?([^`]+)`", r"`\1`", (docstring or "").replace("``", "`"))
+    paragraphs = [" ".join(p.split()) for p in text.split("\n\n")]
+    title = paragraphs[0] if paragraphs[0] else result.stem.replace("_", " ")
+    about = paragraphs[1] if len(paragraphs) > 1 else ""
+    lines = [f"# {title.rstrip('.')}", ""]
+    if about:
+        lines += [about, ""]
+    lines += [
+        f"Made by `python bench/{result.stem}.py` (`make bench` runs every bench); the",
+        f"numbers are in `bench/results/{result.stem}.json`. Generated from",
+        f"`bench/results/{result.name}` at every documentation build.",
+        "",
+        "```{include} ../../bench/results/" + result.name,
+        "```",
+        "",
+    ]
+    for picture in sorted(result.parent.glob(f"{result.stem}*.png")):
+        lines += [f"![{picture.stem}](../../bench/results/{picture.name})", ""]
     return "\n".join(lines)

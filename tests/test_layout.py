@@ -175,6 +175,6 @@ def test_a_stale_table_fails_the_check(tmp_path):
     assert layout.main(["--check"], root=tmp_path) == 1
     assert layout.main([], root=tmp_path) == 0
     assert layout.main(["--check"], root=tmp_path) == 0
-    text = (tmp_path / "README.md").read_text()
+    text = (tmp_path / layout.TARGETS[0]).read_text()
     assert "| `xfem_contact.geometry` | `__init__.py` | Shapes: `phi`. |" in text
     assert text.startswith("# x\n") and text.endswith(f"{layout.END}\n")
