@@ -189,7 +189,7 @@ def case3rot(n, degree):
     build = time.perf_counter() - start
     iterations = 0
     for k in range(1, 5):
-        problem.load_factor.set(k / 4)
+        problem.loads.set_time(k / 4)
         iterations += problem.solve().iterations
         problem.accept_step()
     total = time.perf_counter() - start
@@ -272,11 +272,11 @@ def moving(positions: int = 10) -> dict:
         else:
             cut.update(phi)
         problem = ContactProblem(cut, 2, Material(100e6, 0.0), "sticking")
-        problem.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), 1.0)
-        problem.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 2.0)
-        problem.add_point_displacement([0.5, 0.0], 0.0, 0)
-        problem.add_point_displacement([0.5, 1.0], 0.0, 0)
-        problem.add_point_displacement([0.0, 0.5], 0.0, 1)
+        problem.loads.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), 1.0)
+        problem.loads.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 2.0)
+        problem.loads.add_point_displacement([0.5, 0.0], 0.0, 0)
+        problem.loads.add_point_displacement([0.5, 1.0], 0.0, 0)
+        problem.loads.add_point_displacement([0.0, 0.5], 0.0, 1)
         problem.loading = "paper"
         problem.solve()
         errors.append(inclusion_errors(problem, problem.w).pressure)

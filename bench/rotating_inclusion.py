@@ -52,7 +52,7 @@ def run(n_radial, n_angular, degree, angle_name) -> dict:
     iterations, ends = [], []
     try:
         for k in range(1, steps + 1):
-            problem.load_factor.set(k / steps)
+            problem.loads.set_time(k / steps)
             report = problem.solve()
             problem.accept_step()
             iterations.append(report.iterations)

@@ -44,7 +44,7 @@ from xfem_contact.io.output import write_fields, write_json, write_lips
 from xfem_contact.io.plots import Series, line_plot
 from xfem_contact.io.progress import progress
 from xfem_contact.mechanics.laws import CONTACT_LAWS
-from xfem_contact.mechanics.loading import load_steps
+from xfem_contact.mechanics.loads import load_steps
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
 from xfem_contact.solvers.newton import NewtonFailure
 
@@ -98,7 +98,7 @@ def solve(args, degree: int, say, comm) -> tuple[dict, dict]:
     t0 = time.perf_counter()
     bar = progress(steps, f"degree {degree}: load steps", not args.no_progress, comm)
     for k, t in enumerate(bar, start=1):
-        problem.load_factor.set(t)
+        problem.loads.set_time(t)
         try:
             report = problem.solve(log=say)
         except NewtonFailure as failure:  # the last accepted state is kept in problem.w

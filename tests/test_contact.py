@@ -223,11 +223,11 @@ def test_inclusion_equilibrium(law):
     problem = inclusion_problem(20, 2, law, friction=1.0 if law == "coulomb" else None)
     # a push down and to the right, and a torque about the centre (N/m^3)
     d = ufl.SpatialCoordinate(problem.mesh) - ufl.as_vector(INCLUSION_CENTRE)
-    problem.add_body_force(ufl.as_vector([3.0 - 40.0 * d[1], -10.0 + 40.0 * d[0]]), side=-1)
+    problem.loads.add_body_force(ufl.as_vector([3.0 - 40.0 * d[1], -10.0 + 40.0 * d[0]]), side=-1)
     problem.solve()
     loads = np.array(
         [
-            integrate(ufl.action(problem.linear_form(), m))
+            integrate(ufl.action(problem.loads.linear_form(), m))
             for m in rigid_modes(problem, INCLUSION_CENTRE)
         ]
     )

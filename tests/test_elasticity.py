@@ -117,12 +117,12 @@ def condition_number(eta, degree, n=6):
     y0 = (3 + eta) / n
     cut = xfem_contact.CutMesh(mesh, lambda x: x[1] - y0, degree=1)
     problem = ElasticityProblem(cut, degree, Material(1.0, 0.3), "free")
-    problem.add_displacement(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 0.0)
+    problem.loads.add_displacement(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 0.0)
     R = restriction_matrix(problem.space)
     A, b = assemble_restricted(
         xfem_contact.form(problem.bilinear_form()),
-        xfem_contact.form(problem.linear_form()),
-        problem._bcs,
+        xfem_contact.form(problem.loads.linear_form()),
+        problem.loads.bcs,
         R,
     )
     dense = A.convert("dense").getDenseArray().copy()
@@ -145,13 +145,13 @@ def test_solve_with_a_given_restriction_operator():
     mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 6, 6)
     cut = xfem_contact.CutMesh(mesh, lambda x: x[1] - 0.55, degree=1)
     problem = ElasticityProblem(cut, 1, Material(1.0, 0.3), "bonded")
-    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
-    problem.add_displacement(lambda x: np.isclose(x[1], 1.0), 0.01)
+    problem.loads.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
+    problem.loads.add_displacement(lambda x: np.isclose(x[1], 1.0), 0.01)
     a = xfem_contact.form(problem.bilinear_form())
-    L = xfem_contact.form(problem.linear_form())
-    w, _ = solve_restricted(a, L, problem._bcs, problem.space)
+    L = xfem_contact.form(problem.loads.linear_form())
+    w, _ = solve_restricted(a, L, problem.loads.bcs, problem.space)
     R = restriction_matrix(problem.space)
-    w_R, reason = solve_restricted(a, L, problem._bcs, problem.space, R=R)
+    w_R, reason = solve_restricted(a, L, problem.loads.bcs, problem.space, R=R)
     assert reason > 0
     scale = mesh.comm.allreduce(np.abs(w.x.array).max(), op=MPI.MAX)
     assert scale > 0.0
@@ -172,7 +172,7 @@ def test_bad_input_raises():
         Material(1.0, 0.5)
     problem = ElasticityProblem(cut, 1, Material(1.0, 0.3), "free")
     with pytest.raises(ValueError, match="no boundary facet"):
-        problem.add_pressure(lambda x: np.isclose(x[0], 7.0), 1.0)
+        problem.loads.add_pressure(lambda x: np.isclose(x[0], 7.0), 1.0)
 
 
 @pytest.mark.mpi

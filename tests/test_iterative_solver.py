@@ -89,13 +89,13 @@ def test_large_sliding_iterative_equals_direct():
     """Case 3 turned by pi/2 in 2 steps: the couplings grow the Jacobian's pattern, and
     the preconditioner extracts its blocks afresh (``reset``)."""
     from xfem_contact.cases.rotation import rotating_annulus_problem
-    from xfem_contact.mechanics.loading import load_steps
+    from xfem_contact.mechanics.loads import load_steps
 
     solutions = []
     for solver in ("direct", "iterative"):
         problem = rotating_annulus_problem(6, 2, np.pi / 2)
         for t in load_steps(2):
-            problem.load_factor.set(t)
+            problem.loads.set_time(t)
             report = problem.solve(preset(solver))
         assert (max(report.linear_iterations) > 1) == (solver == "iterative")
         solutions.append(problem.w.x.array.copy())
@@ -120,7 +120,7 @@ def test_a_bonded_interface_beside_a_contact_one():
     problem = build(scene)
     problem = problem[0] if isinstance(problem, tuple) else problem
     assert {law.name for law in problem.laws.values()} == {"bonded", "coulomb"}
-    problem.load_factor.set(0.5)
+    problem.loads.set_time(0.5)
     report = problem.solve(scene.petsc_options)
     assert max(report.linear_iterations) <= 20
     with pytest.raises(ValueError, match="linear problem"):

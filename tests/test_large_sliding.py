@@ -126,7 +126,7 @@ def _perturbed_state(problem, alpha, rng):
         problem.w.x.array[dofs] = u.ravel()
     _, dofs = problem.space.field_space(2)
     problem.w.x.array[dofs] = -1e6 * (1 + 0.1 * rng.standard_normal(len(dofs)))
-    for bc in problem._bcs:
+    for bc in problem.loads.bcs:
         bc.set(problem.w.x.array)
 
 
@@ -138,7 +138,7 @@ def _jacobian_error(problem, eps, seed=0):
     newton = RestrictedNewton(
         problem.residual(),
         problem.w,
-        problem._bcs,
+        problem.loads.bcs,
         problem.restriction(),
         couplings=list(problem.couplings.values()),
     )
@@ -213,9 +213,11 @@ def test_rigid_rotation_by_a_right_angle_carries_no_stress():
     problem = Problem(cut, 2, material, make_law("frictionless"), kinematics="large")
     tol = 1e-6 * r_out
     for r in (r_in, r_out):
-        problem.add_rotation(lambda x, r=r: np.abs(np.hypot(x[0], x[1]) - r) < tol, np.pi / 2)
+        problem.loads.add_rotation(
+            lambda x, r=r: np.abs(np.hypot(x[0], x[1]) - r) < tol, angle=np.pi / 2
+        )
     for t in (0.5, 1.0):
-        problem.load_factor.set(t)
+        problem.loads.set_time(t)
         # no load: the rotation's residual is round-off (4e-9), not to be reduced 1e10 times
         problem.solve({"snes_atol": 1e-7})
         problem.accept_step()
@@ -243,7 +245,7 @@ def test_rigid_rotation_by_a_right_angle_carries_no_stress():
 def _solve(problem, steps):
     reports = []
     for k in range(1, steps + 1):
-        problem.load_factor.set(k / steps)
+        problem.loads.set_time(k / steps)
         reports.append(problem.solve())
         problem.accept_step()
     return reports
@@ -287,7 +289,7 @@ def test_bad_input_is_one_clear_error(build, message):
 def test_rotation_of_a_missing_part_is_an_error():
     problem = rotating_annulus_problem(4, 2, 0.0)
     with pytest.raises(ValueError, match="holds no boundary facet"):
-        problem.add_rotation(lambda x: np.hypot(x[0], x[1]) > 100.0, 0.5)
+        problem.loads.add_rotation(lambda x: np.hypot(x[0], x[1]) > 100.0, angle=0.5)
 
 
 def test_unknown_kinematics_names_the_valid_ones():
@@ -361,14 +363,14 @@ def test_a_failing_step_reports_its_history_and_keeps_the_accepted_state():
     carries the history, ``w`` is the accepted state (not the diverged iterate,
     not the rigidly turned predictor) and the next, smaller step succeeds."""
     problem = rotating_annulus_problem(5, 2, np.pi)
-    problem.load_factor.set(0.25)
+    problem.loads.set_time(0.25)
     problem.solve()
     problem.accept_step()
     accepted = problem.w.x.array.copy()
-    problem.load_factor.set(1.0)
+    problem.loads.set_time(1.0)
     with pytest.raises(NewtonFailure, match="iterate  1") as failure:
         problem.solve({"snes_max_it": 1})
     assert failure.value.report.iterations == 1
     assert np.array_equal(problem.w.x.array, accepted)
-    problem.load_factor.set(0.5)
+    problem.loads.set_time(0.5)
     assert problem.solve().iterations <= 10

@@ -92,11 +92,11 @@ def test_collapse_matches_dolfinx(problem, field):
 def test_direct_assembly_equals_ptap(problem):
     """R^T J R straight into the reduced numbering: the same matrix as PtAP."""
     J, R = _jacobian(problem), problem.restriction()
-    reduced = ReducedMatrix(J, problem._bcs, R)
+    reduced = ReducedMatrix(J, problem.loads.bcs, R)
     assert reduced.direct
     A = reduced.assemble()
     assert A.getInfo()["mallocs"] == 0  # the pattern held every nonzero
-    full = dolfinx.fem.petsc.assemble_matrix(J, bcs=problem._bcs)
+    full = dolfinx.fem.petsc.assemble_matrix(J, bcs=problem.loads.bcs)
     full.assemble()
     reference = full.PtAP(R)
     assert A.getInfo()["nz_used"] <= reference.getInfo()["nz_used"] < full.getInfo()["nz_used"]
@@ -114,11 +114,11 @@ def test_pattern_on_pairs_only_where_the_unknowns_pair_up(law, block_size):
     options = {"friction": 0.3} if law == "coulomb" else {}
     problem = inclusion_problem(8, 2, law, **options)
     J, R = _jacobian(problem), problem.restriction()
-    full = dolfinx.fem.petsc.assemble_matrix(J, bcs=problem._bcs)
+    full = dolfinx.fem.petsc.assemble_matrix(J, bcs=problem.loads.bcs)
     full.assemble()
     reference = full.PtAP(R)
     for blocks in (True, False):
-        reduced = ReducedMatrix(J, problem._bcs, R, blocks=blocks)
+        reduced = ReducedMatrix(J, problem.loads.bcs, R, blocks=blocks)
         A = reduced.assemble()
         assert A.getBlockSize() == (block_size if blocks else 1)
         difference = reference.copy()
@@ -140,12 +140,14 @@ def test_a_facet_term_coupling_two_fields_is_kept():
     extra = 1e6 * ufl.inner(ufl.avg(u_minus), ufl.avg(v_plus)) * ufl.dS
     J = form(ufl.derivative(problem.residual(), problem.w, ufl.TrialFunction(W)) + extra)
     R = problem.restriction()
-    reduced = ReducedMatrix(J, problem._bcs, R)
+    reduced = ReducedMatrix(J, problem.loads.bcs, R)
     A = reduced.assemble()
-    without = ReducedMatrix(form(ufl.derivative(problem.residual(), problem.w)), problem._bcs, R)
+    without = ReducedMatrix(
+        form(ufl.derivative(problem.residual(), problem.w)), problem.loads.bcs, R
+    )
     assert A.getInfo()["nz_used"] > without.assemble().getInfo()["nz_used"]  # inserted
     without.destroy()
-    full = dolfinx.fem.petsc.assemble_matrix(J, bcs=problem._bcs)
+    full = dolfinx.fem.petsc.assemble_matrix(J, bcs=problem.loads.bcs)
     full.assemble()
     reference = full.PtAP(R)
     reference.axpy(-1.0, A, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
@@ -178,11 +180,11 @@ def test_uncut_cells_on_the_fields_own_spaces(law, cell, blocked, coupled):
     assert [b.field for b in split.blocks] == [0, 1]  # the multipliers have no bulk
     R = problem.restriction()
     blocks = [(form(b.form), b.parent, True) for b in split.blocks]
-    reduced = ReducedMatrix(form(split.rest), problem._bcs, R, field_blocks=blocks)
+    reduced = ReducedMatrix(form(split.rest), problem.loads.bcs, R, field_blocks=blocks)
     assert [b[2] for b in reduced._blocks] == [blocked, blocked]
     A = reduced.assemble()
     assert A.getInfo()["mallocs"] == 0
-    full = dolfinx.fem.petsc.assemble_matrix(form(J), bcs=problem._bcs)
+    full = dolfinx.fem.petsc.assemble_matrix(form(J), bcs=problem.loads.bcs)
     full.assemble()
     reference = full.PtAP(R)
     scale = reference.norm()
@@ -202,14 +204,14 @@ def test_constant_blocks_are_added_from_their_copy(problem):
     split = split_uncut(J, problem.space.field_space)
     blocks = [(form(b.form), b.parent, True) for b in split.blocks]
     R, rest = problem.restriction(), form(split.rest)
-    kept = ReducedMatrix(rest, problem._bcs, R, field_blocks=blocks)
+    kept = ReducedMatrix(rest, problem.loads.bcs, R, field_blocks=blocks)
     kept.keep_constant_blocks()
     kept.assemble()  # keeps the copy
     assert kept._kept is not None
     problem.w.x.array[:] = np.random.default_rng(1).standard_normal(problem.w.x.array.size)
     problem.w.x.scatter_forward()
     A = kept.assemble()  # the copy, and the rest at the new state
-    fresh = ReducedMatrix(rest, problem._bcs, R, field_blocks=blocks)
+    fresh = ReducedMatrix(rest, problem.loads.bcs, R, field_blocks=blocks)
     B = fresh.assemble()
     B.axpy(-1.0, A, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
     assert B.norm() <= 1e-14 * A.norm()
@@ -223,8 +225,8 @@ def test_split_newton_lifts_unmet_dirichlet_data():
     Jacobian (compiled then): DOLFINx's lifted residual; and the solution is the
     one without the split."""
     problem = inclusion_problem(8, 2, "sticking")
-    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 1e-4)  # not met by w = 0
-    R, bcs = problem.restriction(), problem._bcs
+    problem.loads.add_displacement(lambda x: np.isclose(x[1], 0.0), 1e-4)  # not met by w = 0
+    R, bcs = problem.restriction(), problem.loads.bcs
     solutions = []
     for field_space in (problem.space.field_space, None):
         problem.w.x.array[:] = 0.0
@@ -269,7 +271,7 @@ def test_prolongation_takes_the_ptap_path():
     R = problem.restriction()
     assert selection(R, problem.space.W) is None
     J = _jacobian(problem)
-    reduced = ReducedMatrix(J, problem._bcs, R)
+    reduced = ReducedMatrix(J, problem.loads.bcs, R)
     assert not reduced.direct
     A = reduced.assemble()
     assert A.getSize() == (R.getSize()[1],) * 2
@@ -322,7 +324,9 @@ def test_first_jacobian_reused_only_at_its_state(monkeypatch):
     solution = problem.w.x.array.copy()
 
     problem.w.x.array[:] = 0.0
-    newton = RestrictedNewton(problem.residual(), problem.w, problem._bcs, problem.restriction())
+    newton = RestrictedNewton(
+        problem.residual(), problem.w, problem.loads.bcs, problem.restriction()
+    )
     problem.w.x.array[:] = 0.5 * solution  # moved after the set-up assembly
     calls.clear()
     newton.solve()

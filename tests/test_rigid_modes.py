@@ -26,11 +26,11 @@ def case2(law, points=PAPER_POINTS, outer_fixed=False, **options):
     """Paper case 2 with the given point constraints only (or the outer boundary fixed)."""
     options = {k: v for k, v in options.items() if v is not None}
     problem = inclusion_problem(10, 2, law, **options)
-    problem._bcs.clear()
+    problem.loads.bcs.clear()
     for point, component in points:
-        problem.add_point_displacement(point, 0.0, component)
+        problem.loads.add_point_displacement(point, 0.0, component)
     if outer_fixed:
-        problem.add_displacement(on_boundary, 0.0)
+        problem.loads.add_displacement(on_boundary, 0.0)
     return problem
 
 
@@ -45,7 +45,7 @@ def fixed_by_the_remedies(problem) -> bool:
     """Whether the point constraints the check proposes leave nothing free."""
     for body in free_bodies(problem):
         for point, component in body.remedies:
-            problem.add_point_displacement(point, 0.0, component)
+            problem.loads.add_point_displacement(point, 0.0, component)
     return check(problem) == []
 
 
@@ -124,7 +124,7 @@ def test_an_elliptic_frictionless_inclusion_is_locked_by_its_shape():
         Material(1e6, 0.3),
         "frictionless",
     )
-    problem.add_displacement(on_boundary, 0.0)
+    problem.loads.add_displacement(on_boundary, 0.0)
     assert check(problem) == []
 
 
@@ -144,7 +144,7 @@ def straight(law):
     )
     cut = CutMesh(mesh, lambda x: x[1] - 1.0, degree=1)
     problem = Problem(cut, 1, Material(1e6, 0.3), law)
-    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
+    problem.loads.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
     return problem
 
 
@@ -174,7 +174,7 @@ def test_each_inclusion_is_a_body():
         },
     )
     problem = Problem(cut, 2, Material(1e6, 0.3), {"left": "sticking", "right": "frictionless"})
-    problem.add_displacement(on_boundary, 0.0)
+    problem.loads.add_displacement(on_boundary, 0.0)
     (message,) = check(problem)
     assert message.startswith(
         "side -1 (inside interface 'right'): rotation about (0.72, 0.5) is not constrained "

@@ -188,7 +188,7 @@ BAD_SCENES = {
     "body force on a part": (
         add_load(part="top", type="body_force", value=[0, 1]),
         "loads[2].part",
-        "is not a key of a 'body_force' load (its keys: value, side)",
+        "is not a key of a 'body_force' load (its keys: value, side, history)",
     ),
     "side of a displacement": (
         set_in("loads", 0, "side", value=1),
@@ -516,7 +516,7 @@ def test_cli_newton_failure_exit_3_with_the_iterations(tmp_path, capsys):
     (out / "summary.json").write_text('{"scene": "an earlier run"}')
     assert cli.main(["run", str(path), "--out", str(out), "--quiet"]) == 3
     err = capsys.readouterr().err.splitlines()
-    assert err[0].startswith(f"error: {path}: Scene 't', load step 1/2 (load factor 0.5)")
+    assert err[0].startswith(f"error: {path}: Scene 't', load step 1/2 (time 0.5)")
     assert err[0].endswith(")") and "Newton failed (SNES reason" in err[0]
     assert err[1].startswith("  iterate  0  |F| = ") and err[2].startswith("  iterate  1")
     assert len(err) == 3 and "Traceback" not in err
@@ -579,7 +579,7 @@ def test_load_factor_scales_every_load_of_a_linear_problem():
     data["loads"].append({"type": "body_force", "value": [0.0, -1e3]})
     problem, _ = build(load_scene(data))
     full = problem.solve().w.x.array.copy()
-    problem.load_factor.set(0.25)
+    problem.loads.set_time(0.25)
     quarter = problem.solve().w.x.array
     assert np.abs(full).max() > 0
     assert np.allclose(quarter, 0.25 * full, rtol=0, atol=1e-12 * np.abs(full).max())

@@ -30,8 +30,8 @@ def test_loads_added_after_a_solve_are_used():
     problem = inclusion_problem(8, 1, "sticking")
     problem.solve()
     once = multipliers(problem)
-    problem.add_pressure(sides, 1.0)
-    problem.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 2.0)
+    problem.loads.add_pressure(sides, 1.0)
+    problem.loads.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 2.0)
     problem.solve()
     assert np.allclose(multipliers(problem), 2.0 * once, rtol=1e-8, atol=1e-10)
 
@@ -54,7 +54,7 @@ def test_a_new_cut_is_refused():
 
 def test_failure_keeps_the_state_before_the_solve():
     problem = inclusion_problem(10, 2, "coulomb", loading="pull", friction=1.0)
-    problem.add_pressure(sides, -0.5)  # a harder load, several Newton steps
+    problem.loads.add_pressure(sides, -0.5)  # a harder load, several Newton steps
     before = problem.w.x.array.copy()
     with pytest.raises(NewtonFailure, match="restored") as failure:
         problem.solve(petsc_options={"snes_max_it": 1})

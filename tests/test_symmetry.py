@@ -51,7 +51,7 @@ def test_coulomb_keeps_lu_and_its_jacobian_fails_the_guard():
     newton = RestrictedNewton(
         problem.residual(),
         problem.w,
-        problem._bcs,
+        problem.loads.bcs,
         problem.restriction(),
         {"pc_type": "cholesky"},
         field_space=problem.space.field_space,

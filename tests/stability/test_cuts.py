@@ -109,11 +109,11 @@ def test_two_interfaces_a_cell_apart(gap_cells):
         k: (lambda x, c=c: np.hypot(x[0] - c[0], x[1] - c[1]) - r) for k, c in centres.items()
     }
     problem = Problem(CutMesh(mesh, levelsets), 2, Material(INCLUSION_E, 0.0), "sticking")
-    problem.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), 1.0)
-    problem.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 2.0)
-    problem.add_point_displacement([0.5, 0.0], 0.0, 0)
-    problem.add_point_displacement([0.5, 1.0], 0.0, 0)
-    problem.add_point_displacement([0.0, 0.5], 0.0, 1)
+    problem.loads.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), 1.0)
+    problem.loads.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 2.0)
+    problem.loads.add_point_displacement([0.5, 0.0], 0.0, 0)
+    problem.loads.add_point_displacement([0.5, 1.0], 0.0, 0)
+    problem.loads.add_point_displacement([0.0, 0.5], 0.0, 1)
     report = problem.solve()
     assert report.iterations <= 30
     for name, (cx, cy) in centres.items():

@@ -21,7 +21,7 @@ from xfem_contact.solvers.newton import NewtonFailure
 def turned(steps: int):
     problem = rotating_annulus_problem(6, 2, np.pi / 2)
     for k in range(1, steps + 1):
-        problem.load_factor.set(k / steps)
+        problem.loads.set_time(k / steps)
         report = problem.solve()
         assert report.iterations <= 30
         problem.accept_step()

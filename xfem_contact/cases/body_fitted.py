@@ -124,11 +124,11 @@ def fitted_inclusion(
     material = Material(INCLUSION_E, 0.0)
     problem = PlainElasticityProblem(gm.mesh, degree, material)
     sxx, syy = LOADINGS["paper"]
-    problem.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), -sxx)
-    problem.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), -syy)
-    problem.add_point_displacement([0.5, 0.0], 0.0, 0)
-    problem.add_point_displacement([0.5, 1.0], 0.0, 0)
-    problem.add_point_displacement([0.0, 0.5], 0.0, 1)
+    problem.loads.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), -sxx)
+    problem.loads.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), -syy)
+    problem.loads.add_point_displacement([0.5, 0.0], 0.0, 0)
+    problem.loads.add_point_displacement([0.5, 1.0], 0.0, 0)
+    problem.loads.add_point_displacement([0.0, 0.5], 0.0, 1)
     start = time.perf_counter()
     u = problem.solve()
     timings["solve"] = time.perf_counter() - start
@@ -151,9 +151,11 @@ def fitted_annulus(h: float, degree: int, cell: str = "triangle", comm=MPI.COMM_
     problem = PlainElasticityProblem(gm.mesh, degree, material)
     r_in, _, r_out = ANNULUS_RADII
     tol = 1e-6 * r_out
-    problem.add_displacement(lambda x: np.abs(np.hypot(x[0], x[1]) - r_in) < tol, 0.0)
-    problem.add_pressure(lambda x: np.abs(np.hypot(x[0], x[1]) - r_out) < tol, ANNULUS_PRESSURE)
-    problem.add_point_displacement([r_out, 0.0], 0.0, 1)
+    problem.loads.add_displacement(lambda x: np.abs(np.hypot(x[0], x[1]) - r_in) < tol, 0.0)
+    problem.loads.add_pressure(
+        lambda x: np.abs(np.hypot(x[0], x[1]) - r_out) < tol, ANNULUS_PRESSURE
+    )
+    problem.loads.add_point_displacement([r_out, 0.0], 0.0, 1)
     start = time.perf_counter()
     u = problem.solve()
     timings["solve"] = time.perf_counter() - start

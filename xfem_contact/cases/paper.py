@@ -66,11 +66,11 @@ def inclusion_problem(
     cls = ContactProblem if law in ContactProblem.LAWS else ElasticityProblem
     problem = cls(cut, degree, material, law, **options)
     sxx, syy = LOADINGS[loading]
-    problem.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), -sxx)
-    problem.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), -syy)
-    problem.add_point_displacement([0.5, 0.0], 0.0, 0)
-    problem.add_point_displacement([0.5, 1.0], 0.0, 0)
-    problem.add_point_displacement([0.0, 0.5], 0.0, 1)
+    problem.loads.add_pressure(lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), -sxx)
+    problem.loads.add_pressure(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), -syy)
+    problem.loads.add_point_displacement([0.5, 0.0], 0.0, 0)
+    problem.loads.add_point_displacement([0.5, 1.0], 0.0, 0)
+    problem.loads.add_point_displacement([0.0, 0.5], 0.0, 1)
     problem.loading = loading
     return problem
 
@@ -151,12 +151,12 @@ def straight_interface_problem(
     )
     cut = CutMesh(mesh, lambda x: x[1] - 1.0, degree=1)
     problem = ElasticityProblem(cut, degree, Material(10e9, 0.2, "stress"), "free")
-    problem.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
-    problem.add_displacement(lambda x: np.isclose(x[1], 2.0), 0.0, component=0)
-    problem.add_displacement(
+    problem.loads.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
+    problem.loads.add_displacement(lambda x: np.isclose(x[1], 2.0), 0.0, component=0)
+    problem.loads.add_displacement(
         lambda x: np.isclose(x[1], 2.0), lambda x: -2.5e-6 * x[0] ** 2 + 1e-5, component=1
     )
-    problem.add_pressure(
+    problem.loads.add_pressure(
         lambda x: np.isclose(np.abs(x[0]), 1.5), lambda x: 1e5 - 5e4 * x[1], side=1
     )
     return problem
@@ -187,9 +187,11 @@ def annulus_problem(
     cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - r_gamma, degree=2)
     problem = ContactProblem(cut, degree, Material(ANNULUS_E, 0.0), "frictionless", **options)
     tol = 1e-6 * r_out
-    problem.add_displacement(lambda x: np.abs(np.hypot(x[0], x[1]) - r_in) < tol, 0.0)
-    problem.add_pressure(lambda x: np.abs(np.hypot(x[0], x[1]) - r_out) < tol, ANNULUS_PRESSURE)
-    problem.add_point_displacement([r_out, 0.0], 0.0, 1)
+    problem.loads.add_displacement(lambda x: np.abs(np.hypot(x[0], x[1]) - r_in) < tol, 0.0)
+    problem.loads.add_pressure(
+        lambda x: np.abs(np.hypot(x[0], x[1]) - r_out) < tol, ANNULUS_PRESSURE
+    )
+    problem.loads.add_point_displacement([r_out, 0.0], 0.0, 1)
     return problem
 
 

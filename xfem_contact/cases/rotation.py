@@ -162,14 +162,14 @@ def rotating_annulus_problem(
         cut, degree, Material(ANNULUS_E, 0.0), interface, kinematics="large", **problem_options
     )
     tol = 1e-6 * r_out
-    problem.add_rotation(lambda x: np.abs(np.hypot(x[0], x[1]) - r_in) < tol, alpha)
+    problem.loads.add_rotation(lambda x: np.abs(np.hypot(x[0], x[1]) - r_in) < tol, angle=alpha)
     outside = lambda x: np.abs(np.hypot(x[0], x[1]) - r_out) < tol  # noqa: E731
-    problem.add_pressure(outside, ANNULUS_PRESSURE)
+    problem.loads.add_pressure(outside, ANNULUS_PRESSURE)
     if outer == "point":
-        problem.add_point_displacement([r_out, 0.0], 0.0, 1)
+        problem.loads.add_point_displacement([r_out, 0.0], 0.0, 1)
     else:
         h = (r_out - r_in) / n_radial
-        problem.add_tangential_spring(outside, 1e3 * ANNULUS_E / h)
+        problem.loads.add_tangential_spring(outside, 1e3 * ANNULUS_E / h)
     return problem
 
 

@@ -28,7 +28,7 @@ from xfem_contact.mechanics.bulk import BULK_MODELS, KINEMATICS, cell_size, chec
 from xfem_contact.mechanics.composition import Materials, interface_laws, side_and_law_materials
 from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw, large_sliding
 from xfem_contact.mechanics.lbb_space import combine_prolongations
-from xfem_contact.mechanics.loading import Loads
+from xfem_contact.mechanics.loads import Loads, SideFields
 from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
 from xfem_contact.solvers.linear import solve_restricted
@@ -49,7 +49,7 @@ class Solution:
         return self.space.field(self.w, i)
 
 
-class Problem(Loads):
+class Problem:
     """Elasticity of the two sides of a cut mesh with a law on each interface.
 
     Args:
@@ -107,7 +107,8 @@ class Problem(Loads):
             min_support_fraction=min_support_fraction,
         )
         check_ghosts(self.mesh)
-        super().__init__(self.mesh, self.space)
+        #: Loads, supports and Dirichlet data (``loads.bcs``), and the pseudo-time
+        self.loads = Loads(SideFields(self.space))
         self.cell_size = cell_size(self.mesh)
         self.side_indicator = cut.side_indicator()
         bulk = BULK_MODELS[kinematics]
@@ -124,7 +125,7 @@ class Problem(Loads):
         self._newton_key = None
         self._checked_loads: int | None = None
         self._cut_revision = cut.revision
-        #: Load factor of the rotations that the bodies of ``w`` have turned by
+        #: Pseudo-time of the rotations that the bodies of ``w`` have turned by
         self._rotated_at = 0.0
         #: Terms of laws coupling two cells (large sliding), assembled outside UFL
         self.couplings = {
@@ -207,7 +208,7 @@ class Problem(Loads):
 
     # -- forms -----------------------------------------------------------------------
     def _law_and_spring_terms(self, u, v) -> list:
-        springs = self.spring_terms(u, v)
+        springs = self.loads.spring_terms(u, v)
         terms = [] if springs is None else [springs]
         for name, law in self.laws.items():
             ctx = self.contexts[name]
@@ -227,8 +228,8 @@ class Problem(Loads):
         """The residual ``F(w; v)`` (UFL, linear in the test functions)."""
         u, v = ufl.split(self.w), self.space.test()
         F = sum(self._law_and_spring_terms(u, v), self.bulk.form(u, v))
-        if self._rhs:
-            F -= sum(self._rhs[1:], self._rhs[0])
+        if self.loads.has_terms:
+            F -= self.loads.linear_form()
         return F
 
     def multipliers(self, fields, name: str | None = None) -> tuple:
@@ -273,16 +274,16 @@ class Problem(Loads):
                 f"space, rules and forms follow the old interface (cut revision "
                 f"{self._cut_revision}, now {self.cut.revision}); build a new Problem"
             )
-        if self._checked_loads != self.loads_revision:  # again only when the loads changed
+        if self._checked_loads != self.loads.revision:  # again only when the loads changed
             check_support(self, log)
-            self._checked_loads = self.loads_revision
+            self._checked_loads = self.loads.revision
         petsc_options = symmetric_options(petsc_options, self.symmetric)
         if self.linear:
-            a, L = form(self.bilinear_form()), form(self.linear_form())
-            w, _ = solve_restricted(a, L, self._bcs, self.space, petsc_options)
+            a, L = form(self.bilinear_form()), form(self.loads.linear_form())
+            w, _ = solve_restricted(a, L, self.loads.bcs, self.space, petsc_options)
             self.w.x.array[:] = w.x.array
             return Solution(w, self.space)
-        key = (self.loads_revision, repr(sorted((petsc_options or {}).items())))
+        key = (self.loads.revision, repr(sorted((petsc_options or {}).items())))
         if self._newton is not None and key != self._newton_key:
             self._newton.destroy()  # loads or solver options changed since it was built
             self._newton = None
@@ -291,7 +292,7 @@ class Problem(Loads):
             self._newton = RestrictedNewton(
                 self.residual(),
                 self.w,
-                self._bcs,
+                self.loads.bcs,
                 self.restriction(),
                 petsc_options,
                 status=_weak_method(self.interface_status),
@@ -305,9 +306,9 @@ class Problem(Loads):
             self._newton_key = key
         self._newton.log = log
         accepted = self.w.x.array.copy()
-        t = self.load_factor.value
+        t = self.loads.time
         if self.kinematics == "large":  # turn rotated bodies rigidly first (predictor)
-            self.rotate_bodies(self.w, self._rotated_at, t)
+            self.loads.rotate_bodies(self.w, self._rotated_at, t)
         try:
             report = self._newton.solve()
             self._rotated_at = t

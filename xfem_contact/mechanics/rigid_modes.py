@@ -9,7 +9,7 @@ without assembling anything:
 - the *bodies*: side +1 (field 1) and, for each interface, the part of side -1
   inside it (field 0 on that interface's region), each with its rigid modes
   (translations x, y and the rotation about its centroid);
-- the *Dirichlet conditions* (``problem._bcs``): the values of each mode at the
+- the *Dirichlet conditions* (``problem.loads.bcs``): the values of each mode at the
   prescribed active dofs of its body;
 - the *interface laws*, by what they transmit once the interface is closed:
   ``free`` nothing; ``frictionless`` (and ``coulomb`` with ``mu = 0``) the normal
@@ -84,7 +84,7 @@ class FreeBody:
         modes: e.g. ``["translation x", "rotation about (0.5, 0.5)"]``.
         reasons: Why nothing holds them (Dirichlet data, interface laws).
         remedies: ``(point, component)`` of point constraints that remove them
-            (``problem.add_point_displacement(point, 0.0, component)``).
+            (``problem.loads.add_point_displacement(point, 0.0, component)``).
         spin_only: The only free mode is a rotation that a frictionless interface of
             the body leaves (a spin its geometry does not lock), not a missing support.
     """
@@ -98,7 +98,7 @@ class FreeBody:
     def message(self) -> str:
         one = len(self.modes) == 1
         fixes = ", ".join(
-            f"add_point_displacement([{_num(p[0], 6)}, {_num(p[1], 6)}], 0.0, {c})"
+            f"loads.add_point_displacement([{_num(p[0], 6)}, {_num(p[1], 6)}], 0.0, {c})"
             for p, c in self.remedies
         )
         return (
@@ -341,7 +341,7 @@ def _dirichlet_gram(problem, bodies: list[_Body]) -> np.ndarray:
     W = problem.space.W
     imap = W.dofmap.index_map
     prescribed = np.zeros((imap.size_local + imap.num_ghosts) * W.dofmap.index_map_bs, bool)
-    for bc in problem._bcs:
+    for bc in problem.loads.bcs:
         prescribed[bc.dof_indices()[0]] = True
     G = np.zeros((3 * len(bodies), 3 * len(bodies)))
     for b, body in enumerate(bodies):

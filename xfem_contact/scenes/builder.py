@@ -16,10 +16,11 @@ from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.io.gmsh import GmshMesh, facets, read_gmsh
 from xfem_contact.io.meshes import annulus
 from xfem_contact.mechanics.laws import ContactLaw, make_law
+from xfem_contact.mechanics.loads import annulus_parts, rectangle_parts
 from xfem_contact.mechanics.plain import PlainElasticityProblem
 from xfem_contact.mechanics.problem import Problem
 from xfem_contact.scenes.expressions import compile_expression
-from xfem_contact.scenes.scene import InterfaceSpec, Scene
+from xfem_contact.scenes.scene import InterfaceSpec, Scene, SceneError
 
 
 def levelset(spec: InterfaceSpec) -> Callable[[np.ndarray], np.ndarray]:
@@ -45,33 +46,29 @@ def levelset(spec: InterfaceSpec) -> Callable[[np.ndarray], np.ndarray]:
     return lambda x: np.broadcast_to(np.asarray(f(x), dtype=float), x[0].shape).copy()
 
 
-def _part(scene: Scene, name: str, meshed: MeshedDomain) -> Callable | np.ndarray:
-    """A boundary part: a locator of ``x`` for built-in and expression parts, local
-    facet indices for the named physical groups of a gmsh file."""
-    if name in scene.parts:
-        f = compile_expression(scene.parts[name], f"parts.{name}.where")
-        return lambda x: np.broadcast_to(np.asarray(f(x), dtype=bool), x[0].shape).copy()
-    if meshed.gmsh is not None and name in meshed.gmsh.parts:
-        return facets(meshed.gmsh, name)
-    (x0, y0), (x1, y1) = scene.corners
-    r0, r1 = scene.radii
-    tol = 1e-6 * r1
-    builtin = {
-        "inner": lambda x: np.abs(np.hypot(x[0], x[1]) - r0) < tol,
-        "outer": lambda x: np.abs(np.hypot(x[0], x[1]) - r1) < tol,
-        "left": lambda x: np.isclose(x[0], x0),
-        "right": lambda x: np.isclose(x[0], x1),
-        "bottom": lambda x: np.isclose(x[1], y0),
-        "top": lambda x: np.isclose(x[1], y1),
-        "boundary": lambda x: np.ones(x.shape[1], dtype=bool),
-    }
-    return builtin[name]
+def scene_parts(scene: Scene, meshed: MeshedDomain) -> dict:
+    """The boundary parts a scene can name: the built-in ones of its mesh kind, the
+    named physical groups of a gmsh file (local facet indices), the scene's own
+    (locators of ``x``)."""
+    if scene.kind == "rectangle":
+        parts = rectangle_parts(scene.corners)
+    elif scene.kind == "annulus":
+        parts = annulus_parts(*scene.radii)
+    else:
+        parts = {"boundary": lambda x: np.ones(x.shape[1], dtype=bool)}
+    if meshed.gmsh is not None:
+        parts |= {name: facets(meshed.gmsh, name) for name in meshed.gmsh.parts}
+    for name, where in scene.parts.items():
+        f = compile_expression(where, f"parts.{name}.where")
+        parts[name] = lambda x, f=f: np.broadcast_to(np.asarray(f(x), dtype=bool), x[0].shape)
+    return parts
 
 
-def _value(value, vector: bool):
-    """A load value: number, [a, b], or expression string(s) -> number/callable."""
+def _value(value):
+    """A load value: number, [a, b], or expression string(s) -> number, tuple or callable
+    (of the UFL ``x`` for loads on forms, of numpy points for displacements)."""
     if isinstance(value, list | tuple):
-        comps = [_value(v, False) for v in value]
+        comps = [_value(v) for v in value]
 
         def vector_value(x):
             if isinstance(x, ufl.core.expr.Expr):
@@ -80,9 +77,7 @@ def _value(value, vector: bool):
                 [np.broadcast_to(c(x) if callable(c) else c, x[0].shape) for c in comps]
             )
 
-        if vector and not any(callable(c) for c in comps):
-            return ufl.as_vector(comps)
-        return vector_value
+        return vector_value if any(callable(c) for c in comps) else tuple(comps)
     if isinstance(value, str):
         f = compile_expression(value, "load value")
         return lambda x: (
@@ -184,28 +179,35 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             else "SNES (generalized Newton)",
             "pairing": bool(problem.couplings),
         }
-    for load in scene.loads:
-        _apply(problem, scene, load, meshed)
+    loads = problem.loads
+    loads.parts = scene_parts(scene, meshed)
+    for name, (start, end) in scene.stages.items():
+        loads.add_stage(name, start, end)
+    for k, load in enumerate(scene.loads):
+        try:
+            _apply(loads, load)
+        except ValueError as error:
+            raise SceneError(f"loads[{k}]", str(error)) from None
     return problem, effects
 
 
-def _apply(problem, scene: Scene, load, meshed: MeshedDomain) -> None:
-    side = {} if isinstance(problem, PlainElasticityProblem) else {"side": load.side}
+def _apply(loads, load) -> None:
+    """Add one scene load to a problem's :class:`~xfem_contact.mechanics.loads.Loads`."""
+    path = {"history": load.history}
     if load.type == "point_displacement":
-        problem.add_point_displacement(load.point, float(load.value), int(load.component))
-        return
-    where = _part(scene, load.part, meshed) if load.part else None
-    if load.type == "displacement":
-        problem.add_displacement(where, _value(load.value, False), load.component)
+        loads.add_point_displacement(load.point, float(load.value), int(load.component), **path)
+    elif load.type == "displacement":
+        loads.add_displacement(load.part, _value(load.value), load.component, **path)
     elif load.type == "pressure":
-        problem.add_pressure(where, _value(load.value, False), **side)
+        loads.add_pressure(load.part, _value(load.value), load.side, **path)
     elif load.type == "traction":
-        problem.add_traction(where, _value(load.value, True), **side)
+        loads.add_traction(load.part, _value(load.value), load.side, **path)
     elif load.type == "body_force":
-        problem.add_body_force(_value(load.value, True), **side)
+        loads.add_body_force(_value(load.value), load.side, **path)
     elif load.type == "rotation":
-        problem.add_rotation(where, float(load.value), load.centre)
+        angle = {"angle": load.value} if load.angle_deg is None else {"angle_deg": load.angle_deg}
+        loads.add_rotation(load.part, centre=load.centre, **angle, **path)
     elif load.type == "tangential_support":
-        problem.add_tangential_spring(where, float(load.value))
+        loads.add_tangential_spring(load.part, float(load.value))
     else:  # the scene schema admits no other type
         raise AssertionError(f"unhandled load type {load.type!r}")

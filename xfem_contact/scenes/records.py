@@ -35,6 +35,10 @@ class LoadSpec:
     component: int | None = None
     point: tuple | None = None
     centre: tuple = (0.0, 0.0)
+    #: Load path: None (factor = t), ((t, factor), ...) or a stage name
+    history: object = None
+    #: A rotation's angle in degrees (``value`` holds radians otherwise)
+    angle_deg: float | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,5 +63,9 @@ class Scene:
     loads: tuple[LoadSpec, ...]
     outputs: dict
     load_steps: int = 1
+    #: Named load stages: name -> (start, end) pseudo-times
+    stages: dict = dataclasses.field(default_factory=dict)
+    #: Pseudo-time of the last load step (None: the loads' last time, at least 1)
+    end_time: float | None = None
     #: PETSc options of the solver (SNES/KSP, without prefix)
     petsc_options: dict = dataclasses.field(default_factory=dict)

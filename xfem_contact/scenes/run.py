@@ -9,15 +9,17 @@ from collections.abc import Callable
 
 import dolfinx.io
 import dolfinx.mesh
-import numpy as np
 from mpi4py import MPI
 
 from xfem_contact._version import versions
 from xfem_contact.fem import forms
+from xfem_contact.io.interface_data import sample_status
 from xfem_contact.io.output import write_json
 from xfem_contact.io.progress import note, progress
-from xfem_contact.mechanics.loading import load_steps
+from xfem_contact.mechanics.loads import load_steps
 from xfem_contact.mechanics.plain import PlainElasticityProblem
+from xfem_contact.mechanics.reactions import balance
+from xfem_contact.mechanics.stress import StressFields
 from xfem_contact.scenes.builder import (  # noqa: F401  (re-exported)
     MeshedDomain,
     build,
@@ -34,7 +36,9 @@ class Result:
 
     Plain problems have one field ``u``; cut problems ``u_minus``, ``u_plus`` and,
     with an interface law that needs one, ``multiplier`` (``multiplier_NAME`` per
-    interface when several have one).
+    interface when several have one). ``stress`` holds the Cauchy and von Mises
+    stresses of each displacement field
+    (:class:`~xfem_contact.mechanics.stress.StressFields`).
     """
 
     def __init__(self, problem):
@@ -55,11 +59,24 @@ class Result:
                 self.fields.append(dolfinx.fem.Function(V, name=name))
                 self._maps.append(dofs)
 
+        self.stress = _stress_fields(problem, self.fields)
+
     def update(self, solution: dolfinx.fem.Function) -> None:
-        """Copy a solution (plain ``u`` or mixed ``w``) into the fields."""
+        """Copy a solution (plain ``u`` or mixed ``w``) into the fields; their stresses."""
         for f, dofs in zip(self.fields, self._maps, strict=True):
             f.x.array[:] = solution.x.array if dofs is None else solution.x.array[dofs]
             f.x.scatter_forward()
+        self.stress.update()
+
+
+def _stress_fields(problem, fields: list) -> StressFields:
+    """The stresses of the displacement fields, with each side's material law."""
+    bulk = getattr(problem, "bulk", None)
+    if bulk is None:  # a plain problem: one field
+        sides = [("", problem.material, fields[0])]
+    else:
+        sides = [("minus", bulk.materials[-1], fields[0]), ("plus", bulk.materials[1], fields[1])]
+    return StressFields(sides, getattr(problem, "kinematics", "small"))
 
 
 def solve_step(
@@ -91,12 +108,13 @@ def run(
 ) -> dict:
     """Build, solve and summarise a scene. Collective.
 
-    The loads are applied in ``scene.load_steps`` equal steps (a line per step and
-    per Newton iterate goes to ``log``; ``None`` for silence), with a progress bar over
+    The pseudo-time runs to ``scene.end_time`` (default: the loads' last time, at
+    least 1) in ``scene.load_steps`` equal steps, each load following its path (a line
+    per step and per Newton iterate goes to ``log``; ``None`` for silence), with a progress bar over
     the steps when there are several and ``progress_bar`` is true
     (:func:`xfem_contact.io.progress.progress`). With ``out``, the
     fields of every step go to VTX files (``displacement.bp``, ``multiplier.bp``,
-    time = load factor), the final state to ``result.vtu``, last the summary to
+    time = pseudo-time), the final state to ``result.vtu``, last the summary to
     ``summary.json`` (atomic; a stale one is removed first: a failed run leaves none).
 
     Returns:
@@ -116,20 +134,21 @@ def run(
     say(f"scene {scene.name}: effects {effects}")
     result = Result(problem)
     series = _open_series(out, result) if (out is not None and scene.outputs["vtx"]) else []
-    steps, iterations, residuals, status = load_steps(scene.load_steps), [], [], {}
+    end_time = scene.end_time or problem.loads.end_time
+    steps, iterations, residuals, status = load_steps(scene.load_steps, end_time), [], [], {}
     pairing = []
     solve_start = time.perf_counter()
     try:
         bar = progress(steps, f"{scene.name}: load steps", progress_bar and len(steps) > 1, comm)
         for k, t in enumerate(bar, start=1):
-            problem.load_factor.set(t)
+            problem.loads.set_time(t)
             try:
                 solution, its, status = solve_step(
                     problem, scene.petsc_options or None, say if log else None
                 )
             except NewtonFailure as failure:
                 raise NewtonFailure(
-                    f"Scene {scene.name!r}, load step {k}/{len(steps)} (load factor {t:.4g}): "
+                    f"Scene {scene.name!r}, load step {k}/{len(steps)} (time {t:.4g}): "
                     f"Newton failed (SNES reason {failure.report.reason})",
                     failure.report,
                 ) from None
@@ -154,7 +173,7 @@ def run(
             for writer in series:
                 writer.write(float(t))
             say(
-                f"load step {k}/{len(steps)} (factor {t:.4g}): {its} iteration(s)"
+                f"load step {k}/{len(steps)} (time {t:.4g}): {its} iteration(s)"
                 + "".join(f", {key} {value}" for key, value in status.items())
             )
     finally:
@@ -183,20 +202,33 @@ def run(
         summary["pairing"] = pairing
     if not isinstance(problem, PlainElasticityProblem):
         samples = {name: problem.interface_samples(name) for name in problem.laws}
+        for name, sampled in samples.items():  # 0 open, 1 stick, 2 slip
+            sampled["status"] = sample_status(problem, name)
         summary["interfaces"] = {
             name: law.describe() | {"samples": samples[name]} for name, law in problem.laws.items()
         }
         if not problem.linear and len(samples) == 1:
             summary["interface_samples"] = next(iter(samples.values()))
+    if hasattr(problem, "space"):  # reactions, interface resultants, global balance (N/m)
+        forces_start = time.perf_counter()
+        summary["forces"] = balance(problem)
+        forces_time = time.perf_counter() - forces_start
+        reactions = ", ".join(f"{k} {v}" for k, v in summary["forces"]["reactions"].items())
+        say(
+            f"reactions (N/m): {reactions or 'none'}; balance (relative) "
+            f"{summary['forces']['balance_relative']:.1e}"
+        )
     summary["forms_compiled"] = len(forms._cache) - compiled_before
     cut_timings = getattr(getattr(problem, "cut", None), "timings", {})
     timings = dict(cut_timings) | {
         "mesh_and_spaces": build_time - sum(cut_timings.values()),
         "solve": solve_time,
     }
+    if "forces" in summary:
+        timings["forces"] = forces_time
     if out is not None:
         output_start = time.perf_counter()
-        _write_grid(out, problem, result.fields)
+        _write_grid(out, problem, result)
         timings["output"] = time.perf_counter() - output_start
     summary["timings"] = timings | {"total": time.perf_counter() - start}
     if out is not None:
@@ -222,29 +254,28 @@ def _open_series(out: str | pathlib.Path, result: Result) -> list:
     groups = [("displacement", result.fields[:2])]
     if len(result.fields) > 2:
         groups.append(("multiplier", result.fields[2:]))
+    groups.append(("stress", result.stress.stress + result.stress.von_mises))
     return [
         dolfinx.io.VTXWriter(comm, out / f"{name}.bp", fields, engine="BP4")
         for name, fields in groups
     ]
 
 
-def _write_grid(out: pathlib.Path, problem, fields) -> None:
-    """``result.vtu`` (per process): the lips of a cut scene, or the plain mesh; and
-    for a cut scene ``subcells.vtu``/``interface.vtu`` (the cut geometry)."""
-    from xfem_contact.io.output import write_cut_geometry, write_lips
+def _write_grid(out: pathlib.Path, problem, result: Result) -> None:
+    """``result.vtu`` (per process): the lips of a cut scene, or the plain mesh, with the
+    displacement and the stresses; for a cut scene ``subcells.vtu`` and ``interface.vtu``
+    (the cut geometry; the laws' state at the interface nodes). Collective."""
+    from xfem_contact.io.interface_data import interface_point_data
+    from xfem_contact.io.output import write_cut_geometry, write_lips, write_plain
 
-    if isinstance(problem, PlainElasticityProblem):
-        import dolfinx.plot
-        import pyvista
-
-        u = fields[0]
-        topology, cell_types, x = dolfinx.plot.vtk_mesh(u.function_space)
-        grid = pyvista.UnstructuredGrid(topology, cell_types, x)
-        values = u.x.array.reshape(-1, 2)
-        grid.point_data["u"] = np.c_[values, np.zeros(values.shape[0])]
-        comm = problem.mesh.comm
-        name = "result.vtu" if comm.size == 1 else f"result_r{comm.rank}.vtu"
-        grid.save(out / name)
+    stress = result.stress
+    if len(result.fields) == 1 or not hasattr(problem, "cut"):  # a plain problem
+        named = {"stress": stress.stress[0], "von_mises": stress.von_mises[0]}
+        write_plain(out / "result.vtu", result.fields[0], named)
     else:
-        write_lips(out / "result.vtu", problem.cut, fields[0], fields[1])
-        write_cut_geometry(out, problem.cut)
+        named = {
+            "stress": dict(zip((-1, 1), stress.stress, strict=True)),
+            "von_mises": dict(zip((-1, 1), stress.von_mises, strict=True)),
+        }
+        write_lips(out / "result.vtu", problem.cut, result.fields[0], result.fields[1], named)
+        write_cut_geometry(out, problem.cut, interface_point_data(problem))

@@ -67,6 +67,7 @@ from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
     check_table,
     describe,
     join,
+    stages_table,
 )
 from xfem_contact.solvers.options import preset
 
@@ -154,8 +155,9 @@ def load_scene(
             known_parts |= set(physical_parts(mesh["file"]))
         except (OSError, ValueError) as error:
             raise SceneError("mesh.file", " ".join(str(error).split())) from None
+    stages = stages_table(data.get("stages", {}), "stages")
     loads = [
-        _load(table, where, known_parts)
+        _load(table, where, known_parts, stages)
         for where, _, table in _tables(data.get("loads", []), "loads", listed=True)
     ]
 
@@ -173,6 +175,8 @@ def load_scene(
         loads=tuple(loads),
         outputs={"vtx": True, "png": True, **outputs},
         load_steps=solver.get("load_steps", 1),
+        stages=stages,
+        end_time=solver.get("end_time"),
         petsc_options=_petsc_options(solver),
     )
 
@@ -274,8 +278,9 @@ def _sides(table, kinematics: str, where: str) -> int:
     return slave
 
 
-def _load(table, where: str, known_parts: set) -> LoadSpec:
-    """A load from its checked table: the keys of its type, its part, the form of its value."""
+def _load(table, where: str, known_parts: set, stages: dict) -> LoadSpec:
+    """A load from its checked table: the keys of its type, its part, the form of its
+    value, the stage its history names."""
     check_table(table, FIELDS["load"], where)
     kind = table["type"]
     required, optional = LOAD_KEYS[kind]
@@ -291,15 +296,24 @@ def _load(table, where: str, known_parts: set) -> LoadSpec:
     if "part" in required and part not in known_parts:
         message = f"{part!r}: no such boundary part; known: {sorted(known_parts)}"
         raise SceneError(f"{where}.part", message)
-    _load_value(table["value"], kind, "component" in table, f"{where}.value")
+    if kind == "rotation" and ("value" in table) == ("angle_deg" in table):
+        raise SceneError(f"{where}.value", "give the angle once: value (rad) or angle_deg")
+    if "value" in table:
+        _load_value(table["value"], kind, "component" in table, f"{where}.value")
+    history = table.get("history")
+    if isinstance(history, str) and history not in stages:
+        message = f"{history!r}: no such stage; known: {sorted(stages)}"
+        raise SceneError(f"{where}.history", message)
     return LoadSpec(
         part,
         kind,
-        table["value"],
+        table.get("value"),
         table.get("side"),
         table.get("component"),
         tuple(table["point"]) if "point" in table else None,
         tuple(table.get("centre", (0.0, 0.0))),
+        history if isinstance(history, str | None) else tuple(map(tuple, history)),
+        table.get("angle_deg"),
     )
 
 

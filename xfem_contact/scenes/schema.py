@@ -62,12 +62,12 @@ SHAPE_KEYS = {
 }
 #: The keys of each load type besides ``type``: (required, optional)
 LOAD_KEYS = {
-    "pressure": (("part", "value"), ("side",)),
-    "traction": (("part", "value"), ("side",)),
-    "displacement": (("part", "value"), ("component",)),
-    "point_displacement": (("point", "component", "value"), ()),
-    "body_force": (("value",), ("side",)),
-    "rotation": (("part", "value"), ("centre",)),
+    "pressure": (("part", "value"), ("side", "history")),
+    "traction": (("part", "value"), ("side", "history")),
+    "displacement": (("part", "value"), ("component", "history")),
+    "point_displacement": (("point", "component", "value"), ("history",)),
+    "body_force": (("value",), ("side", "history")),
+    "rotation": (("part",), ("value", "angle_deg", "centre", "history")),
     "tangential_support": (("part", "value"), ()),
 }
 
@@ -219,6 +219,34 @@ def petsc_table(value, key: str):
     return value
 
 
+def load_path(value, key: str):
+    """A load path: a stage name, or ``[[time, factor], ...]`` with times increasing."""
+    if isinstance(value, str):
+        return _NAME(value, key)
+    if not isinstance(value, list | tuple) or not value:
+        message = f"expected a stage name or a list of [time, factor] pairs, got {describe(value)}"
+        raise SceneError(key, message)
+    times = [Vector(2, Number())(pair, join(key, i))[0] for i, pair in enumerate(value)]
+    if any(b <= a for a, b in zip(times, times[1:], strict=False)):
+        raise SceneError(key, f"the times must increase strictly, got {times}")
+    return value
+
+
+def stages_table(value, key: str) -> dict[str, tuple[float, float]]:
+    """The [stages] table: ``NAME = [start, end]`` pseudo-times, ``start < end``."""
+    if not isinstance(value, dict):
+        raise SceneError(key, f"expected a table of NAME = [start, end], got {describe(value)}")
+    stages = {}
+    for name, interval in value.items():
+        where = join(key, name)
+        _NAME(name, where)
+        start, end = Vector(2, Number())(interval, where)
+        if not start < end:
+            raise SceneError(where, f"start {start} must be before end {end}")
+        stages[name] = (float(start), float(end))
+    return stages
+
+
 @dataclasses.dataclass(frozen=True)
 class Field:
     """A key of a table: its check, its meaning, whether it must be given."""
@@ -289,6 +317,11 @@ FIELDS = {
         "load_steps": Field(
             Number(1, 10_000, integer=True), "number of equal load steps (>= 1, default 1)"
         ),
+        "end_time": Field(
+            _POSITIVE,
+            "pseudo-time of the last step (steps at k end_time / load_steps; default: the "
+            "last time of any history or stage, at least 1)",
+        ),
         "max_iterations": Field(
             Number(1, 10_000, integer=True),
             f"Newton iterations per step (default {_NEWTON['snes_max_it']})",
@@ -314,6 +347,12 @@ FIELDS = {
         "component": Field(Choice((0, 1)), "0 or 1 (displacement)"),
         "point": Field(_POINT, "[x, y] (point_displacement)"),
         "centre": Field(_POINT, "[x, y] (m), centre of a rotation (default [0, 0])"),
+        "angle_deg": Field(Number(), "rotation angle in degrees (instead of value, in rad)"),
+        "history": Field(
+            load_path,
+            "load path: [[t, factor], ...] (piecewise linear in pseudo-time t) or a stage "
+            "name (default: factor = t)",
+        ),
     },
     "outputs": {
         "vtx": Field(flag, "write VTX fields (bool)"),
@@ -324,6 +363,7 @@ FIELDS = {
 SCHEMA = {table: {key: f.doc for key, f in fields.items()} for table, fields in FIELDS.items()}
 TOP_LEVEL = (
     "scene",
+    "stages",
     "mesh",
     "discretisation",
     "materials",

@@ -1,0 +1,154 @@
+"""Handles of the loads of a :class:`~xfem_contact.mechanics.loads.Loads`.
+
+Each ``add_*`` returns one: its ``value`` (the magnitude at factor 1) can be read and
+set, and ``apply(t)`` sets its factor ``history(t)``. Setting a value changes data
+(a Constant, the arrays of Dirichlet functions), never a form: nothing compiles.
+"""
+
+from __future__ import annotations
+
+import dolfinx.fem
+import numpy as np
+
+from xfem_contact.mechanics.loads.history import History
+from xfem_contact.mechanics.loads.values import finite_number, nodal_values, set_constant
+
+
+class Load:
+    """A load or support: its ``kind``, ``part`` (name, or None when given otherwise)
+    and :class:`History`."""
+
+    def __init__(self, kind: str, part, history: History):
+        self.kind, self.history = kind, history
+        self.part = part if isinstance(part, str) else None
+        self._t = 1.0
+
+    def apply(self, t: float) -> None:
+        """Set this load to its value at pseudo-time ``t``."""
+        self._t = t
+
+    def __repr__(self) -> str:
+        part = f" on {self.part!r}" if self.part else ""
+        return f"<{self.kind}{part}: value {self.value!r}, {self.history!r}>"
+
+
+class FormLoad(Load):
+    """A load of the residual (traction, pressure, body force): ``factor * magnitude``,
+    both UFL Constants when the magnitude was given as numbers."""
+
+    def __init__(self, kind, part, history, magnitude, constant, mesh):
+        super().__init__(kind, part, history)
+        self.magnitude, self._constant = magnitude, constant
+        #: The factor ``history(t)`` (dimensionless) multiplying the magnitude in the form
+        self.factor = dolfinx.fem.Constant(mesh, dolfinx.default_scalar_type(1.0))
+
+    @property
+    def value(self):
+        """The magnitude (a float or a tuple; the UFL expression if given as one)."""
+        if self._constant is None:
+            return self.magnitude
+        value = self._constant.value
+        return float(value) if value.shape == () else tuple(value.tolist())
+
+    @value.setter
+    def value(self, value) -> None:
+        if self._constant is None:
+            raise ValueError(
+                f"The {self.kind} was given as an expression; only a magnitude given as "
+                "numbers can be set (add it with a number or a tuple)"
+            )
+        set_constant(self._constant, value, self.kind)
+
+    def apply(self, t: float) -> None:
+        super().apply(t)
+        self.factor.value = self.history(t)
+
+
+class DirichletLoad(Load):
+    """A prescribed displacement: functions ``g`` set to ``history(t)`` times their full
+    values (m), the values interpolated from ``value`` on each function's space."""
+
+    def __init__(self, kind, part, history, functions: list[dolfinx.fem.Function], value):
+        super().__init__(kind, part, history)
+        self.functions = functions
+        self.value = value
+
+    @property
+    def value(self):
+        """The prescribed value (m): a number, a tuple or a callable of ``x``."""
+        return self._value
+
+    @value.setter
+    def value(self, value) -> None:
+        full = [nodal_values(g.function_space, value, self.kind) for g in self.functions]
+        self._value, self._full = value, full
+        self.apply(self._t)
+
+    def apply(self, t: float) -> None:
+        super().apply(t)
+        f = self.history(t)
+        for g, full in zip(self.functions, self._full, strict=True):
+            g.x.array[:] = f * full
+
+
+class RotationLoad(Load):
+    """A rigid rotation of a boundary part by ``history(t)`` times ``value`` (rad,
+    counter-clockwise) about ``centre`` (m): ``u = (Q - I)(X - c)`` (the angle ramps,
+    so each step is an exact rotation)."""
+
+    def __init__(self, part, history, functions, arms, angle: float, centre, nodes):
+        super().__init__("rotation", part, history)
+        self.functions, self.arms, self.centre = functions, arms, centre
+        #: ``(dofs (k, 2), reference nodes (k, 2))`` of the rotated bodies (predictor)
+        self.nodes = nodes
+        self.value = angle
+
+    @property
+    def value(self) -> float:
+        """The angle (rad) at factor 1."""
+        return self._angle
+
+    @value.setter
+    def value(self, angle: float) -> None:
+        self._angle = finite_number(angle, "angle")
+        self.apply(self._t)
+
+    def apply(self, t: float) -> None:
+        super().apply(t)
+        a = self.history(t) * self._angle
+        c, s = np.cos(a), np.sin(a)
+        for g, arm in zip(self.functions, self.arms, strict=True):
+            g.x.array[:] = np.column_stack(
+                [(c - 1) * arm[:, 0] - s * arm[:, 1], s * arm[:, 0] + (c - 1) * arm[:, 1]]
+            ).ravel()
+
+    def rotate(self, w: dolfinx.fem.Function, t_from: float, t_to: float) -> None:
+        """Turn the deformed configuration of the rotated bodies in ``w`` by the angle
+        between ``t_from`` and ``t_to`` (a predictor: exact for a rigidly turning body)."""
+        delta = (self.history(t_to) - self.history(t_from)) * self._angle
+        if self.nodes is None or delta == 0.0:
+            return
+        dofs, X = self.nodes
+        Q = np.array([[np.cos(delta), -np.sin(delta)], [np.sin(delta), np.cos(delta)]])
+        x = X + w.x.array[dofs]
+        w.x.array[dofs] = (x - self.centre) @ Q.T + self.centre - X
+
+
+class SpringSupport(Load):
+    """A tangential spring (Pa/m): its stiffness a Constant; not ramped (a support)."""
+
+    def __init__(self, part, facets: np.ndarray, stiffness: dolfinx.fem.Constant):
+        super().__init__("tangential spring", part, History([(0.0, 1.0)]))
+        self.facets, self.stiffness = facets, stiffness
+
+    @property
+    def value(self) -> float:
+        """The stiffness (Pa/m)."""
+        return float(self.stiffness.value)
+
+    @value.setter
+    def value(self, stiffness: float) -> None:
+        stiffness = finite_number(stiffness, "stiffness")
+        if not stiffness > 0.0:
+            raise ValueError(f"The spring stiffness must be > 0 Pa/m, got {stiffness}")
+        self.stiffness.value = stiffness
