@@ -191,7 +191,7 @@ def tractions(problem) -> tuple:
     n, t = ctx.frame()
     u = ctx.fields(fields)
     slip = u.jump - ctx.fields(ufl.split(problem.w_old)).jump if law.incremental else u.jump
-    r = law.augmentation_coefficient(ctx, ctx.cell_size)
+    r = law.augmentation_coefficient(ctx.materials, ctx.cell_size)
     P_n, P_t = law.augmented(lam_n, lam_t, ufl.dot(u.jump, n), ufl.dot(slip, t), r, UFL_OPS)
     return lam_n * n + lam_t * t, P_n * n + P_t * t
 
@@ -262,7 +262,7 @@ def test_bad_contact_input_raises():
     problem = inclusion_problem(4, 1, "bonded")
     cut = problem.cut
     material = Material(1.0, 0.3)
-    with pytest.raises(ValueError, match="friction coefficient must be >= 0"):
+    with pytest.raises(ValueError, match="friction must be finite and >= 0"):
         ContactProblem(cut, 1, material, "coulomb", friction=-0.1)
     with pytest.raises(ValueError, match="needs a friction coefficient"):
         ContactProblem(cut, 1, material, "coulomb")
@@ -272,6 +272,10 @@ def test_bad_contact_input_raises():
         ContactProblem(cut, 1, material, "sticking", augmentation=0.0)
     with pytest.raises(ValueError, match="LBB"):
         ContactProblem(cut, 1, material, "sticking", lbb="magic")
+    with pytest.raises(ValueError, match=r"'sticking' law takes no option \['friction'\]"):
+        ContactProblem(cut, 1, material, "sticking", friction=0.3)
+    with pytest.raises(TypeError):  # options are keyword-only
+        ContactProblem(cut, 1, material, "coulomb", 0.3)
 
 
 def test_solved_problems_are_freed():

@@ -44,8 +44,8 @@ def main() -> None:
     test_cuts.solve_at = solve_at
 
     harmonic = contact.ContactLaw.augmentation_coefficient
-    contact.ContactLaw.augmentation_coefficient = lambda self, ctx, h: (
-        self.augmentation * 0.5 * (ctx.materials[-1].E + ctx.materials[1].E) / h
+    contact.ContactLaw.augmentation_coefficient = lambda self, m, h: (
+        self.augmentation * 0.5 * (m[-1].E + m[1].E) / h
     )
     attempt(
         "contrast 1e6 with the arithmetic-mean augmentation",

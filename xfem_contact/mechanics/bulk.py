@@ -16,8 +16,10 @@ import ufl
 from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws.base import Fields
-from xfem_contact.mechanics.materials import Material, MaterialField
+from xfem_contact.mechanics.materials import MaterialField, Moduli
+from xfem_contact.mechanics.parameters import Parameter, bind, constant
 
 SIDES = (-1, 1)
 
@@ -48,21 +50,34 @@ class SmallStrain:
         ghost_penalty: Dimensionless weight ``gamma``: for each side,
             ``gamma * 2 mu * sum_k h^(2k-1) [d^k u][d^k v]`` on the interior facets of
             cut cells, k = 1..degree (zero for smooth solutions: exact polynomial
-            fields stay exact). 0 disables it.
+            fields stay exact). A Constant of the forms; 0 at construction leaves the
+            term out of them (it cannot be switched on later).
     """
+
+    name = "bulk"
+    ghost_penalty = Parameter(minimum=0.0)
 
     def __init__(
         self,
         cut: CutMesh,
-        materials: dict[int, Material | MaterialField],
+        materials: dict[int, Moduli | MaterialField],
         degree: int,
         h: dolfinx.fem.Function,
-        ghost_penalty: float = 0.01,
+        ghost_penalty: float = DEFAULT.ghost_penalty,
     ):
-        if ghost_penalty < 0:
-            raise ValueError(f"ghost_penalty must be >= 0, got {ghost_penalty}")
         self.cut, self.materials, self.degree, self.h = cut, materials, degree, h
         self.ghost_penalty = ghost_penalty
+        #: Whether the forms hold the ghost penalty (its weight > 0 at construction)
+        self.penalised = self.ghost_penalty > 0
+        bind(self, cut.mesh)
+
+    def check_parameter(self, name: str, value: float) -> None:
+        """Refuse a positive ghost penalty for forms built without the term."""
+        if name == "ghost_penalty" and value > 0 and not getattr(self, "penalised", True):
+            raise ValueError(
+                "ghost_penalty was 0 when the problem was built, so its forms hold no "
+                "ghost penalty term: build the problem with ghost_penalty > 0"
+            )
 
     def form(self, u: Fields, v: Fields) -> ufl.Form:
         """Elastic energy of both sides plus the ghost penalty (UFL, bilinear in trial
@@ -71,7 +86,7 @@ class SmallStrain:
             ufl.inner(self.materials[s].stress(u[i]), ufl.sym(ufl.grad(v[i]))) * self.cut.dx(s)
             for i, s in enumerate(SIDES)
         )
-        if self.ghost_penalty > 0:
+        if self.penalised:
             a += self._ghost_penalty(u, v)
         return a
 
@@ -80,10 +95,9 @@ class SmallStrain:
         h = ufl.avg(self.h)
         terms = []
         for i, s in enumerate(SIDES):
-            mu = self.materials[s].mu
-            scale = (
-                self.ghost_penalty * 2.0 * (ufl.avg(mu) if isinstance(mu, ufl.Coefficient) else mu)
-            )
+            mu = self.materials[s].ufl_mu
+            mu = ufl.avg(mu) if isinstance(mu, ufl.Coefficient) else mu
+            scale = constant(self, "ghost_penalty") * 2.0 * mu
             du, dv = ufl.grad(trial[i]), ufl.grad(test[i])
             for k in range(1, self.degree + 1):
                 terms.append(
@@ -108,7 +122,7 @@ class SaintVenantKirchhoff(SmallStrain):
             ufl.inner(self.materials[s].piola(u[i]), ufl.grad(v[i])) * self.cut.dx(s)
             for i, s in enumerate(SIDES)
         )
-        if self.ghost_penalty > 0:
+        if self.penalised:
             a += self._ghost_penalty(u, v)
         return a
 

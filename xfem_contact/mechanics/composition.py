@@ -8,12 +8,13 @@ laws' views of them. SI units (Pa).
 
 from __future__ import annotations
 
+import typing
 from collections.abc import Mapping
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.mechanics.bulk import SIDES
 from xfem_contact.mechanics.laws import InterfaceLaw, make_law
-from xfem_contact.mechanics.materials import Material, MaterialField
+from xfem_contact.mechanics.materials import Material, MaterialField, Moduli
 
 #: Materials: one for both sides, or ``{-1: m, 1: m}`` where side -1 may map
 #: interface names to the material inside each
@@ -36,30 +37,56 @@ def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
     return laws
 
 
-def side_and_law_materials(cut: CutMesh, materials: Materials):
-    """Per side (Material or MaterialField) and per interface ({-1, 1}: Material)."""
+class SideMaterials(typing.NamedTuple):
+    """A problem's materials as its forms see them (see :func:`side_and_law_materials`)."""
+
+    #: Per side, what the bulk uses: ``Moduli``, or a ``MaterialField`` on side -1
+    #: when the inclusions differ
+    bulk: dict[int, Moduli | MaterialField]
+    #: Per interface name, ``{-1: Moduli, 1: Moduli}`` (the laws' view)
+    laws: dict[str, dict[int, Moduli]]
+    #: What a user sets: ``{-1: Moduli or {interface name: Moduli}, 1: Moduli}``
+    user: dict
+
+
+def side_and_law_materials(cut: CutMesh, materials: Materials) -> SideMaterials:
+    """The :class:`Moduli` (Constants on ``cut.mesh``) of the materials given: one
+    per distinct :class:`Material`, shared by the bulk and the laws, so that setting
+    its ``E`` or ``nu`` changes every form that uses it. Collective (DG0 fields)."""
     if isinstance(materials, Material):
         materials = {-1: materials, 1: materials}
+    if not isinstance(materials, Mapping):
+        raise ValueError(
+            f"materials: give a Material or {{-1: Material, 1: Material}}, got {materials!r}"
+        )
     missing = [s for s in SIDES if s not in materials]
     if missing:
-        raise ValueError(f"Give a Material for sides -1 and +1 (missing: {missing})")
+        raise ValueError(f"materials: give a Material for sides -1 and +1 (missing: {missing})")
     names = cut.interface_names
     inside = materials[-1]
     if isinstance(inside, Mapping):
         if set(inside) != set(names):
             raise ValueError(
-                f"Side -1 materials must name the interfaces {list(names)}; got {sorted(inside)}"
+                f"materials[-1] must name the interfaces {list(names)}; got {sorted(inside)}"
             )
         per_interface = dict(inside)
     else:
         per_interface = {name: inside for name in names}
-    if not all(isinstance(m, Material) for m in [*per_interface.values(), materials[1]]):
-        raise ValueError("Give a Material for sides -1 and +1")
-    distinct = len({per_interface[n] for n in names}) > 1
+    for key, m in [*per_interface.items(), (1, materials[1])]:
+        if not isinstance(m, Material):
+            raise ValueError(f"materials[{key!r}]: give a Material, got {m!r}")
+    moduli: dict[Material, Moduli] = {}
+    for m in [*per_interface.values(), materials[1]]:
+        if m not in moduli:
+            moduli[m] = Moduli(m, cut.mesh)
+    inside_moduli = {name: moduli[per_interface[name]] for name in names}
+    outside = moduli[materials[1]]
+    distinct = list(dict.fromkeys(inside_moduli.values()))
     side_minus = (
-        MaterialField(cut.cell_regions(), [per_interface[n] for n in names])
-        if distinct
-        else per_interface[names[0]]
+        MaterialField(cut.cell_regions(), [inside_moduli[n] for n in names])
+        if len(distinct) > 1
+        else distinct[0]
     )
-    law_materials = {name: {-1: per_interface[name], 1: materials[1]} for name in names}
-    return {-1: side_minus, 1: materials[1]}, law_materials
+    laws = {name: {-1: inside_moduli[name], 1: outside} for name in names}
+    user_inside = inside_moduli if isinstance(inside, Mapping) else distinct[0]
+    return SideMaterials({-1: side_minus, 1: outside}, laws, {-1: user_inside, 1: outside})

@@ -1,9 +1,16 @@
-"""The two problems by their law names: :class:`ElasticityProblem` (``free``,
+"""The two problems by their law families: :class:`ElasticityProblem` (``free``,
 ``bonded``: one linear solve) and :class:`ContactProblem` (``frictionless``,
 ``coulomb``, ``sticking``: generalized Newton), each a :class:`Problem` composed
-with one law built by :func:`~xfem_contact.mechanics.laws.make_law`."""
+with one law built by :func:`~xfem_contact.mechanics.laws.make_law`.
+
+Both take the law's name and, keyword-only, the problem's options (those of
+:class:`Problem`) and the law's (``friction``, ``augmentation``, ``lbb``, ...: an
+option the law does not take is an error). Defaults:
+:data:`~xfem_contact.mechanics.defaults.DEFAULTS`."""
 
 from __future__ import annotations
+
+import inspect
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.mechanics.composition import Materials
@@ -12,84 +19,55 @@ from xfem_contact.mechanics.problem import Problem
 
 #: Interface laws of :class:`ElasticityProblem`
 INTERFACE_LAWS = LINEAR_LAWS
+#: The keyword options that go to :class:`Problem` (the rest go to the law)
+PROBLEM_OPTIONS = tuple(
+    p.name
+    for p in inspect.signature(Problem.__init__).parameters.values()
+    if p.kind is p.KEYWORD_ONLY
+)
 
 
-class ElasticityProblem(Problem):
+class _LawFamily(Problem):
+    """A :class:`Problem` whose one law is named among :attr:`LAWS`."""
+
+    LAWS: tuple[str, ...] = ()
+
+    def __init__(self, cut: CutMesh, degree: int, materials: Materials, law: str, **options):
+        if law not in self.LAWS:
+            raise ValueError(f"Unknown interface law {law!r}; valid: {self.LAWS}")
+        problem = {k: options.pop(k) for k in PROBLEM_OPTIONS if k in options}
+        super().__init__(cut, degree, materials, make_law(law, **options), **problem)
+
+
+class ElasticityProblem(_LawFamily):
     """Small-strain elasticity of the two sides with a ``free`` or ``bonded`` interface.
 
     Args:
-        cut, degree, materials, ghost_penalty, min_support_fraction: See :class:`Problem`.
-        interface: ``"free"`` or ``"bonded"``.
-        multiplier_stabilization, multiplier_extension: Options of ``bonded`` (see
-            :class:`~xfem_contact.mechanics.laws.MultiplierLaw`).
+        cut, degree, materials: See :class:`Problem`.
+        law: ``"free"`` (default) or ``"bonded"``.
+        options: Keyword-only: :class:`Problem`'s (``ghost_penalty``, ...) and the
+            law's (``lbb``, ``multiplier_stabilization``, ``multiplier_extension`` for
+            ``bonded``).
     """
 
     LAWS = INTERFACE_LAWS
 
     def __init__(
-        self,
-        cut: CutMesh,
-        degree: int,
-        materials: Materials,
-        interface: str = "free",
-        min_support_fraction: float | None = None,
-        ghost_penalty: float = 0.01,
-        multiplier_stabilization: float = 0.1,
-        multiplier_extension: float = 1e-12,
+        self, cut: CutMesh, degree: int, materials: Materials, law: str = "free", **options
     ):
-        if interface not in self.LAWS:
-            raise ValueError(f"Unknown interface law {interface!r}; valid: {self.LAWS}")
-        law = make_law(
-            interface,
-            multiplier_stabilization=multiplier_stabilization,
-            multiplier_extension=multiplier_extension,
-        )
-        super().__init__(
-            cut,
-            degree,
-            materials,
-            law,
-            ghost_penalty=ghost_penalty,
-            min_support_fraction=min_support_fraction,
-        )
+        super().__init__(cut, degree, materials, law, **options)
 
 
-class ContactProblem(Problem):
+class ContactProblem(_LawFamily):
     """Two-sided elasticity with a contact law on the interface, solved by SNES.
 
     Args:
-        cut, degree, materials, ghost_penalty: See :class:`Problem`.
+        cut, degree, materials: See :class:`Problem`.
         law: ``"frictionless"``, ``"coulomb"`` or ``"sticking"``.
-        friction: Coulomb coefficient (>= 0), required by ``"coulomb"``.
-        augmentation: Dimensionless factor of ``r = augmentation * E / h`` (> 0).
-        lbb: ``"stabilized"`` (default), ``"restriction"`` (vital vertices) or ``"none"``.
-        multiplier_stabilization, multiplier_extension: See
-            :class:`~xfem_contact.mechanics.laws.MultiplierLaw`.
+        options: Keyword-only: :class:`Problem`'s (``ghost_penalty``, ``kinematics``,
+            ``slave``, ``pairing``, ...) and the law's (``friction``, required by
+            ``"coulomb"``; ``augmentation``, ``lbb``, ``multiplier_stabilization``,
+            ``multiplier_extension``).
     """
 
     LAWS = CONTACT_LAWS
-
-    def __init__(
-        self,
-        cut: CutMesh,
-        degree: int,
-        materials: Materials,
-        law: str,
-        friction: float | None = None,
-        augmentation: float = 1.0,
-        lbb: str = "stabilized",
-        multiplier_stabilization: float = 0.1,
-        multiplier_extension: float = 1e-12,
-        ghost_penalty: float = 0.01,
-    ):
-        if law not in self.LAWS:
-            raise ValueError(f"Unknown interface law {law!r}; valid: {self.LAWS}")
-        interface_law = make_law(
-            law,
-            friction=friction,
-            augmentation=augmentation,
-            lbb=lbb,
-            multiplier_stabilization=multiplier_stabilization,
-            multiplier_extension=multiplier_extension,
-        )
-        super().__init__(cut, degree, materials, interface_law, ghost_penalty=ghost_penalty)

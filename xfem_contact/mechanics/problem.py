@@ -10,7 +10,7 @@ dofs of the restriction ``R`` (:mod:`xfem_contact.fem.restriction`). SI units (P
 
 from __future__ import annotations
 
-import dataclasses
+import time
 import weakref
 from collections.abc import Callable, Mapping
 
@@ -26,27 +26,18 @@ from xfem_contact.fem.forms import form
 from xfem_contact.fem.restriction import restriction_matrix
 from xfem_contact.mechanics.bulk import BULK_MODELS, KINEMATICS, cell_size, check_ghosts
 from xfem_contact.mechanics.composition import Materials, interface_laws, side_and_law_materials
+from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw, large_sliding
 from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loads import Loads, SideFields
+from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
 from xfem_contact.solvers.linear import solve_restricted
-from xfem_contact.solvers.newton import NewtonFailure, NewtonReport, RestrictedNewton
+from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton
 from xfem_contact.solvers.options import merged_options
+from xfem_contact.solvers.report import SolveReport
 from xfem_contact.solvers.symmetry import symmetric_options
-
-
-@dataclasses.dataclass
-class Solution:
-    """Displacements per side (m) and the multipliers (Pa) of a linear solve."""
-
-    w: dolfinx.fem.Function
-    space: EnrichedSpace
-
-    def field(self, i: int) -> dolfinx.fem.Function:
-        """Collapsed copy of field ``i``: 0 side -1, 1 side +1, 2.. multipliers."""
-        return self.space.field(self.w, i)
 
 
 class Problem:
@@ -58,8 +49,8 @@ class Problem:
             the cut cells (the paper's P2-P1 element for degree 2).
         materials: One :class:`Material`, or ``{-1: inside, 1: outside}``; with several
             interfaces ``inside`` may be ``{interface name: Material}``.
-        interfaces: A law (object or name) for every interface, or
-            ``{interface name: law}`` (names of ``cut.interface_names``).
+        law: A law (object or name) for every interface, or ``{interface name: law}``
+            (names of ``cut.interface_names``).
         ghost_penalty: Weight of the ghost penalty (see :class:`SmallStrain`).
         min_support_fraction: See :class:`EnrichedSpace`. Default: keep every dof
             when the ghost penalty is on (it defines the field's extension over empty
@@ -80,22 +71,25 @@ class Problem:
         cut: CutMesh,
         degree: int,
         materials: Materials,
-        interfaces: InterfaceLaw | str | Mapping[str, InterfaceLaw | str] = "free",
+        law: InterfaceLaw | str | Mapping[str, InterfaceLaw | str] = DEFAULT.law,
         *,
-        ghost_penalty: float = 0.01,
-        min_support_fraction: float | None = None,
-        kinematics: str = "small",
-        slave: int = -1,
-        pairing: str = "iterate",
+        ghost_penalty: float = DEFAULT.ghost_penalty,
+        min_support_fraction: float | None = DEFAULT.min_support_fraction,
+        kinematics: str = DEFAULT.kinematics,
+        slave: int = DEFAULT.slave,
+        pairing: str = DEFAULT.pairing,
     ):
         if kinematics not in KINEMATICS:
             raise ValueError(f"Unknown kinematics {kinematics!r}; valid: {KINEMATICS}")
         self.cut, self.mesh = cut, cut.mesh
         self.kinematics = kinematics
-        self.laws = interface_laws(cut, interfaces)
+        self.laws = interface_laws(cut, law)
         if kinematics == "large":
             self.laws = {n: large_sliding(law, slave, pairing) for n, law in self.laws.items()}
-        side_materials, law_materials = side_and_law_materials(cut, materials)
+        #: Parameters of the laws are Constants of this problem's forms: set them on
+        #: ``problem.law(name)`` (a law object given to a problem on another mesh is copied)
+        self.laws = {n: bound_copy(law, self.mesh) for n, law in self.laws.items()}
+        side_materials = side_and_law_materials(cut, materials)
         if min_support_fraction is None:
             min_support_fraction = 0.0 if ghost_penalty > 0 else 1e-12
         gdim = self.mesh.geometry.dim
@@ -112,14 +106,17 @@ class Problem:
         self.cell_size = cell_size(self.mesh)
         self.side_indicator = cut.side_indicator()
         bulk = BULK_MODELS[kinematics]
-        self.bulk = bulk(cut, side_materials, degree, self.cell_size, ghost_penalty)
-        self.materials = side_materials
+        self.bulk = bulk(cut, side_materials.bulk, degree, self.cell_size, ghost_penalty)
+        #: The materials as Constants of the forms, ``{-1: Moduli or {interface name:
+        #: Moduli}, 1: Moduli}``: set ``E`` or ``nu`` on them (no new compile)
+        self.materials = side_materials.user
         self.w = dolfinx.fem.Function(self.space.W, name="w")
         #: The last accepted load step (its jump is the origin of incremental slips)
         self.w_old = dolfinx.fem.Function(self.space.W, name="w_old")
         fields = {name: field for field, _, name in self.space.multiplier_fields}
         self.contexts = {
-            name: self._context(name, law_materials[name], fields.get(name)) for name in self.laws
+            name: self._context(name, side_materials.laws[name], fields.get(name))
+            for name in self.laws
         }
         self._newton: RestrictedNewton | None = None
         self._newton_key = None
@@ -171,8 +168,13 @@ class Problem:
 
     @property
     def ghost_penalty(self) -> float:
-        """Weight of the ghost penalty."""
+        """Weight of the ghost penalty (a Constant of the forms: settable, see
+        :class:`~xfem_contact.mechanics.bulk.SmallStrain`)."""
         return self.bulk.ghost_penalty
+
+    @ghost_penalty.setter
+    def ghost_penalty(self, value: float) -> None:
+        self.bulk.ghost_penalty = value
 
     @property
     def linear(self) -> bool:
@@ -254,12 +256,13 @@ class Problem:
 
     def solve(
         self, petsc_options: dict | None = None, log: Callable[[str], None] | None = None
-    ) -> Solution | NewtonReport:
+    ) -> SolveReport:
         """Solve on the active dofs; ``self.w`` holds the result. Collective.
 
-        Linear problems: one KSP solve, returns a :class:`Solution`. With a contact
-        law: generalized Newton (SNES) from ``self.w``, a ``log`` line per iterate,
-        returns the :class:`~xfem_contact.solvers.newton.NewtonReport`. The Newton
+        Linear problems: one KSP solve. With a contact law: generalized Newton
+        (SNES) from ``self.w``, a ``log`` line per iterate. Either way returns a
+        :class:`~xfem_contact.solvers.report.SolveReport` (the solution ``w``, its
+        fields, iterations, residual history, reason). The Newton
         solver is kept between solves and rebuilt when loads, Dirichlet conditions
         or ``petsc_options`` changed since.
 
@@ -280,9 +283,15 @@ class Problem:
         petsc_options = symmetric_options(petsc_options, self.symmetric)
         if self.linear:
             a, L = form(self.bilinear_form()), form(self.loads.linear_form())
-            w, _ = solve_restricted(a, L, self.loads.bcs, self.space, petsc_options)
+            start, residuals = time.perf_counter(), []
+            w, reason = solve_restricted(
+                a, L, self.loads.bcs, self.space, petsc_options, residuals=residuals
+            )
             self.w.x.array[:] = w.x.array
-            return Solution(w, self.space)
+            elapsed = time.perf_counter() - start
+            return SolveReport(
+                residuals, reason=reason, total_time=elapsed, w=self.w, space=self.space
+            )
         key = (self.loads.revision, repr(sorted((petsc_options or {}).items())))
         if self._newton is not None and key != self._newton_key:
             self._newton.destroy()  # loads or solver options changed since it was built
@@ -312,6 +321,7 @@ class Problem:
         try:
             report = self._newton.solve()
             self._rotated_at = t
+            report.w, report.space = self.w, self.space
             return report
         except NewtonFailure as failure:
             self.w.x.array[:] = accepted  # the state before this solve, not the diverged one
@@ -327,7 +337,7 @@ class Problem:
         return {} if self._newton is None else dict(self._newton.timings)
 
     @property
-    def last_report(self) -> NewtonReport | None:
+    def last_report(self) -> SolveReport | None:
         """The report of the last Newton solve (None before the first)."""
         return None if self._newton is None else self._newton.report
 

@@ -19,8 +19,9 @@ class InterfaceSpec:
     params: dict
     name: str = "interface"
     friction: float | None = None
-    augmentation: float = 1.0
-    lbb: str = "stabilized"
+    #: None: the law's default (:data:`~xfem_contact.mechanics.defaults.DEFAULTS`)
+    augmentation: float | None = None
+    lbb: str | None = None
     kinematics: str = "small"
     slave: int = -1
     pairing: str = "iterate"

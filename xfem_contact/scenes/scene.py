@@ -39,7 +39,7 @@ import pathlib
 import re
 import tomllib
 
-from xfem_contact.mechanics.laws import LINEAR_LAWS, SLIDING_LAWS
+from xfem_contact.mechanics.laws import LAW_OPTIONS, LINEAR_LAWS, SLIDING_LAWS
 from xfem_contact.mechanics.laws.sliding import SLIDING_LBB
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
@@ -231,6 +231,12 @@ def _interface(table, k: int, materials: dict) -> InterfaceSpec:
     law = table.get("law", "bonded")
     if law == "coulomb" and "friction" not in table:
         raise SceneError(f"{where}.friction", "required for law 'coulomb' (coefficient >= 0)")
+    for key in ("friction", "augmentation", "lbb"):
+        if key in table and key not in LAW_OPTIONS[law]:
+            options = ", ".join(LAW_OPTIONS[law]) or "none"
+            raise SceneError(
+                f"{where}.{key}", f"is not an option of law {law!r} (its options: {options})"
+            )
     kinematics = table.get("kinematics", "small")
     slave = _sides(table, kinematics, where)
     if kinematics == "large":
@@ -257,8 +263,8 @@ def _interface(table, k: int, materials: dict) -> InterfaceSpec:
         inside=table.get("inside", first),
         outside=table.get("outside", first),
         friction=table.get("friction"),
-        augmentation=float(table.get("augmentation", 1.0)),
-        lbb=table.get("lbb", "stabilized"),
+        augmentation=table.get("augmentation"),
+        lbb=table.get("lbb"),
         kinematics=kinematics,
         slave=slave,
         pairing=table.get("pairing", "iterate"),

@@ -67,6 +67,7 @@ def solve_restricted(
     petsc_options: dict | None = None,
     petsc_options_prefix: str = "xfem_linear_",
     R: PETSc.Mat | None = None,
+    residuals: list[float] | None = None,
 ) -> tuple[dolfinx.fem.Function, int]:
     """Solve ``a(u, v) = L(v)`` on the reduced space of ``R`` (one KSP solve).
 
@@ -84,6 +85,8 @@ def solve_restricted(
         R: Restriction operator, global shape ``(dim W, n_reduced)``; by default
             ``restriction_matrix(space)`` (the active dofs), built and destroyed
             here. A given ``R`` is not destroyed.
+        residuals: If given, the norms of the scaled reduced residual before and
+            after the solve are appended to it (``|D b|``, ``|D b - D A D y_s|``).
 
     Returns:
         The solution ``x = R y`` on ``space.W`` (zero on inactive dofs, ghosts
@@ -117,6 +120,12 @@ def solve_restricted(
     y = R.createVecRight()
     with applied_options(prefix, options):  # the factorisation reads options too
         ksp.solve(b, y)
+    if residuals is not None:
+        r = b.duplicate()
+        A.mult(y, r)
+        r.axpy(-1.0, b)
+        residuals += [b.norm(), r.norm()]
+        r.destroy()
     y.pointwiseMult(y, D)
     w = dolfinx.fem.Function(space.W)
     R.mult(y, w.x.petsc_vec)

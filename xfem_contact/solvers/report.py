@@ -1,18 +1,20 @@
-"""What a Newton solve reports: the history of its iterates, and the failure that
-carries it (:mod:`xfem_contact.solvers.newton`)."""
+"""What a solve reports: the solution, the history of its iterates (one for a linear
+solve), and the failure that carries it (:mod:`xfem_contact.solvers.newton`)."""
 
 from __future__ import annotations
 
 import dataclasses
+import typing
 
 
 @dataclasses.dataclass
-class NewtonReport:
-    """History of one solve: residual norms and per-iterate status lines.
+class SolveReport:
+    """One solve: the solution, residual norms and per-iterate status lines.
 
     Attributes:
         residuals: Norm of the scaled reduced residual ``D R^T F`` at each iterate,
-            the initial one first (``iterations + 1`` entries).
+            the initial one first (``iterations + 1`` entries; a linear solve has
+            two: before and after).
         status: The status callback's dict at each iterate (same length).
         reason: SNES converged reason (> 0 converged, < 0 diverged).
         final_residual: The residual norm evaluated after the solve (checked
@@ -30,6 +32,20 @@ class NewtonReport:
     assembly_time: float = 0.0
     status_time: float = 0.0
     total_time: float = 0.0
+    #: The solution on the problem's mixed space (set by ``Problem.solve``)
+    w: typing.Any = None
+    #: The problem's enriched space (for :meth:`field`)
+    space: typing.Any = dataclasses.field(default=None, repr=False)
+
+    @property
+    def converged(self) -> bool:
+        """Whether the solve converged (``reason > 0``)."""
+        return self.reason > 0
+
+    def field(self, i: int):
+        """Collapsed copy of field ``i`` of :attr:`w`: 0 side -1, 1 side +1, 2..
+        multipliers."""
+        return self.space.field(self.w, i)
 
     @property
     def linear_solve_time(self) -> float:
@@ -53,9 +69,13 @@ class NewtonReport:
         return "\n".join(lines)
 
 
+#: The report of a Newton solve (the same type)
+NewtonReport = SolveReport
+
+
 class NewtonFailure(RuntimeError):
     """Newton did not converge; ``report`` holds the iteration history."""
 
-    def __init__(self, message: str, report: NewtonReport):
+    def __init__(self, message: str, report: SolveReport):
         super().__init__(f"{message}\n{report.table()}")
         self.report = report

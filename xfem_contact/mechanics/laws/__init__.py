@@ -11,6 +11,8 @@ A new law subclasses :class:`InterfaceLaw` (or :class:`MultiplierLaw`) and is li
 in :data:`LAWS`.
 """
 
+import inspect
+
 from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw
 from xfem_contact.mechanics.laws.bonding import Bonded, Free
 from xfem_contact.mechanics.laws.contact import ContactLaw, Coulomb, Frictionless, Sticking
@@ -32,38 +34,45 @@ LINEAR_LAWS = tuple(name for name, law in LAWS.items() if law.linear)
 CONTACT_LAWS = tuple(name for name, law in LAWS.items() if not law.linear)
 
 
-def make_law(name: str, **options) -> InterfaceLaw:
-    """The law called ``name`` with its options.
+def law_options(law: type[InterfaceLaw]) -> tuple[str, ...]:
+    """The options a law class takes (the named arguments of its constructors)."""
+    names: list[str] = []
+    for cls in law.__mro__:
+        init = vars(cls).get("__init__")
+        if init is None:
+            continue
+        for p in inspect.signature(init).parameters.values():
+            if p.name != "self" and p.kind is p.POSITIONAL_OR_KEYWORD and p.name not in names:
+                names.append(p.name)
+    return tuple(names)
 
-    Options: ``friction`` (``coulomb``; ``None`` or a coefficient >= 0 is accepted
-    and unused by the other laws), ``augmentation`` (contact laws; unused by
-    ``free``/``bonded``), ``lbb``, ``multiplier_stabilization`` and
-    ``multiplier_extension`` (laws with a multiplier; unused by ``free``).
-    Any other option raises a ValueError naming it.
+
+#: The options of each law by name
+LAW_OPTIONS: dict[str, tuple[str, ...]] = {name: law_options(law) for name, law in LAWS.items()}
+
+
+def make_law(name: str, **options) -> InterfaceLaw:
+    """The law called ``name`` with its options (an option given as ``None`` is
+    absent: the law's default holds).
+
+    Raises:
+        ValueError: for an unknown law, or an option the law does not take (naming
+            the law's options), or an invalid value.
     """
     if name not in LAWS:
         raise ValueError(f"Unknown interface law {name!r}; valid: {tuple(LAWS)}")
-    law = LAWS[name]
-    options = dict(options)
-    friction = options.pop("friction", None)
-    if friction is not None and not friction >= 0.0:
-        raise ValueError(f"The friction coefficient must be >= 0, got {friction}")
-    if law is Coulomb:
-        options["friction"] = friction
-    if not issubclass(law, ContactLaw):
-        options.pop("augmentation", None)
-    if not issubclass(law, MultiplierLaw):
-        for key in ("lbb", "multiplier_stabilization", "multiplier_extension"):
-            options.pop(key, None)
-    try:
-        return law(**options)
-    except TypeError:
-        raise ValueError(f"The {name!r} law takes no option(s) {sorted(options)}") from None
+    options = {k: v for k, v in options.items() if v is not None}
+    unknown = sorted(set(options) - set(LAW_OPTIONS[name]))
+    if unknown:
+        valid = LAW_OPTIONS[name] or "none"
+        raise ValueError(f"The {name!r} law takes no option {unknown}; its options: {valid}")
+    return LAWS[name](**options)
 
 
 __all__ = [
     "CONTACT_LAWS",
     "LAWS",
+    "LAW_OPTIONS",
     "LBB_OPTIONS",
     "LINEAR_LAWS",
     "Bonded",
@@ -80,6 +89,7 @@ __all__ = [
     "SlidingCoulomb",
     "SlidingFrictionless",
     "large_sliding",
+    "law_options",
     "Sticking",
     "make_law",
 ]

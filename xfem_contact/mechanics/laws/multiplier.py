@@ -18,8 +18,10 @@ from __future__ import annotations
 
 import ufl
 
+from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw
 from xfem_contact.mechanics.lbb_space import vital_vertex_prolongation
+from xfem_contact.mechanics.parameters import Parameter, constant
 
 LBB_OPTIONS = ("stabilized", "restriction", "none")
 #: Weight of the normal-gradient term on cells where the interface follows a reference
@@ -33,22 +35,35 @@ class MultiplierLaw(InterfaceLaw):
     Args:
         lbb: ``"stabilized"``, ``"restriction"`` or ``"none"``.
         multiplier_stabilization: Weight ``gamma`` of the Barbosa-Hughes term
-            (used with ``lbb="stabilized"``); 0 disables it.
+            (used with ``lbb="stabilized"``); a Constant of the forms.
         multiplier_extension: Weight of the normal-gradient term (see
-            :meth:`extension_form`; not with ``lbb="none"``); 0 disables it.
+            :meth:`extension_form`; not with ``lbb="none"``); a Constant of the forms.
     """
+
+    multiplier_stabilization = Parameter(minimum=0.0)
+    multiplier_extension = Parameter(minimum=0.0)
 
     def __init__(
         self,
-        lbb: str = "stabilized",
-        multiplier_stabilization: float = 0.1,
-        multiplier_extension: float = 1e-12,
+        lbb: str = DEFAULT.lbb,
+        multiplier_stabilization: float = DEFAULT.multiplier_stabilization,
+        multiplier_extension: float = DEFAULT.multiplier_extension,
     ):
         if lbb not in LBB_OPTIONS:
             raise ValueError(f"Unknown LBB treatment {lbb!r}; valid: {LBB_OPTIONS}")
         self.lbb = lbb
-        self.multiplier_stabilization = multiplier_stabilization if lbb == "stabilized" else 0.0
-        self.multiplier_extension = multiplier_extension if lbb != "none" else 0.0
+        self.multiplier_stabilization = multiplier_stabilization
+        self.multiplier_extension = multiplier_extension
+
+    @property
+    def stabilized(self) -> bool:
+        """Whether the forms hold the Barbosa-Hughes term (``lbb="stabilized"``)."""
+        return self.lbb == "stabilized"
+
+    @property
+    def extended(self) -> bool:
+        """Whether the forms hold the normal-gradient term (not with ``lbb="none"``)."""
+        return self.lbb != "none"
 
     def describe(self) -> dict:
         return super().describe() | {"lbb": self.lbb}
@@ -60,14 +75,14 @@ class MultiplierLaw(InterfaceLaw):
 
     # -- LBB terms ----------------------------------------------------------------------
     @staticmethod
-    def traction_weights(ctx: InterfaceContext) -> tuple[float, float]:
+    def traction_weights(ctx: InterfaceContext) -> tuple:
         """Weights ``(w_-, w_+)`` of the sides in the interface traction average:
         ``w_- = mu_+ / (mu_- + mu_+)``, ``w_+ = mu_- / (mu_- + mu_+)`` (1/2 each for
         one material). The softer side weighs more, as in weighted Nitsche methods:
         with the plain mean, a 1000 times stiffer inclusion under hydrostatic
         pressure had a contact pressure oscillating by 180 % (part of the interface
         even opened); weighted, it is smooth to 2 % at h = 0.05 and converges."""
-        mu_minus, mu_plus = ctx.materials[-1].mu, ctx.materials[1].mu
+        mu_minus, mu_plus = ctx.materials[-1].ufl_mu, ctx.materials[1].ufl_mu
         return mu_plus / (mu_minus + mu_plus), mu_minus / (mu_minus + mu_plus)
 
     def interface_traction(self, ctx: InterfaceContext, u: Fields) -> ufl.core.expr.Expr:
@@ -83,8 +98,8 @@ class MultiplierLaw(InterfaceLaw):
         (UFL): ``gamma h / (2 mu)`` for one material; for two, the shear modulus the
         weighted traction average sees (see :meth:`traction_weights`)."""
         w_minus, w_plus = self.traction_weights(ctx)
-        shear = w_minus**2 * ctx.materials[-1].mu + w_plus**2 * ctx.materials[1].mu
-        return self.multiplier_stabilization * ctx.cell_size / (4.0 * shear)
+        shear = w_minus**2 * ctx.materials[-1].ufl_mu + w_plus**2 * ctx.materials[1].ufl_mu
+        return constant(self, "multiplier_stabilization") * ctx.cell_size / (4.0 * shear)
 
     def stabilization_form(self, ctx: InterfaceContext, lam, mu, u: Fields, v: Fields):
         """Barbosa-Hughes term ``s int (lambda - t(u)).(mu - t(v))`` (``s`` the
@@ -122,8 +137,8 @@ class MultiplierLaw(InterfaceLaw):
         ``lam``, ``mu``: multiplier (scalar or vector) trial/test or coefficient.
         """
         n = ctx.normal
-        shear = 0.5 * (ctx.materials[-1].mu + ctx.materials[1].mu)
-        weight = self.multiplier_extension * ctx.cut_cells
+        shear = 0.5 * (ctx.materials[-1].ufl_mu + ctx.materials[1].ufl_mu)
+        weight = constant(self, "multiplier_extension") * ctx.cut_cells
         if ctx.aligned_cells is not None:
             weight = weight + ALIGNED_EXTENSION * ctx.aligned_cells
         scale = weight * ctx.cell_size**2 / (2.0 * shear)
@@ -134,8 +149,8 @@ class MultiplierLaw(InterfaceLaw):
         """The LBB terms to subtract from the residual: extension and stabilisation
         (``lam``, ``mu``: Cartesian multiplier vectors of ``u``, ``v``), or None."""
         terms = []
-        if self.multiplier_extension > 0:
+        if self.extended:
             terms.append(self.extension_form(ctx, u.multiplier, v.multiplier))
-        if self.multiplier_stabilization > 0:
+        if self.stabilized:
             terms.append(self.stabilization_form(ctx, lam, mu, u, v))
         return sum(terms[1:], terms[0]) if terms else None

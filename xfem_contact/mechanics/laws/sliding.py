@@ -20,8 +20,10 @@ import numpy as np
 import ufl
 from ufl.algorithms import extract_arguments, extract_coefficients
 
+from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw
 from xfem_contact.mechanics.laws.contact import ContactLaw, Coulomb, Frictionless
+from xfem_contact.mechanics.parameters import constant
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES, SlidingCoupling
 
 #: The laws available in large sliding (by their small-sliding name)
@@ -47,10 +49,14 @@ class SlidingContact(ContactLaw):
 
     #: Large sliding
     sliding = True
-    #: Coulomb coefficient (None: frictionless)
-    friction: float | None = None
 
-    def __init__(self, slave: int = -1, pairing: str = "iterate", radius=None, **options):
+    def __init__(
+        self,
+        slave: int = DEFAULT.slave,
+        pairing: str = DEFAULT.pairing,
+        radius: float | None = None,
+        **options,
+    ):
         super().__init__(**options)
         if self.lbb not in SLIDING_LBB:
             raise ValueError(
@@ -93,14 +99,13 @@ class SlidingContact(ContactLaw):
 
     def residual(self, ctx: InterfaceContext, u: Fields, v: Fields):
         terms = []
-        if self.multiplier_extension > 0:
+        if self.extended:
             terms.append(-self.extension_form(ctx, u.multiplier, v.multiplier))
-        if self.multiplier_stabilization > 0:
+        if self.stabilized:
             (w,) = extract_coefficients(u.multiplier)
             (test,) = extract_arguments(v.multiplier)
-            scale = (
-                self.multiplier_stabilization * ctx.cell_size / (2.0 * ctx.materials[self.slave].mu)
-            )
+            gamma = constant(self, "multiplier_stabilization")
+            scale = gamma * ctx.cell_size / (2.0 * ctx.materials[self.slave].ufl_mu)
             T_n, T_t = self.slave_traction(ctx, u)
             lam_n, lam_t = self.multipliers(u)
             misfit = (lam_n - T_n) ** 2
@@ -159,20 +164,23 @@ class SlidingCoulomb(SlidingContact):
     name = "coulomb"
     incremental = True
 
-    def __init__(self, friction: float, **options):
-        if friction is None or not friction >= 0.0:
-            raise ValueError(f"The friction coefficient must be >= 0, got {friction}")
+    friction = Coulomb.friction
+
+    def __init__(self, friction: float | None = None, **options):
+        if friction is None:
+            raise ValueError("The 'coulomb' law needs a friction coefficient (friction=...)")
         super().__init__(**options)
         self.friction = friction
 
     def describe(self) -> dict:
         return super().describe() | {"friction": self.friction}
 
-    def friction_bound(self, P_n, ops):
-        return -self.friction * P_n
+    friction_bound = Coulomb.friction_bound
 
 
-def large_sliding(law: InterfaceLaw, slave: int = -1, pairing: str = "iterate") -> InterfaceLaw:
+def large_sliding(
+    law: InterfaceLaw, slave: int = DEFAULT.slave, pairing: str = DEFAULT.pairing
+) -> InterfaceLaw:
     """The large-sliding version of a law: contact laws become their hybrid-element
     counterparts; ``free`` and ``bonded`` (no relative motion or none resisted) stay.
 
@@ -193,9 +201,8 @@ def large_sliding(law: InterfaceLaw, slave: int = -1, pairing: str = "iterate") 
         "augmentation": law.augmentation,
         "lbb": law.lbb,
         "multiplier_extension": law.multiplier_extension,
+        "multiplier_stabilization": law.multiplier_stabilization,
     }
-    if law.lbb == "stabilized":
-        options["multiplier_stabilization"] = law.multiplier_stabilization
     if isinstance(law, Coulomb):
         return SlidingCoulomb(law.friction, **options)
     return SlidingFrictionless(**options)

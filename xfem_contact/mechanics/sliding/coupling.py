@@ -70,7 +70,7 @@ class SlidingCoupling:
         self.slave_dofs = _flat(cell_dofs(V_s, cells))  # (m, nodes x components)
         self.lam_dofs = _flat(cell_dofs(V_l, cells))
         h = ctx.cell_size_at()
-        self.r = law.augmentation_coefficient(ctx, h)
+        self._materials, self._h = ctx.materials, h
         self.radius = radius or self.comm.allreduce(float(h.max(initial=0.0)), op=MPI.MAX)
         tdim = cut.mesh.topology.dim
         self.slave_cells = cut.mesh.topology.index_map(tdim).local_to_global(cells)
@@ -79,8 +79,6 @@ class SlidingCoupling:
         self._frozen: np.ndarray | None = None
         self._accepted_cells: np.ndarray | None = None
         self._merged: set = set()
-        #: Coulomb coefficient (None: frictionless, analytic Jacobian)
-        self.friction = getattr(law, "friction", None) if law.tangential else None
         #: Frictionless through the complex-step element too (a cross-check)
         self.complex_step = False
         #: ``(slip increment (m), lambda_t, P_t (Pa))`` at the points (Coulomb)
@@ -89,6 +87,17 @@ class SlidingCoupling:
         self._coo: tuple | None = None
         #: Pairing counts of the last evaluation (global): paired, unpaired, changed
         self.counts: dict[str, int] = {}
+
+    @property
+    def r(self) -> np.ndarray:
+        """The augmentation ``r`` (Pa/m) at the slave points, ``(npoints,)``, from the
+        law's current parameters."""
+        return self.law.augmentation_coefficient(self._materials, self._h)
+
+    @property
+    def friction(self) -> float | None:
+        """The law's current Coulomb coefficient (None: frictionless, analytic Jacobian)."""
+        return self.law.friction if self.law.tangential else None
 
     # -- set-up ----------------------------------------------------------------------
     def bind(self, columns: np.ndarray, bcs: list) -> None:

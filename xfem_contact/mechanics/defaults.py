@@ -1,0 +1,40 @@
+"""Every default of a problem and of its interface laws, in one table.
+
+Constructors, the scene schema and the docs read their defaults from :data:`DEFAULTS`
+(as FFCx's ``options.py`` does), so that a default is written once.
+"""
+
+from __future__ import annotations
+
+import types
+import typing
+
+
+class Default(typing.NamedTuple):
+    """A default value and what it means."""
+
+    value: typing.Any
+    doc: str
+
+
+#: Defaults by option name
+DEFAULTS: dict[str, Default] = {
+    "law": Default("free", "interface law of a Problem (scenes: 'bonded')"),
+    "kinematics": Default(
+        "small", "'small' (linear elasticity) or 'large' (Saint Venant-Kirchhoff)"
+    ),
+    "ghost_penalty": Default(0.01, "dimensionless weight of the ghost penalty (0: none)"),
+    "min_support_fraction": Default(
+        None, "enriched dofs kept down to this cut fraction (None: all with the ghost penalty)"
+    ),
+    "augmentation": Default(1.0, "dimensionless factor of r = augmentation E / h (contact laws)"),
+    "lbb": Default("stabilized", "LBB treatment: 'stabilized', 'restriction' or 'none'"),
+    "multiplier_stabilization": Default(0.1, "weight of the Barbosa-Hughes term"),
+    "multiplier_extension": Default(1e-12, "weight of the multiplier's normal-gradient term"),
+    "slave": Default(-1, "slave side of large sliding (-1 or +1)"),
+    "pairing": Default("iterate", "large-sliding pairing: at every 'iterate' or once a 'step'"),
+}
+
+
+#: The default values as attributes (``DEFAULT.ghost_penalty``), for signatures
+DEFAULT = types.SimpleNamespace(**{name: d.value for name, d in DEFAULTS.items()})
