@@ -101,7 +101,10 @@ class CutMesh:
         #: Names of the interfaces, in the order of their measure ids
         self.interface_names: tuple[str, ...] = names
         self._components = components
-        self.levelset: LevelSet = interpolate(mesh, levelset, self.degree)
+        previous = getattr(self, "levelset", None)  # kept: forms keep their signatures
+        self.levelset: LevelSet = interpolate(
+            mesh, levelset, self.degree, into=None if previous is None else previous.function
+        )
         maps = CellMaps(mesh, self.levelset)
         num_owned = mesh.topology.index_map(tdim).size_local
         owned = np.arange(num_owned, dtype=np.int32)

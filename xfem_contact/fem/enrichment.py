@@ -174,6 +174,11 @@ class EnrichedSpace:
         total = self._mark(field, np.arange(areas.size, dtype=np.int32), areas)
         return np.divide(on_side, total, out=np.zeros_like(total), where=total > 0)
 
+    def refresh(self) -> None:
+        """Recompute the active dofs after the cut was updated (``W`` is kept).
+        Collective."""
+        self._active = self._active_dofs()
+
     @property
     def active(self) -> npt.NDArray[np.bool_]:
         """Active flags of the local (owned + ghost) dofs of ``W``."""

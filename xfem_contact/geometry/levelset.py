@@ -44,6 +44,7 @@ def interpolate(
     mesh: dolfinx.mesh.Mesh,
     levelset: LevelSetCallable | dolfinx.fem.Function,
     degree: int,
+    into: dolfinx.fem.Function | None = None,
 ) -> LevelSet:
     """Interpolate a level set into scalar Lagrange of ``degree`` (1 or 2). Collective.
 
@@ -52,6 +53,9 @@ def interpolate(
         levelset: A callable ``phi(x)`` with ``x`` of shape ``(3, n)``, or a
             scalar DOLFINx Function on ``mesh`` (its nodal values are the data).
         degree: 1 or 2.
+        into: A Function of that space to hold the values (a moved interface keeps
+            its level-set Function, so that forms using it keep their signature);
+            written only once the values are checked. Default: a new one.
 
     Raises:
         ValueError: for a degree other than 1 or 2, NaN/inf values, or a level
@@ -95,6 +99,9 @@ def interpolate(
             f"The level set never crosses zero on the mesh (its nodal values lie in "
             f"[{lo:.6g}, {hi:.6g}]): there is no interface; the side phi < 0 is side -1"
         )
+    if into is not None:
+        into.x.array[:] = phi.x.array
+        phi = into
     return LevelSet(phi, exact)
 
 

@@ -104,7 +104,6 @@ class Problem:
         #: Loads, supports and Dirichlet data (``loads.bcs``), and the pseudo-time
         self.loads = Loads(SideFields(self.space))
         self.cell_size = cell_size(self.mesh)
-        self.side_indicator = cut.side_indicator()
         bulk = BULK_MODELS[kinematics]
         self.bulk = bulk(cut, side_materials.bulk, degree, self.cell_size, ghost_penalty)
         #: The materials as Constants of the forms, ``{-1: Moduli or {interface name:
@@ -113,23 +112,71 @@ class Problem:
         self.w = dolfinx.fem.Function(self.space.W, name="w")
         #: The last accepted load step (its jump is the origin of incremental slips)
         self.w_old = dolfinx.fem.Function(self.space.W, name="w_old")
-        fields = {name: field for field, _, name in self.space.multiplier_fields}
-        self.contexts = {
-            name: self._context(name, side_materials.laws[name], fields.get(name))
-            for name in self.laws
-        }
+        self._law_materials = side_materials.laws
         self._newton: RestrictedNewton | None = None
         self._newton_key = None
-        self._checked_loads: int | None = None
-        self._cut_revision = cut.revision
         #: Pseudo-time of the rotations that the bodies of ``w`` have turned by
         self._rotated_at = 0.0
+        self._attach_cut()
+
+    def _attach_cut(self) -> None:
+        """(Re)build what follows the current cut: side indicator, the laws' contexts
+        and couplings; the Newton solver is rebuilt at the next solve. Collective."""
+        side = self.cut.side_indicator()
+        if hasattr(self, "side_indicator"):  # kept, so that the forms keep their signature
+            self.side_indicator.x.array[:] = side.x.array
+        else:
+            self.side_indicator = side
+        fields = {name: field for field, _, name in self.space.multiplier_fields}
+        self.contexts = {
+            name: self._context(name, self._law_materials[name], fields.get(name))
+            for name in self.laws
+        }
         #: Terms of laws coupling two cells (large sliding), assembled outside UFL
         self.couplings = {
             name: c
             for name, law in self.laws.items()
             if (c := law.coupling(self.contexts[name])) is not None
         }
+        if self._newton is not None:
+            self._newton.destroy()
+            self._newton = None
+        self._checked_loads: int | None = None
+        self._cut_revision = self.cut.revision
+
+    def update_interface(self, levelset) -> None:
+        """Move the interfaces: cut the mesh with ``levelset`` (as
+        :meth:`~xfem_contact.fem.cutmesh.CutMesh.update`; the same interface names)
+        and keep everything else: loads, supports, laws and their parameters, the
+        mixed space ``W``. Forms are re-created from the compiled ones (nothing is
+        compiled unless the new cut adds an integral the old one had none of).
+
+        The next solve starts from the previous solution carried onto the new
+        active dofs (a warm start): a dof that becomes active on one side takes the
+        value of the other side's field at the same node when that one was active
+        (the displacement continued across the old interface), otherwise 0;
+        multipliers of new cut cells start at 0; inactive dofs are zeroed. The last
+        accepted state ``w_old`` (the origin of Coulomb's slip increments) is
+        carried the same way, so a moved Coulomb interface keeps its history where
+        the two positions overlap. Collective.
+        """
+        before = self.space.active.copy()
+        self.cut.update(levelset)
+        self.space.refresh()
+        self._attach_cut()
+        for w in (self.w, self.w_old):
+            self._carry(w, before)
+
+    def _carry(self, w: dolfinx.fem.Function, before: np.ndarray) -> None:
+        """Carry ``w`` from the active dofs ``before`` onto the current ones (see
+        :meth:`update_interface`)."""
+        active = self.space.active
+        minus, plus = (self.space.field_space(i)[1] for i in (0, 1))
+        for mine, other in ((minus, plus), (plus, minus)):
+            take = active[mine] & ~before[mine] & before[other]
+            w.x.array[mine[take]] = w.x.array[other[take]]
+        w.x.array[~active] = 0.0
+        w.x.scatter_forward()
 
     def _context(self, name: str, materials: dict, field: int | None) -> InterfaceContext:
         cut = self.cut
@@ -275,7 +322,8 @@ class Problem:
             raise ValueError(
                 "The cut changed (cut.update) after this problem was built: its enriched "
                 f"space, rules and forms follow the old interface (cut revision "
-                f"{self._cut_revision}, now {self.cut.revision}); build a new Problem"
+                f"{self._cut_revision}, now {self.cut.revision}); move interfaces with "
+                "problem.update_interface(levelset)"
             )
         if self._checked_loads != self.loads.revision:  # again only when the loads changed
             check_support(self, log)
