@@ -62,7 +62,7 @@ def test_without_point_constraints_the_plate_and_inclusion_are_free():
     assert message.startswith(
         f"{OUTSIDE}: translations x, y and rotation about (0.5, 0.5) are not constrained "
         "(no Dirichlet condition; interface 'interface' is sticking: it ties the two sides; "
-        f"it moves together with {INSIDE}); fix them with add_point_displacement("
+        f"it moves together with {INSIDE}); fix them with loads.add_point_displacement("
     )
     assert fixed_by_the_remedies(case2("sticking", points=[]))
 
@@ -88,7 +88,7 @@ def test_a_frictionless_circle_leaves_the_inclusion_free_to_spin(points, outer_f
     assert message.startswith(
         f"{INSIDE}: rotation about (0.5, 0.5) is not constrained (no Dirichlet condition; "
         "interface 'interface' is frictionless: it transmits no tangential traction); "
-        "fix it with add_point_displacement("
+        "fix it with loads.add_point_displacement("
     )
     assert fixed_by_the_remedies(case2("frictionless", points, outer_fixed))
 

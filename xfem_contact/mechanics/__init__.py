@@ -1,8 +1,8 @@
 """Mechanics on cut meshes: materials, loading, problems, interface laws, LBB treatments.
 
 Owns the physics written in UFL: linear elastic materials
-(:mod:`~xfem_contact.mechanics.materials`), boundary parts, load factors and load
-steps (:mod:`~xfem_contact.mechanics.loading`), the problems (enriched elasticity
+(:mod:`~xfem_contact.mechanics.materials`), the loads of a problem (parts, magnitudes,
+load paths: :mod:`~xfem_contact.mechanics.loads`), the problems (enriched elasticity
 with free or bonded interfaces, augmented-Lagrangian contact, plain uncut
 elasticity), the interface laws they compose, and the inf-sup (LBB) treatments of the
 contact multiplier (:mod:`~xfem_contact.mechanics.lbb`). Sixth step of the layout: it
