@@ -1,0 +1,75 @@
+"""The [[loads]] of a scene: each table checked against its type's keys, its part, the
+form of its value and the stage its history names (:func:`load_spec`)."""
+
+from __future__ import annotations
+
+from xfem_contact.scenes.schema import (
+    FIELDS,
+    LOAD_KEYS,
+    LoadSpec,
+    Number,
+    Scalar,
+    SceneError,
+    Vector,
+    check_table,
+)
+
+
+def load_spec(table, where: str, known_parts: set, stages: dict) -> LoadSpec:
+    """A load from its checked table: the keys of its type, its part, the form of its
+    value, the stage its history names."""
+    check_table(table, FIELDS["load"], where)
+    kind = table["type"]
+    required, optional = LOAD_KEYS[kind]
+    for key in required:
+        if key not in table:
+            raise SceneError(f"{where}.{key}", f"required for a {kind!r} load")
+    for key in table:
+        if key != "type" and key not in required + optional:
+            keys = ", ".join(required + optional)
+            message = f"is not a key of a {kind!r} load (its keys: {keys})"
+            raise SceneError(f"{where}.{key}", message)
+    part = table.get("part")
+    if "part" in required and part not in known_parts:
+        message = f"{part!r}: no such boundary part; known: {sorted(known_parts)}"
+        raise SceneError(f"{where}.part", message)
+    if kind == "rotation" and ("value" in table) == ("angle_deg" in table):
+        raise SceneError(f"{where}.value", "give the angle once: value (rad) or angle_deg")
+    if "value" in table:
+        _load_value(table["value"], kind, "component" in table, f"{where}.value")
+    history = table.get("history")
+    if isinstance(history, str) and history not in stages:
+        message = f"{history!r}: no such stage; known: {sorted(stages)}"
+        raise SceneError(f"{where}.history", message)
+    return LoadSpec(
+        part,
+        kind,
+        table.get("value"),
+        table.get("side"),
+        table.get("component"),
+        tuple(table["point"]) if "point" in table else None,
+        tuple(table.get("centre", (0.0, 0.0))),
+        history if isinstance(history, str | None) else tuple(map(tuple, history)),
+        table.get("angle_deg"),
+    )
+
+
+def _load_value(value, kind: str, component: bool, key: str) -> None:
+    """Check the value of a load: its form (scalar, [vx, vy]) by type, each entry a finite
+    number or an expression (UFL for loads on forms, numpy for interpolated data)."""
+    if kind in ("point_displacement", "rotation"):
+        Number()(value, key)
+    elif kind == "tangential_support":
+        Number(0.0, open=True)(value, key)
+    elif kind == "pressure":
+        Scalar("load")(value, key)
+    elif kind in ("traction", "body_force"):
+        Vector(2, Scalar("load"))(value, key)
+    elif component:
+        Scalar("number")(value, key)
+    elif isinstance(value, list | tuple):
+        Vector(2, Scalar("number"))(value, key)
+    elif isinstance(value, str):
+        raise SceneError(key, "an expression needs component = 0 or 1; for both give [vx, vy]")
+    else:
+        Scalar("number")(value, key)
