@@ -31,15 +31,16 @@ test: $(VENV)/.installed bytecode
 	$(MAKE) test-notebooks
 	$(MAKE) docs
 
+# both cores (pytest-xdist), one test file per worker at a time (module fixtures built once)
 test-serial: $(VENV)/.installed
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q -n 2 --dist loadfile tests
 
 test-mpi: $(VENV)/.installed
 	$(MPIEXEC) -n 2 $(PY) -m pytest -q -m mpi -p no:cacheprovider tests
 
 test-notebooks: $(VENV)/.installed
 	@if ls notebooks/*.ipynb >/dev/null 2>&1; then \
-		$(PY) -m pytest -q --nbmake notebooks; \
+		$(PY) -m pytest -q -n 2 --nbmake notebooks; \
 	else echo "no notebooks yet"; fi
 
 # the documentation site, warnings as errors (make test builds it too)

@@ -25,6 +25,11 @@ from xfem_contact.codegen.compat import analyze_ufl_objects, compute_ir, get_opt
 from xfem_contact.codegen.tables import RuntimeIntegral, runtime_integral
 from xfem_contact.quadrature.cell_rules import CellRules
 
+#: DOLFINx JIT options under those a caller gives: kernels compiled with -O1, not
+#: DOLFINx's -O2 (about half the compile time of the cut forms' large kernels for
+#: the same assembly time; see the docs' performance notes), and a wait of up to
+#: 5 min (not 10 s) for a module another process is compiling (parallel test runs)
+JIT_DEFAULTS = {"cffi_extra_compile_args": ["-O1", "-g0"], "timeout": 300}
 _STANDARD_ID0 = 1000
 _RUNTIME_ID0 = 2000
 _TYPES = {
@@ -143,6 +148,7 @@ def _runtime_kernels(ufl_form: ufl.Form, options: dict, cell) -> dict[int, Runti
 def _compile(
     comm, ufl_form: ufl.Form, options: dict, jit_options: dict | None
 ) -> tuple[_Compiled, CompiledForm]:
+    jit_options = JIT_DEFAULTS | (jit_options or {})
     key = (
         ufl_form.signature(),
         tuple(sorted((k, str(v)) for k, v in options.items())),
@@ -197,7 +203,7 @@ def form(
         form_compiler_options: FFCx options (``scalar_type`` defaults to
             ``dolfinx.default_scalar_type``; ``language`` and the layout version
             :data:`~xfem_contact.codegen.runtime_abi.LAYOUT_OPTION` are set here).
-        jit_options: DOLFINx JIT options.
+        jit_options: DOLFINx JIT options (over :data:`JIT_DEFAULTS`).
 
     Returns:
         A :class:`dolfinx.fem.Form` (or a nested list of them) for
