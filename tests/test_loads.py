@@ -28,6 +28,7 @@ def plain():
     return PlainElasticityProblem(mesh, 1, Material(1e3, 0.3))
 
 
+@pytest.mark.mpi
 def test_built_in_part_names():
     square = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 3, 3)
     assert sorted(named_parts(square)) == ["bottom", "boundary", "left", "right", "top"]
@@ -35,6 +36,7 @@ def test_built_in_part_names():
     assert sorted(named_parts(ring)) == ["boundary", "inner", "outer"]
 
 
+@pytest.mark.mpi
 def test_a_value_change_compiles_nothing_and_changes_the_solution(plain):
     loads = plain.loads
     loads.add_displacement("bottom", 0.0)
@@ -55,6 +57,7 @@ def test_a_value_change_compiles_nothing_and_changes_the_solution(plain):
     assert len(forms._cache) == compiled
 
 
+@pytest.mark.mpi
 def test_each_load_follows_its_path(plain):
     loads = plain.loads
     loads.add_stage("late", 1.0, 3.0)

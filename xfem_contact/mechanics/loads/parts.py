@@ -59,8 +59,9 @@ def named_parts(mesh: dolfinx.mesh.Mesh) -> dict[str, Callable]:
     nodes = dolfinx.mesh.entities_to_geometry(mesh, fdim, facets).ravel()
     x = mesh.geometry.x[np.unique(nodes), :2]
     comm = mesh.comm
-    low = comm.allreduce(x.min(axis=0) if x.size else np.full(2, np.inf), op=MPI.MIN)
-    high = comm.allreduce(x.max(axis=0) if x.size else np.full(2, -np.inf), op=MPI.MAX)
+    low, high = np.full(2, np.inf), np.full(2, -np.inf)
+    comm.Allreduce(x.min(axis=0) if x.size else low.copy(), low, op=MPI.MIN)
+    comm.Allreduce(x.max(axis=0) if x.size else high.copy(), high, op=MPI.MAX)
     size = float(np.max(high - low))
     on_box = np.all(
         np.isclose(x, low, rtol=0, atol=1e-8 * size).any(axis=1)
@@ -69,8 +70,8 @@ def named_parts(mesh: dolfinx.mesh.Mesh) -> dict[str, Callable]:
     if comm.allreduce(bool(on_box), op=MPI.LAND):
         return rectangle_parts((low, high))
     r = np.hypot(x[:, 0], x[:, 1])
-    r0 = comm.allreduce(r.min() if r.size else np.inf, op=MPI.MIN)
-    r1 = comm.allreduce(r.max() if r.size else -np.inf, op=MPI.MAX)
+    r0 = comm.allreduce(float(r.min()) if r.size else np.inf, op=MPI.MIN)
+    r1 = comm.allreduce(float(r.max()) if r.size else -np.inf, op=MPI.MAX)
     on_circles = np.all((np.abs(r - r0) < 1e-6 * r1) | (np.abs(r - r1) < 1e-6 * r1))
     if r0 > 1e-6 * r1 and comm.allreduce(bool(on_circles), op=MPI.LAND):
         return annulus_parts(r0, r1)
@@ -101,7 +102,16 @@ def boundary_facets(
     label = repr(name) if name is not None else ("of the locator" if callable(part) else "given")
     fdim = mesh.topology.dim - 1
     if callable(part):
-        facets = dolfinx.mesh.locate_entities_boundary(mesh, fdim, _checked_locator(part, label))
+        try:  # a bad locator is refused on every process, not on those it failed on
+            facets, message = (
+                dolfinx.mesh.locate_entities_boundary(mesh, fdim, _checked_locator(part, label)),
+                "",
+            )
+        except (TypeError, ValueError) as error:
+            facets, message = np.zeros(0, dtype=np.int32), " ".join(str(error).split())
+        messages = [m for m in mesh.comm.allgather(message) if m]
+        if messages:
+            raise ValueError(messages[0])
     else:
         facets = np.asarray(part)
         if facets.ndim != 1 or not (facets.size == 0 or np.issubdtype(facets.dtype, np.integer)):
