@@ -55,6 +55,11 @@ def to_toml(data: dict) -> str:
     return "".join(f"{json.dumps(key)} = {value(v)}\n" for key, v in data.items())
 
 
+def coulomb_friction(law: str) -> dict:
+    """The friction key a law takes: Coulomb's only (any other law refuses it)."""
+    return {"friction": 0.5} if law == "coulomb" else {}
+
+
 @pytest.mark.parametrize(
     "law, multipliers, tangential, solver",
     [
@@ -67,7 +72,7 @@ def to_toml(data: dict) -> str:
     ],
 )
 def test_only_named_effects_are_built(law, multipliers, tangential, solver):
-    data = base(law=law, friction=0.5) if law else base()
+    data = base(law=law, **coulomb_friction(law)) if law else base()
     if law in ("frictionless", "coulomb", "sticking", "free"):
         # keep the inclusion in place: fix the plate fully, press the inclusion through it
         data["loads"] = [
@@ -563,7 +568,7 @@ def test_run_contact_scene_reports_newton():
 
 def pressed_inclusion(law: str, **solver) -> dict:
     """A plate fixed all round, its inclusion pushed down by a body force."""
-    data = base(law=law, friction=0.5)
+    data = base(law=law, **coulomb_friction(law))
     data["loads"] = [
         {"part": "boundary", "type": "displacement", "value": [0.0, 0.0]},
         {"type": "body_force", "value": [0.0, -1e3], "side": -1},

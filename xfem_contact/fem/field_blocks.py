@@ -59,6 +59,26 @@ def _embedded(x, offsets: list[int], field: int) -> ufl.core.expr.Expr:
     )
 
 
+def _canonical_facets(form: ufl.Form) -> ufl.Form:
+    """``form`` with its interior-facet integrals relabelled: the facets of subdomain
+    ``k`` become subdomain 1 (their entities kept), so that the blocks of two fields
+    whose integrands agree but for which facet set they integrate on (the ghost
+    penalty of each side) have one signature, so one compiled form."""
+    facets = [i for i in form.integrals() if i.integral_type() == "interior_facet"]
+    ids = {i.subdomain_id() for i in facets}
+    if len(ids) != 1 or not isinstance(facets[0].subdomain_data(), list | tuple):
+        return form
+    (sid,) = ids
+    entities = dict(facets[0].subdomain_data())[sid]
+    data = [(1, entities)]
+    return ufl.Form(
+        [
+            i.reconstruct(subdomain_id=1, subdomain_data=data) if i in facets else i
+            for i in form.integrals()
+        ]
+    )
+
+
 def _empty(form: ufl.Form) -> bool:
     return expand_derivatives(form).empty()
 
@@ -118,6 +138,7 @@ def split_uncut(
             continue
         V, parent = field_space(i)
         form = block(i, i, ufl.TrialFunction(V), ufl.TestFunction(V))
+        form = _canonical_facets(expand_derivatives(form))  # grad([0, v]) -> [0, grad v]
         blocks.append(FieldBlock(i, form, V, parent))
     rest = ufl.Form(rest)
     for i, j in itertools.permutations(fields, 2):  # trial field i, test field j
