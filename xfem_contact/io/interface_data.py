@@ -100,3 +100,14 @@ def interface_point_data(problem) -> dict[str, np.ndarray]:
                 data[key][rows] = state[key]
         data["status"][rows] = status_codes(law, state, rows.size)
     return data
+
+
+def sample_status(problem, name: str) -> list[int]:
+    """The status codes (0 open, 1 stick, 2 slip) at the rule points of interface
+    ``name`` of all processes, in the order of ``problem.interface_samples(name)``.
+    Collective."""
+    law = problem.laws[name]
+    state = problem.interface_state(name=name)
+    npoints = problem.contexts[name].rules.points.shape[0]
+    local = status_codes(law, state, npoints)
+    return np.concatenate(problem.mesh.comm.allgather(local)).tolist()

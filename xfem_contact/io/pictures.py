@@ -133,8 +133,10 @@ def plot_deformed(
     window_size: tuple[int, int] = (800, 600),
     edges: bool = True,
     bounds: Sequence[float] | None = None,
+    field: str | None = None,
+    label: str = "displacement (m)",
 ) -> pathlib.Path:
-    """PNG of the deformed configuration coloured by ``|u|`` (m).
+    """PNG of the deformed configuration coloured by ``|u|`` (m) or by a point field.
 
     Args:
         grid: A grid with point data ``u`` (m, shape ``(npoints, 3)``), e.g. a
@@ -148,13 +150,21 @@ def plot_deformed(
         edges: Draw the cell outlines (thin).
         bounds: ``(xmin, xmax, ymin, ymax)`` in m (deformed coordinates) to zoom
             on; default: the whole grid, deformed and undeformed.
+        field: A scalar point field to colour by (e.g. ``von_mises``, Pa); default
+            ``|u|``. The colour bar runs from exact zero to the largest value
+            (:func:`colour_range`).
+        label: The colour bar's caption.
     """
     if scale is None:
         scale = auto_scale(grid)
     u = np.asarray(grid.point_data["u"])
     warped = grid.warp_by_vector("u", factor=scale)
-    magnitude = np.sqrt((u**2).sum(axis=1))
-    warped.point_data["|u| (m)"] = magnitude
+    if field is None:
+        values = np.sqrt((u**2).sum(axis=1))
+    else:
+        values = np.asarray(grid.point_data[field], dtype=np.float64).reshape(u.shape[0], -1)[:, 0]
+    values, clim = colour_range(values)
+    warped.point_data["colour"] = values
     plotter = _plotter(window_size)
     # The undeformed outline, for reference
     dz = 1e-3 * grid.length
@@ -163,8 +173,8 @@ def plot_deformed(
         plotter.add_mesh(reference, color="#b0b0b0", line_width=1.0)
     plotter.add_mesh(
         _clip(_surface(warped), bounds),
-        scalars="|u| (m)",
-        clim=(float(magnitude.min()), float(magnitude.max())),
+        scalars="colour",
+        clim=clim,
         cmap="viridis",
         lighting=False,
         scalar_bar_args={
@@ -179,9 +189,7 @@ def plot_deformed(
             "label_font_size": 12,
         },
     )
-    plotter.add_text(
-        "displacement (m)", position=(0.74, 0.81), viewport=True, font_size=10, color="black"
-    )
+    plotter.add_text(label, position=(0.74, 0.81), viewport=True, font_size=10, color="black")
     if edges:
         lines = _lift(_clip(_outlines(warped), bounds), dz)
         plotter.add_mesh(lines, color="white", line_width=0.5, opacity=0.35)
@@ -208,21 +216,42 @@ def plot_deformed(
     return _save(plotter, path)
 
 
+def _friction_law(law: dict) -> bool:
+    """Whether an interface's summary entry describes a law with tangential traction."""
+    return "friction" in law or law.get("law") == "sticking"
+
+
+def colour_range(values: np.ndarray, tiny: float = 1e-12) -> tuple[np.ndarray, tuple]:
+    """``values`` with ``|x| < tiny * max|x|`` set to exact 0, and a colour range that
+    starts at exact 0 for values of one sign (``(0, max)`` or ``(min, 0)``), else
+    ``(min, max)``; ``(0, 1)`` for all zeros."""
+    values = np.array(values, dtype=np.float64)
+    top = float(np.abs(values).max()) if values.size else 0.0
+    values[np.abs(values) < tiny * top] = 0.0
+    if top == 0.0:
+        return values, (0.0, 1.0)
+    low, high = float(values.min()), float(values.max())
+    return values, (min(low, 0.0), max(high, 0.0))
+
+
 def render_folder(
     folder: str | pathlib.Path, log: Callable[[str], None] | None = None
 ) -> list[pathlib.Path]:
     """Render the results of a scene run folder to PNG (serial; reads the files).
 
     Writes ``result.png`` (deformed configuration, from ``result*.vtu``),
-    ``cut.png`` (uncut cells and sub-triangles from ``result*.vtu``, the interface
-    from ``interface*.vtu``) and ``pressure.png`` (``lambda_n`` of the
-    ``interface_samples`` of ``summary.json``); a picture whose data is missing is
-    skipped with a ``log`` line.
+    ``von_mises.png`` (the same coloured by the von Mises stress), ``cut.png`` (uncut
+    cells and sub-triangles from ``result*.vtu``, the interface from
+    ``interface*.vtu``), ``pressure.png`` (``lambda_n`` of the interface samples of
+    ``summary.json``) and, for friction laws, ``traction.png`` (the tangential traction
+    with each point's stick / slip status); one plot per interface when there are
+    several (``pressure_NAME.png``, ``traction_NAME.png``). A picture whose data is
+    missing is skipped with a ``log`` line.
 
     Raises:
         FileNotFoundError: if the folder holds no ``result*.vtu``.
     """
-    from xfem_contact.io.plots import interface_abscissa, plot_pressure
+    from xfem_contact.io.plots import interface_abscissa, plot_pressure, plot_traction
 
     say = log or (lambda line: None)
     folder = pathlib.Path(folder)
@@ -244,6 +273,19 @@ def render_folder(
             grid, folder / "result.png", title=f"{name}: deformed", scale=1.0 if large else None
         )
     )
+    if "von_mises" in grid.point_data:
+        written.append(
+            plot_deformed(
+                grid,
+                folder / "von_mises.png",
+                title=f"{name}: von Mises stress",
+                scale=1.0 if large else None,
+                field="von_mises",
+                label="von Mises (Pa)",
+            )
+        )
+    else:
+        say(f"skipped von_mises.png: no von_mises in the result*.vtu of {folder}")
     interface_files = sorted(folder.glob("interface*.vtu"))
     if interface_files and "cut" in grid.cell_data:
         pieces = [g for g in (pyvista.read(p) for p in interface_files) if g.n_cells]
@@ -263,6 +305,21 @@ def render_folder(
     else:
         plots = {"pressure.png": (None, summary.get("interface_samples"))}
     for file, (interface, samples) in plots.items():
+        law = interfaces.get(interface, next(iter(interfaces.values()), {})) if interfaces else {}
+        if isinstance(samples, dict) and samples.get("lambda_t") and _friction_law(law):
+            s, label = interface_abscissa(samples["x"], samples["y"])
+            written.append(
+                plot_traction(
+                    s,
+                    samples,
+                    folder / file.replace("pressure", "traction"),
+                    friction=law.get("friction"),
+                    xlabel=label,
+                    title=f"{name}: "
+                    + (f"{interface}, " if interface else "")
+                    + "tangential traction",
+                )
+            )
         if not (isinstance(samples, dict) and samples.get("lambda_n")):
             say(f"skipped {file}: summary.json has no interface samples with lambda_n")
             continue

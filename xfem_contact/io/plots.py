@@ -97,3 +97,59 @@ def plot_pressure(
         e = np.full_like(t, exact) if np.isscalar(exact) else np.asarray(exact(t), dtype=float)
         series.append(Series(t, e, "k--", "exact"))
     return line_plot(path, series, xlabel, "contact pressure λₙ (Pa)", title)
+
+
+#: Colours and labels of the contact status codes (:mod:`xfem_contact.io.interface_data`)
+STATUS_STYLE = {0: ("#9a9a9a", "open"), 1: ("#1f5fbf", "stick"), 2: ("#d2452b", "slip")}
+
+
+def plot_traction(
+    abscissa: np.ndarray,
+    samples: dict,
+    path: str | pathlib.Path,
+    friction: float | None = None,
+    xlabel: str = "polar angle about the interface centroid (degrees)",
+    title: str = "Tangential traction on the interface",
+) -> pathlib.Path:
+    """PNG of the tangential traction (Pa) at interface points, each point coloured by
+    its contact status (open, stick, slip), with the Coulomb bound ``+-mu |P_n|``.
+
+    Args:
+        abscissa: Coordinate of each point, shape ``(n,)``; points are sorted by it.
+        samples: ``P_t`` (applied tangential traction, Pa; ``lambda_t`` without it),
+            ``P_n`` (Pa) and ``status`` (0, 1, 2), each of length ``n``.
+        path: The PNG file.
+        friction: Coulomb's coefficient (the bound is drawn), or None.
+        xlabel: Label of the abscissa.
+        title: Title of the plot.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    s = np.asarray(abscissa, dtype=np.float64)
+    order = np.argsort(s)
+    s = s[order]
+    t = np.asarray(samples.get("P_t", samples.get("lambda_t")), dtype=np.float64)[order]
+    status = np.asarray(samples.get("status", np.zeros(s.size)), dtype=np.int64)[order]
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig = Figure(figsize=(6, 4))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    if friction is not None and "P_n" in samples:
+        bound = friction * np.abs(np.asarray(samples["P_n"], dtype=np.float64)[order])
+        ax.plot(s, bound, "k--", lw=0.8, label=f"±μ|Pₙ| (μ = {friction:g})")
+        ax.plot(s, -bound, "k--", lw=0.8)
+    ax.plot(s, t, "-", color="#c8c8c8", lw=0.8, zorder=1)
+    for code, (colour, label) in STATUS_STYLE.items():
+        mine = status == code
+        if mine.any():
+            ax.plot(s[mine], t[mine], ".", ms=4, color=colour, label=f"{label} ({mine.sum()})")
+    ax.axhline(0.0, color="black", lw=0.5)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("tangential traction Pₜ (Pa)")
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    return path

@@ -11,14 +11,12 @@ applied loads are ``L(e_c)`` (tractions, pressures, body forces). A tangential s
 support acts as a reaction too: ``-F_spring(w; e_c)``. SI units: forces per unit
 thickness (N/m), 2-vectors.
 
-A Dirichlet dof on several boundary parts (a corner) counts for the first part named;
-Dirichlet dofs on no part named (fixed points) count under ``"points"``, so the
-reactions of all parts add up to the total.
+Reactions are grouped by the load that prescribes the displacement (by its part's name,
+or its kind, e.g. ``point displacement``); a dof two loads hold (a corner held by two
+parts in the same component) counts for the first, so the reactions add up to the total.
 """
 
 from __future__ import annotations
-
-from collections.abc import Callable, Mapping
 
 import dolfinx.fem
 import dolfinx.fem.petsc
@@ -28,18 +26,9 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from xfem_contact.fem.forms import form
-from xfem_contact.fem.subspaces import collapse
-
-#: A boundary part for :func:`reactions`: local facet indices or a locator ``x -> bool``
-Part = np.ndarray | Callable[[np.ndarray], np.ndarray]
 
 
 # -- accessors of the problem (one place to follow its API) ---------------------------
-def dirichlet_conditions(problem) -> list:
-    """The problem's Dirichlet conditions."""
-    return list(problem.loads.bcs)
-
-
 def _load_form(problem) -> ufl.Form:
     """The loads' terms ``L(v)`` (tractions, pressures, body forces)."""
     return problem.loads.linear_form()
@@ -50,17 +39,25 @@ def _springs(problem):
     return problem.loads.spring_terms(ufl.split(problem.w), problem.space.test())
 
 
-def named_parts(problem) -> dict[str, Part]:
-    """The problem's named boundary parts: those its Dirichlet conditions name first (in
-    the order added), then the others, ``boundary`` (the whole) last."""
-    parts = dict(problem.loads.parts)
-    named = [
-        item.part
-        for item in problem.loads.items
-        if item.part in parts and getattr(item, "functions", None) is not None
-    ]
-    order = [*dict.fromkeys(named), *(k for k in parts if k != "boundary"), "boundary"]
-    return {k: parts[k] for k in dict.fromkeys(order) if k in parts}
+def _functions(load) -> list:
+    """The Dirichlet functions of a load (none for tractions, pressures, springs)."""
+    return getattr(load, "functions", None) or []
+
+
+def supports(problem) -> dict[str, list]:
+    """The Dirichlet conditions grouped by what they hold: the boundary part's name for a
+    prescribed displacement or rotation given by name, else the load's kind (e.g.
+    ``point displacement``), in the order added."""
+    groups: dict[str, list] = {}
+    for bc in problem.loads.bcs:
+        value = bc.g
+        item = next(
+            (i for i in problem.loads.items if any(value is f._cpp_object for f in _functions(i))),
+            None,
+        )
+        name = "other" if item is None else (item.part or item.kind)
+        groups.setdefault(name, []).append(bc)
+    return groups
 
 
 # -- vectors --------------------------------------------------------------------------
@@ -114,66 +111,43 @@ def _force(problem, b: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray
     return problem.mesh.comm.allreduce(local, op=MPI.SUM)
 
 
-def _part_dofs(problem, part: Part) -> np.ndarray:
-    """Local dofs of ``W`` (both displacement fields) on a boundary part."""
-    fdim = problem.mesh.topology.dim - 1
-    dofs = []
-    for field in (0, 1):
-        sub = problem.space.W.sub(field)
-        V, _ = collapse(sub)
-        if callable(part):
-            dofs.append(dolfinx.fem.locate_dofs_geometrical((sub, V), part)[0])
-        else:
-            facets = np.asarray(part, dtype=np.int32)
-            dofs.append(dolfinx.fem.locate_dofs_topological((sub, V), fdim, facets)[0])
-    return np.concatenate(dofs)
-
-
 # -- public ---------------------------------------------------------------------------
-def reactions(
-    problem, parts: Mapping[str, Part] | None = None, b: np.ndarray | None = None
-) -> dict:
-    """Force (N/m, ``(2,)``) of the supports of each boundary part on the body.
+def reactions(problem, b: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Force (N/m, ``(2,)``) of each support (:func:`supports`) on the body.
 
     Args:
         problem: A solved problem (its ``w``).
-        parts: Name to part, in order of precedence (default: :func:`named_parts`);
-            parts with no Dirichlet dof are left out.
-        b: The residual vector's local array (:func:`residual_vector`), if at hand.
+        b: The residual vector's owned entries (:func:`residual_vector`), if at hand.
 
     Returns:
-        ``{name: array([R_x, R_y])}``, and ``"points"`` for Dirichlet dofs on no part.
-        Collective.
+        ``{name: array([R_x, R_y])}``. Collective.
     """
     if b is None:
         vec = residual_vector(problem)
         b = vec.array_r.copy()
         vec.destroy()
     n = _owned(problem)
-    b = np.concatenate([b[:n], np.zeros(len(unit_vectors(problem)[0]) - n)])
-    constrained = np.zeros(b.size, dtype=bool)
-    for bc in dirichlet_conditions(problem):
-        constrained[bc.dof_indices()[0]] = True
-    comm, out = problem.mesh.comm, {}
-    for name, part in (named_parts(problem) if parts is None else parts).items():
+    b = np.concatenate([b[:n], np.zeros(unit_vectors(problem)[0].size - n)])
+    taken = np.zeros(b.size, dtype=bool)
+    out = {}
+    for name, bcs in supports(problem).items():
         mine = np.zeros(b.size, dtype=bool)
-        mine[_part_dofs(problem, part)] = True
-        mine &= constrained
-        constrained &= ~mine
-        if comm.allreduce(int(mine[:n].sum()), op=MPI.SUM):
-            out[name] = _force(problem, b, mine)
-    if comm.allreduce(int(constrained[:n].sum()), op=MPI.SUM):
-        out["points"] = _force(problem, b, constrained)
+        for bc in bcs:
+            mine[bc.dof_indices()[0]] = True
+        mine &= ~taken  # a dof held twice counts once, for the first
+        taken |= mine
+        out[name] = _force(problem, b, mine)
     return out
 
 
-def applied_loads(problem) -> np.ndarray:
+def applied_loads(problem) -> tuple[np.ndarray, float]:
     """The resultant (N/m, ``(2,)``) of the tractions, pressures and body forces at the
-    current load factor, ``L(e_c)``. Collective."""
+    current time, ``L(e_c)``, and their total size ``max_c sum_i |L_i e_c(i)|`` (N/m: the
+    scale of a balance of self-equilibrated loads). Collective."""
     vec = _vector(problem, _load_form(problem))
-    force = _force(problem, vec.array_r)
+    L = vec.array_r.copy()
     vec.destroy()
-    return force
+    return _force(problem, L), float(_force(problem, np.abs(L)).max())
 
 
 def interface_resultants(problem) -> dict[str, np.ndarray]:
@@ -213,21 +187,21 @@ def spring_reactions(problem) -> np.ndarray | None:
     return force
 
 
-def balance(problem, parts: Mapping[str, Part] | None = None) -> dict:
-    """Reactions per part, the applied loads, interface resultants and the global
-    balance ``sum(reactions) + loads`` (N/m) with its size relative to the largest force.
-    Collective."""
+def balance(problem) -> dict:
+    """Reactions per support, the applied loads, interface resultants and the global
+    balance ``sum(reactions) + loads`` (N/m), with its size relative to the largest
+    reaction or the total size of the loads (:func:`applied_loads`). Collective."""
     vec = residual_vector(problem)
-    supports = reactions(problem, parts, vec.array_r.copy())
+    held = reactions(problem, vec.array_r.copy())
     vec.destroy()
     springs = spring_reactions(problem)
     if springs is not None:
-        supports["tangential_supports"] = springs
-    loads = applied_loads(problem)
-    total = sum(supports.values(), np.zeros(2)) + loads
-    scale = max([np.abs(loads).max(), *(np.abs(r).max() for r in supports.values()), 0.0])
+        held["tangential_supports"] = springs
+    loads, size = applied_loads(problem)
+    total = sum(held.values(), np.zeros(2)) + loads
+    scale = max([size, *(np.abs(r).max() for r in held.values()), 0.0])
     return {
-        "reactions": {k: r.tolist() for k, r in supports.items()},
+        "reactions": {k: r.tolist() for k, r in held.items()},
         "applied_loads": loads.tolist(),
         "interface_resultants": {k: r.tolist() for k, r in interface_resultants(problem).items()},
         "balance": total.tolist(),

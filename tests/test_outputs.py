@@ -1,0 +1,180 @@
+"""Engineering outputs: stresses, reactions and the global balance, interface point data,
+pictures coloured from exact zero."""
+
+import xfem_contact  # noqa: F401
+
+# isort: split
+import dolfinx.fem
+import dolfinx.mesh
+import numpy as np
+import pytest
+import pyvista
+from mpi4py import MPI
+from test_scenes import base
+
+from xfem_contact.cases.paper import inclusion_problem
+from xfem_contact.io.pictures import colour_range
+from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.reactions import balance
+from xfem_contact.mechanics.stress import StressFields
+from xfem_contact.scenes.run import build, run
+from xfem_contact.scenes.scene import load_scene
+
+#: Global balance: reactions + applied loads = 0, relative to the largest force
+BALANCE = 1e-8
+
+
+def plate(law: str | None, cells: int = 12, **options) -> dict:
+    """A plate fixed at the bottom, sheared and compressed on top, with an inclusion."""
+    data = base(law=law, **options) if law else base()
+    data["mesh"]["cells"] = [cells, cells]
+    data["materials"]["m"]["nu"] = 0.3
+    data["loads"][1] = {"part": "top", "type": "traction", "value": [0.4e6, -1.0e6]}
+    return data
+
+
+def solved(data: dict, comm=MPI.COMM_WORLD):
+    problem, _ = build(load_scene(data), comm)
+    problem.solve()
+    return problem
+
+
+@pytest.mark.mpi
+@pytest.mark.filterwarnings("ignore::UserWarning")
+@pytest.mark.parametrize(
+    "law, options", [("bonded", {}), ("coulomb", {"friction": 0.3}), ("frictionless", {})]
+)
+def test_reactions_balance_the_loads(law, options):
+    forces = [
+        balance(solved(plate(law, **options), comm)) for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)
+    ]
+    for f in forces:
+        assert f["balance_relative"] < BALANCE, f
+        assert set(f["reactions"]) == {"bottom"}  # corners of left/right are bottom's
+        np.testing.assert_allclose(f["reactions"]["bottom"], [-0.4e6, 1.0e6], rtol=1e-8)
+        np.testing.assert_allclose(f["applied_loads"], [0.4e6, -1.0e6], rtol=1e-12)
+        # a floating inclusion with no load: the interface carries no net force
+        (resultant,) = f["interface_resultants"].values()
+        assert np.abs(resultant).max() < 1e-8 * 1e6
+    # 2 ranks = 1 rank
+    np.testing.assert_allclose(
+        forces[0]["reactions"]["bottom"], forces[1]["reactions"]["bottom"], rtol=1e-10
+    )
+
+
+def test_point_supports_and_parts_share_out_the_reactions():
+    data = plate("sticking")
+    data["loads"] = [
+        {"part": "left", "type": "displacement", "value": 0.0, "component": 0},
+        {"part": "bottom", "type": "displacement", "value": 0.0, "component": 1},
+        {"part": "right", "type": "pressure", "value": 1.0e6},
+        {"part": "top", "type": "pressure", "value": 2.0e6},
+    ]
+    forces = balance(solved(data))
+    assert forces["balance_relative"] < BALANCE, forces
+    np.testing.assert_allclose(forces["reactions"]["left"], [1.0e6, 0.0], atol=1e-6)
+    np.testing.assert_allclose(forces["reactions"]["bottom"], [0.0, 2.0e6], atol=1e-6)
+
+
+def test_interface_resultant_balances_the_load_on_the_inclusion():
+    problem = inclusion_problem(10, 2, "sticking")  # body-force free, pressure outside
+    problem.solve()
+    forces = balance(problem)
+    assert forces["balance_relative"] < BALANCE, forces
+    (resultant,) = forces["interface_resultants"].values()
+    assert np.abs(resultant).max() < 1e-10  # the inclusion carries no load (N/m)
+
+
+def test_spring_supports_are_reactions():
+    data = plate("sticking")
+    data["loads"].append({"part": "left", "type": "tangential_support", "value": 1e9})
+    forces = balance(solved(data))
+    assert set(forces["reactions"]) == {"bottom", "tangential_supports"}
+    assert np.abs(forces["reactions"]["tangential_supports"]).max() > 1e3  # it carries load
+    assert forces["balance_relative"] < BALANCE, forces
+
+
+@pytest.fixture(scope="module")
+def coulomb_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("coulomb")
+    data = plate("coulomb", cells=10, friction=0.3)
+    data["solver"] = {"load_steps": 2}
+    summary = run(load_scene(data), out, log=None, progress_bar=False)
+    return out, summary
+
+
+def test_summary_has_reactions_and_balance(coulomb_run):
+    _, summary = coulomb_run
+    forces = summary["forces"]
+    assert forces["balance_relative"] < BALANCE
+    assert set(forces) >= {"reactions", "applied_loads", "interface_resultants", "balance"}
+    status = summary["interface_samples"]["status"]
+    assert set(status) <= {0, 1, 2} and {1, 2} <= set(status)  # stick and slip both
+
+
+def test_result_vtu_carries_stress_and_von_mises(coulomb_run):
+    out, _ = coulomb_run
+    grid = pyvista.read(out / "result.vtu")
+    sigma = np.asarray(grid.point_data["stress"]).reshape(-1, 3, 3)
+    vm = np.asarray(grid.point_data["von_mises"])
+    s = sigma - np.trace(sigma, axis1=1, axis2=2)[:, None, None] / 3 * np.eye(3)
+    # von Mises is interpolated on its own (DG1): equal to that of the stress at the
+    # DG1 nodes, apart from it in between where the stress changes sign
+    rel = np.abs(vm - np.sqrt(1.5 * (s**2).sum(axis=(1, 2)))) / vm.max()
+    assert vm.min() >= 0 and np.median(rel) < 1e-3
+    # plane strain: sigma_zz = nu (sigma_xx + sigma_yy), nu = 0.3
+    np.testing.assert_allclose(
+        sigma[:, 2, 2], 0.3 * (sigma[:, 0, 0] + sigma[:, 1, 1]), atol=1e-8 * vm.max()
+    )
+    # equilibrium at the top: sigma_yy = -1e6, sigma_xy = 0.4e6 on average there
+    top = grid.points[:, 1] > 1 - 1e-9
+    assert abs(sigma[top, 1, 1].mean() + 1.0e6) < 0.05e6
+    assert abs(sigma[top, 0, 1].mean() - 0.4e6) < 0.05e6
+    assert (out / "stress.bp").is_dir()
+
+
+def test_interface_vtu_carries_the_laws_state(coulomb_run):
+    out, summary = coulomb_run
+    grid = pyvista.read(out / "interface.vtu")
+    data = {k: np.asarray(grid.point_data[k]) for k in ("lambda_n", "lambda_t", "gap", "slip")}
+    status = np.asarray(grid.point_data["status"])
+    assert set(np.unique(status)) <= {0, 1, 2} and {1, 2} <= set(np.unique(status))
+    samples = summary["interface_samples"]
+    # the nodes see the same ranges as the rule points
+    for key in ("lambda_n", "lambda_t"):
+        scale = np.abs(samples[key]).max()
+        assert np.abs(data[key]).max() == pytest.approx(scale, rel=0.3)
+    # closed where in contact (up to the weak enforcement between the rule points)
+    u = np.abs(pyvista.read(out / "result.vtu").point_data["u"]).max()
+    assert np.all(np.abs(data["gap"][status > 0]) < 1e-2 * u)
+
+
+def test_show_draws_von_mises_and_the_traction(coulomb_run):
+    out, _ = coulomb_run
+    for name in ("von_mises.png", "traction.png", "pressure.png", "result.png"):
+        image = pyvista.read(out / name)
+        assert np.asarray(image.point_data.active_scalars).std() > 0, name
+
+
+def test_stress_fields_are_exact_for_a_uniform_strain():
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    u = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 2, (2,))))
+    u.interpolate(lambda x: np.vstack([1e-3 * x[0] + 2e-3 * x[1], -0.5e-3 * x[1]]))
+    E, nu = 100e6, 0.3
+    fields = StressFields([("", Material(E, nu), u)])
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    eps = np.array([[1e-3, 1e-3], [1e-3, -0.5e-3]])
+    sigma = np.zeros((3, 3))
+    sigma[:2, :2] = 2 * mu * eps + lam * np.trace(eps) * np.eye(2)
+    sigma[2, 2] = nu * np.trace(sigma)
+    s = sigma - np.trace(sigma) / 3 * np.eye(3)
+    values = fields.stress[0].x.array.reshape(-1, 9)
+    np.testing.assert_allclose(values, np.tile(sigma.ravel(), (values.shape[0], 1)), atol=1e-6)
+    np.testing.assert_allclose(fields.von_mises[0].x.array, np.sqrt(1.5 * (s**2).sum()))
+
+
+def test_colour_range_starts_at_exact_zero():
+    values, clim = colour_range(np.array([4.84e-22, 1.0, 2.0]))
+    assert values[0] == 0.0 and clim == (0.0, 2.0)
+    assert colour_range(np.array([-3.0, -1e-20]))[1] == (-3.0, 0.0)
+    assert colour_range(np.zeros(3))[1] == (0.0, 1.0)
