@@ -19,7 +19,7 @@ BOUND = 1e6
 
 def factored_condition(problem) -> float:
     """2-norm condition number of the Jacobian the last Newton solve factored (serial)."""
-    J = problem._newton.J_r.convert("dense").getDenseArray()
+    J = problem.newton.J_r.convert("dense").getDenseArray()
     s = np.linalg.svd(J, compute_uv=False)
     return float(s[0] / s[-1])
 

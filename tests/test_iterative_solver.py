@@ -33,7 +33,7 @@ def test_iterative_equals_direct(law):
 
 
 def _context(problem):
-    return problem._newton.snes.getKSP().getPC().getPythonContext()
+    return problem.newton.snes.getKSP().getPC().getPythonContext()
 
 
 def test_band_and_interpolation():
@@ -42,7 +42,7 @@ def test_band_and_interpolation():
     scaled reduced unknowns the solver works with."""
     problem = inclusion_problem(10, 2, "sticking")
     problem.solve(preset("iterative"))
-    context, newton = _context(problem), problem._newton
+    context, newton = _context(problem), problem.newton
     dofs = problem.space.dof_counts()
     assert context.u.getSize() + dofs.multiplier == newton.J_r.getSize()[0]
     assert dofs.multiplier < context.band.getSize() < context.u.getSize()

@@ -260,7 +260,7 @@ def test_the_jacobian_keeps_its_structure_through_newton():
     before = event.getPerfInfo()["count"]
     report = problem.solve()
     assert report.iterations > 2
-    J_r = problem._newton.J_r
+    J_r = problem.newton.J_r
     assert J_r.getInfo()["mallocs"] == 0
     assert event.getPerfInfo()["count"] - before == 1
 

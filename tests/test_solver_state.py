@@ -40,7 +40,7 @@ def test_solver_options_given_after_a_solve_are_used():
     problem = inclusion_problem(8, 1, "sticking")
     problem.solve()
     problem.solve(petsc_options={"snes_rtol": 1e-6, "snes_atol": 1e-9})
-    rtol, atol, _, _ = problem._newton.snes.getTolerances()
+    rtol, atol, _, _ = problem.newton.snes.getTolerances()
     assert (rtol, atol) == (1e-6, 1e-9)
 
 

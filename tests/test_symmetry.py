@@ -34,7 +34,7 @@ def test_symmetric_laws_factor_ldlt_to_the_lu_solution(law):
     default, lu = _solved(law, None), _solved(law, "lu")
     assert default.symmetric
     if not default.linear:
-        assert default._newton._options["pc_type"] == "cholesky"
+        assert default.newton.options["pc_type"] == "cholesky"
     scale = np.abs(lu.w.x.array).max()
     assert np.abs(default.w.x.array - lu.w.x.array).max() <= 1e-9 * scale
     if law != "bonded":

@@ -40,7 +40,7 @@ ERROR_FACTOR = 2.0
 
 def condition(problem) -> float:
     """2-norm condition number (SVD) of the last factored Jacobian (serial)."""
-    J = problem._newton.J_r.convert("dense").getDenseArray()
+    J = problem.newton.J_r.convert("dense").getDenseArray()
     s = np.linalg.svd(J, compute_uv=False)
     return float(s[0] / s[-1])
 

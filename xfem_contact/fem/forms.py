@@ -186,6 +186,11 @@ def _other_domains(ufl_form: ufl.Form, ids: dict[str, list[int]]) -> dict:
     return out
 
 
+def compiled_forms() -> int:
+    """Number of distinct forms (signatures) compiled or loaded by this process."""
+    return len(_cache)
+
+
 def form(
     ufl_form: ufl.Form | collections.abc.Iterable,
     form_compiler_options: dict | None = None,

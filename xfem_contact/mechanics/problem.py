@@ -385,6 +385,13 @@ class Problem:
         return {} if self._newton is None else dict(self._newton.timings)
 
     @property
+    def newton(self) -> RestrictedNewton | None:
+        """The Newton solver of the contact solves (its ``snes``, the reduced Jacobian
+        ``J_r``, ``options``), kept between solves; None before the first or after the
+        loads, the solver options or the cut changed."""
+        return self._newton
+
+    @property
     def last_report(self) -> SolveReport | None:
         """The report of the last Newton solve (None before the first)."""
         return None if self._newton is None else self._newton.report

@@ -127,7 +127,7 @@ def run(
     out = None if out is None else pathlib.Path(out)
     if out is not None and comm.rank == 0:  # a summary.json is a finished run's
         (out / "summary.json").unlink(missing_ok=True)
-    compiled_before = len(forms._cache)
+    compiled_before = forms.compiled_forms()
     start = time.perf_counter()
     problem, effects = build(scene, comm)
     build_time = time.perf_counter() - start
@@ -209,23 +209,21 @@ def run(
         }
         if not problem.linear and len(samples) == 1:
             summary["interface_samples"] = next(iter(samples.values()))
-    if hasattr(problem, "space"):  # reactions, interface resultants, global balance (N/m)
-        forces_start = time.perf_counter()
-        summary["forces"] = balance(problem)
-        forces_time = time.perf_counter() - forces_start
-        reactions = ", ".join(f"{k} {v}" for k, v in summary["forces"]["reactions"].items())
-        say(
-            f"reactions (N/m): {reactions or 'none'}; balance (relative) "
-            f"{summary['forces']['balance_relative']:.1e}"
-        )
-    summary["forms_compiled"] = len(forms._cache) - compiled_before
+    forces_start = time.perf_counter()  # reactions, interface resultants, balance (N/m)
+    summary["forces"] = balance(problem, result.fields[0])  # the field: plain problems only
+    forces_time = time.perf_counter() - forces_start
+    reactions = ", ".join(f"{k} {v}" for k, v in summary["forces"]["reactions"].items())
+    say(
+        f"reactions (N/m): {reactions or 'none'}; balance (relative) "
+        f"{summary['forces']['balance_relative']:.1e}"
+    )
+    summary["forms_compiled"] = forms.compiled_forms() - compiled_before
     cut_timings = getattr(getattr(problem, "cut", None), "timings", {})
     timings = dict(cut_timings) | {
         "mesh_and_spaces": build_time - sum(cut_timings.values()),
         "solve": solve_time,
+        "forces": forces_time,
     }
-    if "forces" in summary:
-        timings["forces"] = forces_time
     if out is not None:
         output_start = time.perf_counter()
         _write_grid(out, problem, result)

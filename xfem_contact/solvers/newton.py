@@ -144,8 +144,9 @@ class RestrictedNewton:
         self.D = saddle_point_scaling(self.J_r)
         self.J_r.diagonalScale(self.D, self.D)
         self.timings["scaling"] = time.perf_counter() - start
-        self._options = merged_options("newton", petsc_options)
-        self._symmetric = self._options.get("pc_type") == "cholesky"
+        #: The PETSc options (without prefix) of this solver's SNES, KSP and PC
+        self.options = merged_options("newton", petsc_options)
+        self._symmetric = self.options.get("pc_type") == "cholesky"
         if self._symmetric:
             mark_symmetric(self.J_r)
         self.R = R.copy()
@@ -157,7 +158,7 @@ class RestrictedNewton:
         # during each solve, when the factorisation reads e.g. mat_mumps_* options)
         self._prefix = unique_prefix(petsc_options_prefix)
         self.snes.setOptionsPrefix(self._prefix)
-        with applied_options(self._prefix, self._options):
+        with applied_options(self._prefix, self.options):
             self.snes.setFromOptions()
         self._split_objects = split_sets(
             self.snes.getKSP().getPC(),
@@ -276,7 +277,7 @@ class RestrictedNewton:
         self.jacobian.keep_constant_blocks()  # the uncut cells' linear bulk: once a solve
         for coupling in self.couplings:
             coupling.begin_step(self.w)
-        with applied_options(self._prefix, self._options):
+        with applied_options(self._prefix, self.options):
             try:
                 self.snes.solve(None, self.y)
             except PETSc.Error as error:  # a callback's own error (e.g. an unsymmetric

@@ -1,0 +1,65 @@
+"""Each stability test fails with the guard it checks switched off.
+
+Guards: the ghost penalty (cut fractions), the harmonic-mean augmentation (stiffness
+contrast), the Coulomb clamp (friction cone), the objective bulk (a large rotation in
+one step or ten). The LBB check carries its own counter-test (``lbb="none"``).
+Marked ``guards``: ``pytest -m guards`` runs these alone.
+"""
+
+import pytest
+import test_cuts
+import test_friction
+import test_materials
+import test_rotation
+
+import xfem_contact.mechanics.problem as problem_module
+from xfem_contact.mechanics.bulk import SmallStrain
+from xfem_contact.mechanics.laws import contact
+from xfem_contact.solvers.newton import NewtonFailure
+
+
+def without_ghost_penalty(monkeypatch):
+    solve_at = test_cuts.solve_at
+    monkeypatch.setattr(
+        test_cuts, "solve_at", lambda f, d, comm=None, **o: solve_at(f, d, ghost_penalty=0.0)
+    )
+    return lambda: test_cuts.test_condition_and_error_stay_bounded_as_the_cut_vanishes(2)
+
+
+def with_arithmetic_mean_augmentation(monkeypatch):
+    monkeypatch.setattr(
+        contact.ContactLaw,
+        "augmentation_coefficient",
+        lambda self, m, h: self.augmentation * 0.5 * (m[-1].E + m[1].E) / h,
+    )
+    return lambda: test_materials.test_stiffness_contrast_keeps_the_interface_closed_and_smooth(
+        1e6
+    )
+
+
+def without_coulomb_clamp(monkeypatch):
+    monkeypatch.setattr(contact.Coulomb, "friction_bound", lambda self, P_n, ops: None)
+    return lambda: test_friction.test_any_friction_converges_inside_the_cone(0.3)
+
+
+def with_small_strain_bulk(monkeypatch):
+    monkeypatch.setattr(
+        problem_module, "BULK_MODELS", dict(problem_module.BULK_MODELS, large=SmallStrain)
+    )
+    return test_rotation.test_one_step_or_ten_give_the_same_pressures
+
+
+GUARDS = {
+    "ghost penalty": without_ghost_penalty,
+    "harmonic-mean augmentation": with_arithmetic_mean_augmentation,
+    "Coulomb clamp": without_coulomb_clamp,
+    "objective bulk": with_small_strain_bulk,
+}
+
+
+@pytest.mark.guards
+@pytest.mark.parametrize("guard", GUARDS)
+def test_a_stability_test_fails_without_its_guard(guard, monkeypatch):
+    check = GUARDS[guard](monkeypatch)
+    with pytest.raises((AssertionError, NewtonFailure)):
+        check()
