@@ -29,6 +29,45 @@ from xfem_contact.fem.forms import form
 
 
 # -- accessors of the problem (one place to follow its API) ---------------------------
+class _OneField:
+    """The space of a plain problem seen as an enriched space with one displacement field."""
+
+    fields = (0,)
+
+    def __init__(self, V: dolfinx.fem.FunctionSpace):
+        self.W = V
+        imap = V.dofmap.index_map
+        self._all = np.arange((imap.size_local + imap.num_ghosts) * V.dofmap.index_map_bs)
+
+    def field_space(self, field: int):
+        return self.W, self._all
+
+    def test(self) -> tuple:
+        return (ufl.TestFunction(self.W),)
+
+
+class _PlainView:
+    """A plain (uncut) problem with its solution ``w``, seen as a cut one with no law."""
+
+    linear, laws, couplings = True, {}, {}
+
+    def __init__(self, problem, w: dolfinx.fem.Function):
+        self.problem, self.w, self.loads, self.mesh = problem, w, problem.loads, problem.mesh
+        self.space = _OneField(problem.V)
+
+    def bilinear_form(self) -> ufl.Form:
+        return self.problem.bilinear_form()
+
+
+def _view(problem, w: dolfinx.fem.Function | None):
+    """``problem`` itself, or a plain problem with its solution ``w`` (required)."""
+    if hasattr(problem, "space"):
+        return problem
+    if w is None:
+        raise ValueError("w: a plain problem keeps no solution; pass the one solve() returned")
+    return _PlainView(problem, w)
+
+
 def _load_form(problem) -> ufl.Form:
     """The loads' terms ``L(v)`` (tractions, pressures, body forces)."""
     return problem.loads.linear_form()
@@ -36,7 +75,8 @@ def _load_form(problem) -> ufl.Form:
 
 def _springs(problem):
     """The springs' residual terms (UFL, linear in the test of ``W``), or None."""
-    return problem.loads.spring_terms(ufl.split(problem.w), problem.space.test())
+    u = ufl.split(problem.w) if len(getattr(problem.space, "fields", (0, 1))) > 1 else (problem.w,)
+    return problem.loads.spring_terms(u, problem.space.test())
 
 
 def _functions(load) -> list:
@@ -91,7 +131,7 @@ def unit_vectors(problem) -> list[np.ndarray]:
     W = problem.space.W
     size = W.dofmap.index_map.size_local + W.dofmap.index_map.num_ghosts
     units = [np.zeros(size * W.dofmap.index_map_bs) for _ in range(2)]
-    for field in (0, 1):
+    for field in getattr(problem.space, "fields", (0, 1)):
         _, parent = problem.space.field_space(field)
         for c, e in enumerate(units):
             e[parent[c::2]] = 1.0
@@ -112,16 +152,19 @@ def _force(problem, b: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray
 
 
 # -- public ---------------------------------------------------------------------------
-def reactions(problem, b: np.ndarray | None = None) -> dict[str, np.ndarray]:
+def reactions(
+    problem, b: np.ndarray | None = None, w: dolfinx.fem.Function | None = None
+) -> dict[str, np.ndarray]:
     """Force (N/m, ``(2,)``) of each support (:func:`supports`) on the body.
 
     Args:
-        problem: A solved problem (its ``w``).
+        problem: A solved problem (its ``w``; a plain problem needs ``w``).
         b: The residual vector's owned entries (:func:`residual_vector`), if at hand.
 
     Returns:
         ``{name: array([R_x, R_y])}``. Collective.
     """
+    problem = _view(problem, w)
     if b is None:
         vec = residual_vector(problem)
         b = vec.array_r.copy()
@@ -140,19 +183,21 @@ def reactions(problem, b: np.ndarray | None = None) -> dict[str, np.ndarray]:
     return out
 
 
-def applied_loads(problem) -> tuple[np.ndarray, float]:
+def applied_loads(problem, w: dolfinx.fem.Function | None = None) -> tuple[np.ndarray, float]:
     """The resultant (N/m, ``(2,)``) of the tractions, pressures and body forces at the
     current time, ``L(e_c)``, and their total size ``max_c sum_i |L_i e_c(i)|`` (N/m: the
     scale of a balance of self-equilibrated loads). Collective."""
+    problem = _view(problem, w)
     vec = _vector(problem, _load_form(problem))
     L = vec.array_r.copy()
     vec.destroy()
     return _force(problem, L), float(_force(problem, np.abs(L)).max())
 
 
-def interface_resultants(problem) -> dict[str, np.ndarray]:
+def interface_resultants(problem, w: dolfinx.fem.Function | None = None) -> dict[str, np.ndarray]:
     """Per interface, the resultant (N/m, ``(2,)``) of its traction on side -1 (the force
     side +1 exerts on side -1 across it; zero for a free interface). Collective."""
+    problem = _view(problem, w)
     out = {}
     v = problem.space.test()
     for name, law in problem.laws.items():
@@ -175,9 +220,10 @@ def interface_resultants(problem) -> dict[str, np.ndarray]:
     return out
 
 
-def spring_reactions(problem) -> np.ndarray | None:
+def spring_reactions(problem, w: dolfinx.fem.Function | None = None) -> np.ndarray | None:
     """The force (N/m, ``(2,)``) of the tangential spring supports on the body, or None
     without springs. Collective."""
+    problem = _view(problem, w)
     terms = _springs(problem)
     if terms is None:
         return None
@@ -187,10 +233,11 @@ def spring_reactions(problem) -> np.ndarray | None:
     return force
 
 
-def balance(problem) -> dict:
+def balance(problem, w: dolfinx.fem.Function | None = None) -> dict:
     """Reactions per support, the applied loads, interface resultants and the global
     balance ``sum(reactions) + loads`` (N/m), with its size relative to the largest
     reaction or the total size of the loads (:func:`applied_loads`). Collective."""
+    problem = _view(problem, w)
     vec = residual_vector(problem)
     held = reactions(problem, vec.array_r.copy())
     vec.destroy()

@@ -85,7 +85,8 @@ def _scenes(args) -> int:
 
 
 def _show(args) -> int:
-    """Render a run folder: result.png, cut.png and pressure.png (those with data)."""
+    """Render a run folder: result.png, von_mises.png, cut.png, pressure.png and, for
+    friction laws, traction.png (those with data)."""
     from xfem_contact.io.pictures import render_folder
 
     try:
