@@ -179,6 +179,20 @@ class EnrichedSpace:
         Collective."""
         self._active = self._active_dofs()
 
+    def carry(self, w: dolfinx.fem.Function, before: npt.NDArray[np.bool_]) -> None:
+        """Carry ``w`` (on ``W``) from the active dofs ``before`` (a copy of
+        :attr:`active` taken before a :meth:`refresh`) onto the current ones: a side's
+        dof that became active takes the other side's value at its node where that one
+        was active (the field continued across the old interface); inactive dofs are
+        zeroed. Collective (ghost update)."""
+        active = self._active
+        minus, plus = (self.field_space(i)[1] for i in (0, 1))
+        for mine, other in ((minus, plus), (plus, minus)):
+            take = active[mine] & ~before[mine] & before[other]
+            w.x.array[mine[take]] = w.x.array[other[take]]
+        w.x.array[~active] = 0.0
+        w.x.scatter_forward()
+
     @property
     def active(self) -> npt.NDArray[np.bool_]:
         """Active flags of the local (owned + ghost) dofs of ``W``."""

@@ -17,17 +17,16 @@ from collections.abc import Callable, Mapping
 import dolfinx.fem
 import numpy as np
 import ufl
-from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.enrichment import EnrichedSpace
-from xfem_contact.fem.evaluation import interface_points
 from xfem_contact.fem.forms import form
 from xfem_contact.fem.restriction import restriction_matrix
 from xfem_contact.mechanics.bulk import BULK_MODELS, KINEMATICS, cell_size, check_ghosts
 from xfem_contact.mechanics.composition import Materials, interface_laws, side_and_law_materials
+from xfem_contact.mechanics.contexts import interface_context, samples, status_counts
 from xfem_contact.mechanics.defaults import DEFAULT
-from xfem_contact.mechanics.laws import InterfaceContext, InterfaceLaw, large_sliding
+from xfem_contact.mechanics.laws import InterfaceLaw, large_sliding
 from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loads import Loads, SideFields
 from xfem_contact.mechanics.parameters import bound_copy
@@ -86,8 +85,7 @@ class Problem:
         self.laws = interface_laws(cut, law)
         if kinematics == "large":
             self.laws = {n: large_sliding(law, slave, pairing) for n, law in self.laws.items()}
-        #: Parameters of the laws are Constants of this problem's forms: set them on
-        #: ``problem.law(name)`` (a law object given to a problem on another mesh is copied)
+        # the laws' parameters become Constants of these forms (copied if bound elsewhere)
         self.laws = {n: bound_copy(law, self.mesh) for n, law in self.laws.items()}
         side_materials = side_and_law_materials(cut, materials)
         if min_support_fraction is None:
@@ -129,7 +127,15 @@ class Problem:
             self.side_indicator = side
         fields = {name: field for field, _, name in self.space.multiplier_fields}
         self.contexts = {
-            name: self._context(name, self._law_materials[name], fields.get(name))
+            name: interface_context(
+                self.cut,
+                name,
+                self._law_materials[name],
+                fields.get(name),
+                self.side_indicator,
+                self.cell_size,
+                self.w_old,
+            )
             for name in self.laws
         }
         #: Terms of laws coupling two cells (large sliding), assembled outside UFL
@@ -146,72 +152,19 @@ class Problem:
 
     def update_interface(self, levelset) -> None:
         """Move the interfaces: cut the mesh with ``levelset`` (as
-        :meth:`~xfem_contact.fem.cutmesh.CutMesh.update`; the same interface names)
-        and keep everything else: loads, supports, laws and their parameters, the
-        mixed space ``W``. Forms are re-created from the compiled ones (nothing is
-        compiled unless the new cut adds an integral the old one had none of).
-
-        The next solve starts from the previous solution carried onto the new
-        active dofs (a warm start): a dof that becomes active on one side takes the
-        value of the other side's field at the same node when that one was active
-        (the displacement continued across the old interface), otherwise 0;
-        multipliers of new cut cells start at 0; inactive dofs are zeroed. The last
-        accepted state ``w_old`` (the origin of Coulomb's slip increments) is
-        carried the same way, so a moved Coulomb interface keeps its history where
-        the two positions overlap. Collective.
+        :meth:`~xfem_contact.fem.cutmesh.CutMesh.update`, the same interface names),
+        keeping the loads, supports, laws, parameters and ``W``; forms are re-created
+        from the compiled ones. The next solve starts from the solution carried onto
+        the new active dofs (:meth:`~xfem_contact.fem.enrichment.EnrichedSpace.carry`;
+        new multipliers start at 0), and so does Coulomb's last accepted state
+        ``w_old``: the slip history stays where the two positions overlap. Collective.
         """
         before = self.space.active.copy()
         self.cut.update(levelset)
         self.space.refresh()
         self._attach_cut()
         for w in (self.w, self.w_old):
-            self._carry(w, before)
-
-    def _carry(self, w: dolfinx.fem.Function, before: np.ndarray) -> None:
-        """Carry ``w`` from the active dofs ``before`` onto the current ones (see
-        :meth:`update_interface`)."""
-        active = self.space.active
-        minus, plus = (self.space.field_space(i)[1] for i in (0, 1))
-        for mine, other in ((minus, plus), (plus, minus)):
-            take = active[mine] & ~before[mine] & before[other]
-            w.x.array[mine[take]] = w.x.array[other[take]]
-        w.x.array[~active] = 0.0
-        w.x.scatter_forward()
-
-    def _context(self, name: str, materials: dict, field: int | None) -> InterfaceContext:
-        cut = self.cut
-        if len(cut.interface_names) == 1:
-            on_cut_cells = 1.0 - abs(self.side_indicator)  # 1 on cut cells, 0 elsewhere
-        else:
-            indicator = dolfinx.fem.Function(self.side_indicator.function_space)
-            dofs = indicator.function_space.dofmap.list[cut.interface_cells(name), 0]
-            indicator.x.array[dofs] = 1.0
-            indicator.x.scatter_forward()
-            on_cut_cells = indicator
-        return InterfaceContext(
-            aligned_cells=self._aligned_cells(name),
-            cut=cut,
-            name=name,
-            measure=cut.interface_measure(name),
-            rules=cut.interface_rules_of(name),
-            materials=materials,
-            cell_size=self.cell_size,
-            cut_cells=on_cut_cells,
-            field=field,
-            w_old=self.w_old,
-        )
-
-    def _aligned_cells(self, name: str) -> dolfinx.fem.Function | None:
-        """DG0 indicator of the cut cells of interface ``name`` whose piece follows a
-        line of the reference coordinates; None when no process has one. Collective."""
-        cut = self.cut
-        local = cut.cut_cells[cut.trace_nullity(name) >= 2]
-        if self.mesh.comm.allreduce(local.size, op=MPI.SUM) == 0:
-            return None
-        aligned = dolfinx.fem.Function(self.side_indicator.function_space, name="aligned")
-        aligned.x.array[aligned.function_space.dofmap.list[local, 0]] = 1.0
-        aligned.x.scatter_forward()
-        return aligned
+            self.space.carry(w, before)
 
     @property
     def ghost_penalty(self) -> float:
@@ -428,28 +381,14 @@ class Problem:
     def interface_status(self, w: dolfinx.fem.Function) -> dict:
         """Global counts of interface rule points by status (contact / stick / slip),
         prefixed by the interface name when there are several. Collective."""
-        counts = {}
-        for name, law in self.laws.items():
-            local = law.status(law.state(self.contexts[name], w))
-            prefix = f"{name} " if len(self.laws) > 1 else ""
-            counts |= {prefix + k: v for k, v in local.items()}
-        comm = self.mesh.comm
-        return {k: comm.allreduce(v, op=MPI.SUM) for k, v in counts.items()}
+        return status_counts(self.laws, self.contexts, w)
 
     def interface_samples(self, name: str | None = None) -> dict[str, list[float]]:
-        """The state of the solution at the rule points of all processes (for plots
-        and summaries): ``x``, ``y`` (m) and the law's state (``gap``, ``slip``,
-        ``lambda_n``, ``lambda_t``, and ``P_n``, ``P_t`` for contact laws), each a
-        list over the points. Collective."""
+        """The state of the solution at the rule points of all processes, for plots
+        and summaries (see :func:`~xfem_contact.mechanics.contexts.samples`).
+        Collective."""
         name = self._name(name)
-        ctx = self.contexts[name]
-        state = self.laws[name].state(ctx, self.w)
-        points = interface_points(self.cut, ctx.rules)
-        local = {"x": points[:, 0], "y": points[:, 1]}
-        keys = ("gap", "slip", "lambda_n", "lambda_t", "P_n", "P_t")
-        local |= {k: state[k] for k in keys if k in state}
-        comm = self.mesh.comm
-        return {k: np.concatenate(comm.allgather(v)).tolist() for k, v in local.items()}
+        return samples(self.laws[name], self.contexts[name], self.w)
 
 
 def _weak_method(method: Callable) -> Callable:
