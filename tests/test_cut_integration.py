@@ -1,6 +1,7 @@
 """Cut-cell integration through UFL forms against exact geometry."""
 
 import dolfinx.fem
+import dolfinx.mesh
 import numpy as np
 import pytest
 import ufl
@@ -247,3 +248,19 @@ def test_parallel_equals_serial_integrals():
             ]
         )
     assert np.allclose(values[0], values[1], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "levelset, message",
+    [
+        (lambda x: 1.0, r"Interface 'interface': the level set must return one value per point"),
+        (lambda x: np.array([x[0], x[1]]), r"returned shape \(2, "),
+        (lambda x: x[0] + 2.0, r"Interface 'interface': The level set never crosses zero"),
+        (lambda x: np.full(x.shape[1], np.nan), r"Interface 'interface': .*NaN"),
+        ({"a": lambda x: x[0] - 0.5, "b": lambda x: x[0] + 3.0}, "Interface 'b': .*never crosses"),
+    ],
+)
+def test_a_bad_level_set_is_refused_naming_its_interface(levelset, message):
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    with pytest.raises(ValueError, match=message):
+        xfem_contact.CutMesh(mesh, levelset)

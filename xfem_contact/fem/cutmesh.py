@@ -102,9 +102,14 @@ class CutMesh:
         self.interface_names: tuple[str, ...] = names
         self._components = components
         previous = getattr(self, "levelset", None)  # kept: forms keep their signatures
-        self.levelset: LevelSet = interpolate(
-            mesh, levelset, self.degree, into=None if previous is None else previous.function
-        )
+        try:
+            self.levelset: LevelSet = interpolate(
+                mesh, levelset, self.degree, into=None if previous is None else previous.function
+            )
+        except ValueError as error:
+            if len(names) > 1:  # the union: each interface was checked by name
+                raise
+            raise ValueError(f"Interface {names[0]!r}: {error}") from None
         maps = CellMaps(mesh, self.levelset)
         num_owned = mesh.topology.index_map(tdim).size_local
         owned = np.arange(num_owned, dtype=np.int32)

@@ -40,6 +40,20 @@ class LevelSet(typing.NamedTuple):
 ZERO_TOLERANCE = 64 * np.finfo(np.float64).eps
 
 
+def _values(levelset: LevelSetCallable, x: np.ndarray) -> np.ndarray:
+    """``levelset(x)`` checked: one float per point of ``x`` (shape ``(3, n)``)."""
+    try:
+        values = np.asarray(levelset(x), dtype=np.float64)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"the level set failed on points x of shape {x.shape}: {error}") from None
+    if values.shape != (x.shape[1],):
+        raise ValueError(
+            f"the level set must return one value per point, shape ({x.shape[1]},) for x "
+            f"of shape {x.shape}; it returned shape {values.shape}"
+        )
+    return values
+
+
 def interpolate(
     mesh: dolfinx.mesh.Mesh,
     levelset: LevelSetCallable | dolfinx.fem.Function,
@@ -73,7 +87,7 @@ def interpolate(
         phi.interpolate(levelset)
         exact = None
     elif callable(levelset):
-        phi.interpolate(lambda x: np.asarray(levelset(x), dtype=np.float64))
+        phi.interpolate(lambda x: _values(levelset, x))
         exact = levelset
     else:
         raise ValueError(f"A level set is a callable or a dolfinx Function, not {type(levelset)}")
