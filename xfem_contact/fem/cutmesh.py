@@ -1,6 +1,4 @@
-"""CutMesh: a mesh cut by a level-set interface, with UFL measures for each side
-and for the interface.
-"""
+"""CutMesh: a mesh cut by a level-set interface, with UFL measures for its sides and interface."""
 
 from __future__ import annotations
 
@@ -40,24 +38,22 @@ _counter = itertools.count()
 class CutMesh:
     """A mesh cut by the zero line of a level set.
 
-    Side -1 is ``phi < 0``, side +1 is ``phi >= 0``; the interface normal points
-    from side -1 to side +1. Cut cells are sub-triangulated into curved 6-node
-    triangles on each side and a 3-node curved segment on the interface
-    (straight for ``degree=1``), and integrated with per-cell runtime rules;
-    uncut cells use FFCx's standard rule.
+    Side -1 is ``phi < 0``, side +1 is ``phi >= 0``; the interface normal points from side
+    -1 to side +1. Cut cells are sub-triangulated into curved 6-node triangles on each side
+    and a 3-node curved segment on the interface (straight for ``degree=1``), integrated
+    with per-cell runtime rules; uncut cells use FFCx's standard rule.
 
     Args:
         mesh: A triangle or quadrilateral mesh (affine, distorted or curved).
-        levelset: A callable ``phi(x)`` (``x`` of shape ``(3, n)``) or a
-            scalar DOLFINx Function. With a callable the interface nodes lie
-            on its exact zero set; with a Function, on its interpolant's.
-            Several interfaces: a mapping ``{name: callable}``; they are cut as
-            one level set, ``min_i phi_i`` (checked apart, see
-            :func:`xfem_contact.geometry.levelset.union`), and each keeps its
-            own measure (:meth:`interface_measure`) and rules.
+        levelset: A callable ``phi(x)`` (``x`` of shape ``(3, n)``) or a scalar DOLFINx
+            Function. With a callable the interface nodes lie on its exact zero set; with
+            a Function, on its interpolant's. Several interfaces: a mapping ``{name:
+            callable}``, cut as one level set ``min_i phi_i`` (checked apart, see
+            :func:`xfem_contact.geometry.levelset.union`), each with its own measure
+            (:meth:`interface_measure`) and rules.
         degree: Lagrange degree (1 or 2) the level set is interpolated in.
-        quadrature_degree: Polynomial degree of the rules on each curved
-            sub-triangle and on each interface segment.
+        quadrature_degree: Polynomial degree of the rules on each curved sub-triangle and
+            on each interface segment.
 
     Example:
         >>> cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 0.5)

@@ -60,9 +60,8 @@ SOLVER_OPTIONS: dict[str, Option] = {
     "mat_mumps_icntl_7": Option(
         int,
         4,
-        "MUMPS fill-reducing ordering; 4 = PORD (case-2 Jacobian at 320x320, 830 k dofs: "
-        "factorisation 7.3 s and 204 M factor entries, METIS 14.1 s and 207 M, its "
-        "analysis alone 5.6 s; AMF 8.5 s and 233 M)",
+        "MUMPS fill-reducing ordering; 4 = PORD (faster than METIS and AMF on these "
+        "Jacobians: see the docs' performance page)",
         None,
         _BOTH,
     ),
@@ -70,10 +69,9 @@ SOLVER_OPTIONS: dict[str, Option] = {
         int,
         7,
         "MUMPS row/column scaling; 7 = its cheap iterative one, on top of ours "
-        "(xfem_contact.solvers.scaling). Its automatic choice (77: weighted matching) spent "
-        "5.2 s of 13.0 s factorising the case-2 Jacobian at 320x320 (830 k dofs); none (0) "
-        "is as fast but runs out of workspace (INFO(1) = -9) on the delayed pivots of the "
-        "LBB restriction's systems",
+        "(xfem_contact.solvers.scaling). Its automatic choice (77: weighted matching) is "
+        "slow on large meshes; none (0) runs out of workspace (INFO(1) = -9) on the "
+        "delayed pivots of the LBB restriction's systems",
         None,
         _BOTH,
     ),
