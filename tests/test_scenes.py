@@ -233,7 +233,7 @@ BAD_SCENES = {
     "ellipse without axes": (
         interface(shape="ellipse", centre=[0.5, 0.5]),
         "interfaces[0].axes",
-        "required for shape 'ellipse' (its parameters: centre, axes, angle)",
+        "required for shape 'ellipse' (its parameters: centre, axes, angle, angle_deg)",
     ),
     "negative ellipse axis": (
         interface(shape="ellipse", centre=[0.5, 0.5], axes=[0.2, -0.1]),
@@ -254,6 +254,21 @@ BAD_SCENES = {
     "coulomb without friction": (circle(law="coulomb"), "interfaces[0].friction", "required"),
     "negative friction": (circle(friction=-0.1), "interfaces[0].friction", "must be >= 0.0"),
     "lbb choice": (circle(lbb="magic"), "interfaces[0].lbb", "choose one of ['stabilized'"),
+    "friction on a sticking law": (
+        circle(law="sticking", friction=0.3),
+        "interfaces[0].friction",
+        "is not an option of law 'sticking'",
+    ),
+    "ellipse angle in degrees as radians": (
+        interface(shape="ellipse", centre=[0.5, 0.5], axes=[0.2, 0.1], angle=30),
+        "interfaces[0].angle",
+        "is in radians (30 rad is more than a turn); use angle_deg",
+    ),
+    "ellipse angle twice": (
+        interface(shape="ellipse", centre=[0.5, 0.5], axes=[0.2, 0.1], angle=0.5, angle_deg=30),
+        "interfaces[0].angle_deg",
+        "give the angle once",
+    ),
     "missing material": (circle(inside="steel"), "interfaces[0].inside", "no such material"),
     "expression name": (
         interface(shape="expression", expression="os.system(1)"),

@@ -3,6 +3,7 @@ problem, creating only the effects it names (see :func:`build`)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import NamedTuple
 
@@ -30,7 +31,8 @@ def levelset(spec: InterfaceSpec) -> Callable[[np.ndarray], np.ndarray]:
         (cx, cy), r = p["centre"], float(p["radius"])
         return lambda x: np.hypot(x[0] - cx, x[1] - cy) - r
     if spec.shape == "ellipse":
-        (cx, cy), (a, b), t = p["centre"], p["axes"], float(p.get("angle", 0.0))
+        (cx, cy), (a, b) = p["centre"], p["axes"]
+        t = math.radians(p["angle_deg"]) if "angle_deg" in p else float(p.get("angle", 0.0))
 
         def phi(x):
             dx, dy = x[0] - cx, x[1] - cy

@@ -227,6 +227,11 @@ def _interface(table, k: int, materials: dict) -> InterfaceSpec:
         if key in table and key not in required + optional:
             message = f"is not a parameter of shape {shape!r} (its parameters: {parameters})"
             raise SceneError(f"{where}.{key}", message)
+    if "angle" in table and "angle_deg" in table:
+        raise SceneError(f"{where}.angle_deg", "give the angle once: angle (rad) or angle_deg")
+    if abs(table.get("angle", 0.0)) > 2.0 * math.pi:
+        message = f"is in radians ({table['angle']} rad is more than a turn); use angle_deg"
+        raise SceneError(f"{where}.angle", message)
     if "normal" in table and not 0.0 < math.hypot(*table["normal"]) < math.inf:
         raise SceneError(f"{where}.normal", f"must be a non-zero vector, got {table['normal']}")
     law = table.get("law", "bonded")

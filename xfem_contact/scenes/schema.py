@@ -55,7 +55,7 @@ MESH_KEYS = {
 #: The parameters of each interface shape: (required, optional)
 SHAPE_KEYS = {
     "circle": (("centre", "radius"), ()),
-    "ellipse": (("centre", "axes"), ("angle",)),
+    "ellipse": (("centre", "axes"), ("angle", "angle_deg")),
     "line": (("point", "normal"), ()),
     "half-plane": (("point", "normal"), ()),
     "expression": (("expression",), ()),
@@ -291,7 +291,8 @@ FIELDS = {
         "centre": Field(_POINT, "[x, y] (m)"),
         "radius": Field(_POSITIVE, "(m) > 0"),
         "axes": Field(Vector(2, _POSITIVE), "[a, b] (m) > 0"),
-        "angle": Field(Number(), "(rad)"),
+        "angle": Field(Number(), "(rad) in [-2 pi, 2 pi]; or angle_deg"),
+        "angle_deg": Field(Number(), "(degrees), instead of angle"),
         "point": Field(_POINT, "[x, y]"),
         "normal": Field(_POINT, "[nx, ny], non-zero"),
         "expression": Field(Expression(), "phi(x, y), negative inside"),
