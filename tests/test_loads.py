@@ -44,14 +44,14 @@ def test_a_value_change_compiles_nothing_and_changes_the_solution(plain):
     traction = loads.add_traction("right", (0.5, 0.0))
     spring = loads.add_tangential_spring("left", 10.0)
     signature = (plain.bilinear_form().signature(), loads.linear_form().signature())
-    first = plain.solve().x.array.copy()
+    first = plain.solve().w.x.array.copy()
     compiled = forms.compiled_forms()
     pressure.value, traction.value = 2.0, (1.0, 0.0)
     assert (pressure.value, traction.value) == (2.0, (1.0, 0.0))
-    doubled = plain.solve().x.array.copy()
+    doubled = plain.solve().w.x.array.copy()
     assert np.allclose(doubled, 2 * first, rtol=0, atol=1e-12 * np.abs(first).max())
     spring.value = 1e4
-    stiffer = plain.solve().x.array
+    stiffer = plain.solve().w.x.array
     assert np.abs(stiffer - doubled).max() > 1e-3 * np.abs(doubled).max()
     assert (plain.bilinear_form().signature(), loads.linear_form().signature()) == signature
     assert forms.compiled_forms() == compiled

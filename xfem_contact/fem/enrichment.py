@@ -94,6 +94,19 @@ class EnrichedSpace:
         self._collapsed: dict[int, tuple[dolfinx.fem.FunctionSpace, npt.NDArray]] = {}
 
     # -- fields -------------------------------------------------------------
+    def field_names(self) -> list[str]:
+        """Output names of the fields: ``u_minus``, ``u_plus``, then ``multiplier``
+        (``multiplier_NAME`` per interface when several have one)."""
+        names = ["u_minus", "u_plus"]
+        one = len(self.multiplier_fields) == 1
+        return names + [
+            "multiplier" if one else f"multiplier_{name}" for _, _, name in self.multiplier_fields
+        ]
+
+    def displacement_sides(self) -> list[tuple[str, int]]:
+        """``(label, side)`` of the displacement fields 0 and 1."""
+        return [("minus", -1), ("plus", 1)]
+
     def trial(self) -> tuple:
         """``(u_minus, u_plus[, lambda])`` trial functions."""
         return ufl.split(ufl.TrialFunction(self.W))

@@ -1,5 +1,10 @@
 """Plain (uncut) linear elasticity: what a scene without interfaces builds.
 
+It follows the protocol of :class:`~xfem_contact.mechanics.problem.Problem` with no
+interface: ``loads``, ``space`` (one field), ``w``, ``laws`` (none), ``solve()``
+returning a :class:`~xfem_contact.solvers.report.SolveReport`, ``accept_step()``, so
+that the scene runner, the outputs and the reactions treat both alike.
+
 One displacement field on the whole mesh, standard DOLFINx forms and one
 linear solve; no level set, no cut, no enrichment, no multiplier. Its loads are a
 :class:`~xfem_contact.mechanics.loads.Loads` as a cut problem's (``problem.loads``).
@@ -7,15 +12,66 @@ linear solve; no level set, no cut, no enrichment, no multiplier. Its loads are 
 
 from __future__ import annotations
 
+import time
+
 import dolfinx.fem
 import dolfinx.fem.petsc
 import dolfinx.mesh
+import numpy as np
+import numpy.typing as npt
 import ufl
 
+from xfem_contact.fem.enrichment import DofCounts
 from xfem_contact.fem.forms import form
 from xfem_contact.mechanics.loads import Loads, PlainFields
-from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.materials import Material, Moduli
 from xfem_contact.solvers.options import remove_options, unique_prefix
+from xfem_contact.solvers.report import SolveReport
+
+
+class PlainSpace:
+    """One displacement field on the whole mesh, seen as an enriched space with no
+    enrichment (the names and methods of :class:`~xfem_contact.fem.enrichment.EnrichedSpace`
+    that a runner reads)."""
+
+    #: The displacement fields (one) and their sides
+    fields = (0,)
+    multiplier_fields: list = []
+
+    def __init__(self, V: dolfinx.fem.FunctionSpace):
+        self.W = V
+        imap = V.dofmap.index_map
+        self._all = np.arange((imap.size_local + imap.num_ghosts) * V.dofmap.index_map_bs)
+
+    def field_names(self) -> list[str]:
+        """``["u"]``."""
+        return ["u"]
+
+    def displacement_sides(self) -> list[tuple[str, int]]:
+        """``(label, side)`` of each displacement field: one, side +1."""
+        return [("", 1)]
+
+    def field_space(self, field: int) -> tuple[dolfinx.fem.FunctionSpace, npt.NDArray]:
+        """The space itself and the identity map of its local dofs."""
+        return self.W, self._all
+
+    def test(self) -> tuple:
+        return (ufl.TestFunction(self.W),)
+
+    def trial(self) -> tuple:
+        return (ufl.TrialFunction(self.W),)
+
+    def dof_counts(self) -> DofCounts:
+        """Global dof counts (all standard)."""
+        n = self.W.dofmap.index_map.size_global * self.W.dofmap.index_map_bs
+        return DofCounts(n, 0, 0)
+
+
+class _Bulk:
+    """The bulk model's view a runner reads: the material of the one side."""
+
+    def __init__(self, material: Moduli):
+        self.materials = {1: material}
 
 
 class PlainElasticityProblem:
@@ -24,19 +80,27 @@ class PlainElasticityProblem:
     Args:
         mesh: The mesh.
         degree: Displacement degree (Lagrange).
-        material: The material.
+        material: The material (its moduli become Constants: ``problem.material.E``).
 
     Collective.
     """
 
-    #: One linear solve
-    linear = True
+    #: One linear solve; no interface, no law, small kinematics
+    linear, symmetric, kinematics, cut = True, True, "small", None
 
     def __init__(self, mesh: dolfinx.mesh.Mesh, degree: int, material: Material):
-        self.mesh, self.material = mesh, material
+        self.mesh = mesh
+        self.material = Moduli(material, mesh)
         self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (mesh.geometry.dim,)))
+        self.space = PlainSpace(self.V)
+        self.bulk = _Bulk(self.material)
+        self.laws: dict = {}
+        self.couplings: dict = {}
+        #: The solution (m)
+        self.w = dolfinx.fem.Function(self.V, name="u")
         #: Loads, supports and Dirichlet data (``loads.bcs``), and the pseudo-time
         self.loads = Loads(PlainFields(self.V))
+        self.last_report: SolveReport | None = None
 
     def bilinear_form(self) -> ufl.Form:
         """``a(u, v)``: the bulk and the springs' terms (UFL)."""
@@ -45,18 +109,32 @@ class PlainElasticityProblem:
         springs = self.loads.spring_terms((u,), (v,))
         return a if springs is None else a + springs
 
-    def solve(self, petsc_options: dict | None = None) -> dolfinx.fem.Function:
-        """One linear solve (PETSc LU unless ``petsc_options`` say otherwise). Collective."""
+    def solve(self, petsc_options: dict | None = None, log=None) -> SolveReport:
+        """One linear solve (PETSc LU unless ``petsc_options`` say otherwise); ``w``
+        holds the result. ``log`` is unused (no iterates). Collective."""
+        start = time.perf_counter()
         prefix = unique_prefix("xfem_plain_")
         problem = dolfinx.fem.petsc.LinearProblem(
             form(self.bilinear_form()),
             form(self.loads.linear_form()),
             bcs=self.loads.bcs,
-            u=dolfinx.fem.Function(self.V, name="u"),
+            u=self.w,
             petsc_options_prefix=prefix,
             petsc_options={"ksp_type": "preonly", "pc_type": "lu", **(petsc_options or {})},
         )
         try:
-            return problem.solve()
+            problem.solve()
+            reason = problem.solver.getConvergedReason()
         finally:
             remove_options(prefix)  # nothing of ours outlives the solve
+        self.last_report = SolveReport(
+            reason=reason, total_time=time.perf_counter() - start, w=self.w, space=self.space
+        )
+        return self.last_report
+
+    def accept_step(self) -> None:
+        """Nothing to accept: no interface law has a history."""
+
+    def interface_status(self, w: dolfinx.fem.Function) -> dict:
+        """No interface: ``{}``."""
+        return {}

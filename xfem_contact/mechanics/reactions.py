@@ -29,43 +29,19 @@ from xfem_contact.fem.forms import form
 
 
 # -- accessors of the problem (one place to follow its API) ---------------------------
-class _OneField:
-    """The space of a plain problem seen as an enriched space with one displacement field."""
-
-    fields = (0,)
-
-    def __init__(self, V: dolfinx.fem.FunctionSpace):
-        self.W = V
-        imap = V.dofmap.index_map
-        self._all = np.arange((imap.size_local + imap.num_ghosts) * V.dofmap.index_map_bs)
-
-    def field_space(self, field: int):
-        return self.W, self._all
-
-    def test(self) -> tuple:
-        return (ufl.TestFunction(self.W),)
-
-
-class _PlainView:
-    """A plain (uncut) problem with its solution ``w``, seen as a cut one with no law."""
-
-    linear, laws, couplings = True, {}, {}
+class _AtState:
+    """``problem`` seen at the state ``w`` instead of its solution."""
 
     def __init__(self, problem, w: dolfinx.fem.Function):
-        self.problem, self.w, self.loads, self.mesh = problem, w, problem.loads, problem.mesh
-        self.space = _OneField(problem.V)
+        self._problem, self.w = problem, w
 
-    def bilinear_form(self) -> ufl.Form:
-        return self.problem.bilinear_form()
+    def __getattr__(self, name):
+        return getattr(self._problem, name)
 
 
 def _view(problem, w: dolfinx.fem.Function | None):
-    """``problem`` itself, or a plain problem with its solution ``w`` (required)."""
-    if hasattr(problem, "space"):
-        return problem
-    if w is None:
-        raise ValueError("w: a plain problem keeps no solution; pass the one solve() returned")
-    return _PlainView(problem, w)
+    """``problem`` itself, or seen at the state ``w``."""
+    return problem if w is None or w is problem.w else _AtState(problem, w)
 
 
 def _load_form(problem) -> ufl.Form:

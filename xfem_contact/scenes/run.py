@@ -17,7 +17,6 @@ from xfem_contact.io.interface_data import sample_status
 from xfem_contact.io.output import write_json
 from xfem_contact.io.progress import note, progress
 from xfem_contact.mechanics.loads import load_steps
-from xfem_contact.mechanics.plain import PlainElasticityProblem
 from xfem_contact.mechanics.reactions import balance
 from xfem_contact.mechanics.stress import StressFields
 from xfem_contact.scenes.builder import (  # noqa: F401  (re-exported)
@@ -43,60 +42,48 @@ class Result:
 
     def __init__(self, problem):
         self.problem = problem
-        if isinstance(problem, PlainElasticityProblem):
-            self.names = ["u"]
-            self.fields = [dolfinx.fem.Function(problem.V, name="u")]
-            self._maps = [None]
-        else:
-            fields = problem.space.multiplier_fields
-            self.names = ["u_minus", "u_plus"]
-            self.names += [
-                "multiplier" if len(fields) == 1 else f"multiplier_{name}" for _, _, name in fields
-            ]
-            self.fields, self._maps = [], []
-            for i, name in enumerate(self.names):
-                V, dofs = problem.space.field_space(i)
-                self.fields.append(dolfinx.fem.Function(V, name=name))
-                self._maps.append(dofs)
-
+        space = problem.space
+        self.names = space.field_names()
+        self.fields, self._maps = [], []
+        for i, name in enumerate(self.names):
+            V, dofs = space.field_space(i)
+            self.fields.append(dolfinx.fem.Function(V, name=name))
+            self._maps.append(dofs)
         self.stress = _stress_fields(problem, self.fields)
 
     def update(self, solution: dolfinx.fem.Function) -> None:
         """Copy a solution (plain ``u`` or mixed ``w``) into the fields; their stresses."""
         for f, dofs in zip(self.fields, self._maps, strict=True):
-            f.x.array[:] = solution.x.array if dofs is None else solution.x.array[dofs]
+            f.x.array[:] = solution.x.array[dofs]
             f.x.scatter_forward()
         self.stress.update()
 
 
 def _stress_fields(problem, fields: list) -> StressFields:
     """The stresses of the displacement fields, with each side's material law."""
-    bulk = getattr(problem, "bulk", None)
-    if bulk is None:  # a plain problem: one field
-        sides = [("", problem.material, fields[0])]
-    else:
-        sides = [("minus", bulk.materials[-1], fields[0]), ("plus", bulk.materials[1], fields[1])]
-    return StressFields(sides, getattr(problem, "kinematics", "small"))
+    materials = problem.bulk.materials
+    sides = [
+        (label, materials[side], fields[i])
+        for i, (label, side) in enumerate(problem.space.displacement_sides())
+    ]
+    return StressFields(sides, problem.kinematics)
 
 
 def solve_step(
     problem, petsc_options: dict | None = None, log: Callable[[str], None] | None = None
 ) -> tuple[dolfinx.fem.Function, int, dict]:
-    """Solve a problem at its current load factor: (solution, iterations, status).
+    """Solve a problem at its current time and accept the step: (solution, iterations,
+    status).
 
     Contact problems run Newton from the previous step (a ``log`` line per
-    iterate) and accept the step; linear ones solve once. ``petsc_options``
-    override the solver's defaults (cut problems). Raises
+    iterate); linear ones solve once. ``petsc_options`` override the solver's
+    defaults. Raises
     :class:`~xfem_contact.solvers.newton.NewtonFailure` with the iteration
     history when Newton fails.
     """
-    if isinstance(problem, PlainElasticityProblem):
-        return problem.solve(petsc_options), 1, {}
-    if not problem.linear:
-        report = problem.solve(petsc_options=petsc_options, log=log)
-        problem.accept_step()
-        return problem.w, report.iterations, report.status[-1]
-    return problem.solve(petsc_options=petsc_options).w, 1, {}
+    report = problem.solve(petsc_options=petsc_options, log=log)
+    problem.accept_step()
+    return problem.w, report.iterations or 1, report.status[-1] if report.status else {}
 
 
 def run(
@@ -155,7 +142,7 @@ def run(
             iterations.append(its)
             if not problem.linear:
                 residuals.append(problem.last_report.residuals)
-            if getattr(problem, "couplings", None):
+            if problem.couplings:
                 unpaired = problem.unpaired_points()  # collective
                 pairing.append(
                     {
@@ -190,17 +177,14 @@ def run(
         "iterations": int(sum(iterations)),
         "iterations_per_step": iterations,
     }
-    if isinstance(problem, PlainElasticityProblem):
-        summary["dofs"] = {"u": problem.V.dofmap.index_map.size_global * problem.V.dofmap.bs}
-    else:
-        dofs = problem.space.dof_counts()
-        summary["dofs"] = dofs._asdict() | {"total": dofs.total}
+    dofs = problem.space.dof_counts()
+    summary["dofs"] = dofs._asdict() | {"total": dofs.total}
     if not problem.linear:
         summary["contact_status"] = status
         summary["newton_residuals"] = residuals
     if pairing:
         summary["pairing"] = pairing
-    if not isinstance(problem, PlainElasticityProblem):
+    if problem.laws:
         samples = {name: problem.interface_samples(name) for name in problem.laws}
         for name, sampled in samples.items():  # 0 open, 1 stick, 2 slip
             sampled["status"] = sample_status(problem, name)
@@ -210,7 +194,7 @@ def run(
         if not problem.linear and len(samples) == 1:
             summary["interface_samples"] = next(iter(samples.values()))
     forces_start = time.perf_counter()  # reactions, interface resultants, balance (N/m)
-    summary["forces"] = balance(problem, result.fields[0])  # the field: plain problems only
+    summary["forces"] = balance(problem)
     forces_time = time.perf_counter() - forces_start
     reactions = ", ".join(f"{k} {v}" for k, v in summary["forces"]["reactions"].items())
     say(
@@ -218,7 +202,7 @@ def run(
         f"{summary['forces']['balance_relative']:.1e}"
     )
     summary["forms_compiled"] = forms.compiled_forms() - compiled_before
-    cut_timings = getattr(getattr(problem, "cut", None), "timings", {})
+    cut_timings = {} if problem.cut is None else problem.cut.timings
     timings = dict(cut_timings) | {
         "mesh_and_spaces": build_time - sum(cut_timings.values()),
         "solve": solve_time,
@@ -267,7 +251,7 @@ def _write_grid(out: pathlib.Path, problem, result: Result) -> None:
     from xfem_contact.io.output import write_cut_geometry, write_lips, write_plain
 
     stress = result.stress
-    if len(result.fields) == 1 or not hasattr(problem, "cut"):  # a plain problem
+    if problem.cut is None:  # a plain problem
         named = {"stress": stress.stress[0], "von_mises": stress.von_mises[0]}
         write_plain(out / "result.vtu", result.fields[0], named)
     else:
