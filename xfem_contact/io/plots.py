@@ -24,7 +24,7 @@ def line_plot(
 
     Draws on a :class:`matplotlib.figure.Figure` of its own with the Agg canvas: no
     pyplot, so neither the process's backend nor pyplot's figure list is touched.
-    Labels in Unicode (``λₙ``), not mathtext: its parser takes 0.07 s to build."""
+    Labels in Unicode (``λₙ``), not mathtext (whose parser is slow to build)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 

@@ -24,9 +24,8 @@ body by about one. The question is geometric and answered alike for any mesh and
 cut: a straight frictionless interface leaves the sliding along it free, an ellipse
 nothing, a frictionless circle the spin of the inner body. The discrete normal
 (that of the interpolated level set) makes that spin stiff to round-off of the
-geometry only: 1e-4 of a translation's stiffness at 4 cells per diameter, 1e-6 at
-16 (reported); at 2-3 cells per diameter 1e-3 to 1e-2 (not reported with the
-default ``tol``). The bulk adds no constraint (a rigid mode has no strain and no
+geometry only, weakly and the less the finer the mesh (figures: the docs' mechanics
+page). The bulk adds no constraint (a rigid mode has no strain and no
 ghost-penalty jump), nor do the multiplier stabilisations (nor any traction).
 Contact laws are judged closed: an interface that opens under the load may still
 leave a body free, which only the solve can tell.
@@ -131,8 +130,8 @@ def check_support(problem, log=None) -> None:
     """Act on the free rigid modes of ``problem``'s bodies: a body without support is
     an error naming the modes and the constraints that remove them; a spin only a
     frictionless interface leaves free is a :class:`RigidModeWarning` (and a ``log``
-    line on rank 0): a point constraint for it would carry a spurious reaction
-    (hydrostatic case 2: pressure error 1.2e-2 instead of 1.9e-4). Collective.
+    line on rank 0): a point constraint for it would carry a spurious reaction and
+    spoil the pressure (docs' mechanics page). Collective.
 
     Raises:
         ValueError: a body has free rigid modes beyond such a spin.

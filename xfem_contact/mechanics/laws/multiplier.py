@@ -78,10 +78,9 @@ class MultiplierLaw(InterfaceLaw):
     def traction_weights(ctx: InterfaceContext) -> tuple:
         """Weights ``(w_-, w_+)`` of the sides in the interface traction average:
         ``w_- = mu_+ / (mu_- + mu_+)``, ``w_+ = mu_- / (mu_- + mu_+)`` (1/2 each for
-        one material). The softer side weighs more, as in weighted Nitsche methods:
-        with the plain mean, a 1000 times stiffer inclusion under hydrostatic
-        pressure had a contact pressure oscillating by 180 % (part of the interface
-        even opened); weighted, it is smooth to 2 % at h = 0.05 and converges."""
+        one material). The softer side weighs more, as in weighted Nitsche methods: with
+        the plain mean a much stiffer inclusion's contact pressure oscillates (docs'
+        mechanics page)."""
         mu_minus, mu_plus = ctx.materials[-1].ufl_mu, ctx.materials[1].ufl_mu
         return mu_plus / (mu_minus + mu_plus), mu_minus / (mu_minus + mu_plus)
 
@@ -120,20 +119,16 @@ class MultiplierLaw(InterfaceLaw):
         then stalls on round-off). This term sets the multiplier constant along the
         normal off the interface (the normal-gradient stabilisation of TraceFEM): it
         removes those modes. It only has to make them determinate, so its weight is
-        tiny: on the annulus (paper case 3) every weight from 1e-16 to 0.1 gave one
-        Newton step where none stalled on round-off or took 3-4 steps; but the term
-        is not consistent for a multiplier varying along a curved interface, and
-        weights of 1e-8 (P2 triangles, h = 1/160: pressure error 4.5e-5 instead of
-        2.9e-5) to 0.1 (bonded inclusion: 4 times larger) spoil the accuracy. The
-        default 1e-12 changes no measured error.
+        tiny: the term is not consistent for a multiplier varying along a curved
+        interface, and larger weights spoil the accuracy (the docs' mechanics page
+        gives the weights tried).
 
         On cells whose piece follows a line of the reference coordinates
         (``ctx.aligned_cells``) the modes have no trace at all, and the term there acts
         on them alone (the normal derivative of a Q1 function across such a line is
         independent of its values on it): it gets the weight ``ALIGNED_EXTENSION``
         instead, so that they are fixed by a term of the size of the others, not by a
-        1e-12 one (paper case 3 at n = 10: pressure error 8.1317e-4 for every weight
-        from 1e-12 to 1e-2; condition of the factored matrix 2.5e10 at 1e-12).
+        tiny one (the pressure does not depend on that weight; the conditioning does).
         ``lam``, ``mu``: multiplier (scalar or vector) trial/test or coefficient.
         """
         n = ctx.normal
