@@ -104,8 +104,8 @@ class Problem:
         self.cell_size = cell_size(self.mesh)
         bulk = BULK_MODELS[kinematics]
         self.bulk = bulk(cut, side_materials.bulk, degree, self.cell_size, ghost_penalty)
-        #: The materials as Constants of the forms, ``{-1: Moduli or {interface name:
-        #: Moduli}, 1: Moduli}``: set ``E`` or ``nu`` on them (no new compile)
+        #: The materials as Constants of the forms (``Moduli`` per side, per interface
+        #: name on side -1 when given so): set ``E`` or ``nu`` on them (no new compile)
         self.materials = side_materials.user
         self.w = dolfinx.fem.Function(self.space.W, name="w")
         #: The last accepted load step (its jump is the origin of incremental slips)
