@@ -55,6 +55,8 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/iterative.py --tiny
 	$(PY) bench/rotating_inclusion.py --no-progress
 	$(PY) bench/accuracy_vs_time.py --no-progress
+	$(PY) bench/moving_interface.py --no-progress
+	$(PY) bench/parameter_sweep.py --no-progress
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check xfem_contact tests demos bench
