@@ -29,7 +29,7 @@ import numpy.typing as npt
 from xfem_contact.geometry.cut import CutGeometry
 from xfem_contact.geometry.cut_topology import seg3_basis
 
-__all__ = ["RuleSet", "interface_rule", "side_rules"]
+__all__ = ["RuleSet", "curve_rules", "interface_rule", "side_rules", "triangle_rules"]
 
 
 @dataclass(frozen=True)
@@ -121,8 +121,25 @@ def side_rules(geom: CutGeometry, side: int, degree: int, ncut: int) -> RuleSet:
         (geom.tri_minus, geom.tri_minus_cell) if side == -1 else (geom.tri_plus, geom.tri_plus_cell)
     )
     order = np.argsort(cell, kind="stable")
-    tri, cell = tri[order], cell[order]
     xi, w_hat = basix.make_quadrature(basix.CellType.triangle, degree)
+    return triangle_rules(tri[order], cell[order], ncut, xi, w_hat)
+
+
+def triangle_rules(
+    tri: np.ndarray, cell: np.ndarray, ncut: int, xi: np.ndarray, w_hat: np.ndarray
+) -> RuleSet:
+    """Rules of cells through their curved P2 sub-triangles and a reference-triangle rule.
+
+    Args:
+        tri: P2 sub-triangles ``(m, 6, 2)`` (Basix node order), sorted by cell.
+        cell: Cell row of each, shape ``(m,)``, sorted.
+        ncut: Number of cells (rules).
+        xi: Points of the rule on the reference triangle, shape ``(nq, 2)``.
+        w_hat: Its weights, shape ``(nq,)``.
+
+    Returns:
+        A :class:`RuleSet` (no normals): ``X = sum_i N_i(xi) X_i``, ``w = w_hat det(dX/dxi)``.
+    """
     tab = _p2_triangle().tabulate(1, xi)[:, :, :, 0]  # (3, nq, 6)
     X = np.einsum("qi,tid->tqd", tab[0], tri)
     J = np.einsum("kqi,tid->tqdk", tab[1:], tri)  # dX_d / dxi_k
@@ -192,7 +209,32 @@ def interface_rule(
     N, dN = seg3_basis(s[:, 0])
     X = np.einsum("qk,ckd->cqd", N, seg[pieces]).reshape(-1, 2)
     dX = np.einsum("qk,ckd->cqd", dN, seg[pieces]).reshape(-1, 2)
-    rows = np.repeat(cells, nq)
+    w = np.tile(w_hat, pieces.size)
+    return curve_rules(X, dX, w, np.repeat(cells, nq), ncut, jacobian, grad_phi_ref)
+
+
+def curve_rules(
+    X: np.ndarray,
+    dX: np.ndarray,
+    w: np.ndarray,
+    rows: np.ndarray,
+    ncut: int,
+    jacobian: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    grad_phi_ref: Callable[[np.ndarray, np.ndarray], np.ndarray],
+) -> RuleSet:
+    """Rules on curves given by points, tangents and parameter weights (see :func:`interface_rule`).
+
+    Args:
+        X: Reference points ``(N, 2)``, sorted by ``rows``.
+        dX: Reference tangents ``dX/ds`` there, ``(N, 2)``; side -1 lies on their left.
+        w: Weights in the curve parameter ``s``, ``(N,)``.
+        rows: Cell row of each point, ``(N,)``, sorted.
+        ncut: Number of cells (rules).
+        jacobian, grad_phi_ref: As for :func:`interface_rule`.
+
+    Returns:
+        A :class:`RuleSet` with weights ``w |J dX/ds| / vol(J)`` and normals ``(N, gdim)``.
+    """
     J = np.asarray(jacobian(rows, X), dtype=np.float64)
     if J.ndim != 3 or J.shape[0] != rows.size or J.shape[2] != 2:
         raise ValueError(f"jacobian must return shape ({rows.size}, gdim, 2), got {J.shape}")
@@ -201,10 +243,10 @@ def interface_rule(
     Ginv = np.stack([[G[:, 1, 1], -G[:, 0, 1]], [-G[:, 1, 0], G[:, 0, 0]]]).transpose(2, 0, 1)
     Ginv = Ginv / detG[:, None, None]
     t = np.einsum("mdi,mi->md", J, dX)
-    weights = np.tile(w_hat, pieces.size) * np.linalg.norm(t, axis=1) / np.sqrt(detG)
+    weights = w * np.linalg.norm(t, axis=1) / np.sqrt(detG)
     n_ref = np.stack([dX[:, 1], -dX[:, 0]], axis=1)  # towards side +1 (see CutGeometry.seg)
     normal = _unit(np.einsum("mdi,mij,mj->md", J, Ginv, n_ref))
     grad = np.asarray(grad_phi_ref(rows, X), dtype=np.float64)
     grad_x = np.einsum("mdi,mij,mj->md", J, Ginv, grad)
     normal = np.where(((normal * grad_x).sum(axis=1) < 0)[:, None], -normal, normal)
-    return RuleSet(X, weights, _offsets(np.bincount(cells, minlength=ncut) * nq), normal)
+    return RuleSet(X, weights, _offsets(np.bincount(rows, minlength=ncut)), normal)

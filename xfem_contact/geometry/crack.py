@@ -1,0 +1,275 @@
+"""Cracks as two level sets: cell classification, tip positions and the tip's polar coordinates.
+
+Pure numpy and Basix, no DOLFINx. A crack is the zero line of a *normal* level set
+``phi`` where a *tangential* level set ``psi`` is negative (Code_Aster's ``LN``/``LT``,
+GetFEM's two level sets); its tip is where ``phi = psi = 0``. Both are Lagrange
+interpolants (degree 1 or 2, Basix ``gll_warped`` node order) of nodal values
+``(ncells, ndofs)`` on the same cells, as in :mod:`xfem_contact.geometry.cut`. All
+positions are reference coordinates of the parent cell.
+
+Each cell is of one kind (:data:`KIND_NAMES`): :data:`NONE` (``phi`` keeps its sign,
+or ``psi >= 0`` along the whole zero line of ``phi`` in the cell), :data:`CROSSED`
+(``psi < 0`` along all of it: the crack crosses the cell and is cut as a closed
+interface by :func:`xfem_contact.geometry.cut.subtriangulate`; a crack that meets the
+domain boundary ends in such cells) or :data:`TIP` (``psi`` changes sign once along
+it: the tip is inside; cut by :mod:`xfem_contact.geometry.crack_tip_cell`).
+
+Tolerance policy: ``psi`` is sampled at :data:`SAMPLES` points of the SEG3 of the
+``phi`` cut; the tip is the Newton solution of ``(phi, psi) = 0`` started from the
+sampled sign change, converged to ``16 eps``. Degenerate positions are refused
+with a ``ValueError`` naming the case and the cell: a tip within ``tip_tol``
+(reference units) of an edge (*tip on an edge*) or of a vertex (*tip on a node*),
+``|psi| <= tip_tol * (max psi - min psi)`` where the crack leaves a crossed cell,
+a crack along a mesh edge (``phi`` vanishing on an edge where ``psi < 0``),
+``psi`` changing sign more than once in a cell (*crack ends twice*), a tip in a
+cell that ``phi`` does not cut simply, and level sets tangent at the tip. A crack
+through a vertex of a crossed or tip cell is handled.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from xfem_contact.geometry.cut_simple import cut_simple, interpolant
+from xfem_contact.geometry.cut_topology import (
+    CellData,
+    cell_data,
+    check_values,
+    describe_cells,
+    describe_kinds,
+    interior_values,
+    seg3_basis,
+    topology,
+    zero_edges,
+)
+
+__all__ = ["NONE", "CROSSED", "TIP", "KIND_NAMES", "CrackCells", "classify_crack", "polar"]
+
+NONE, CROSSED, TIP = 0, 1, 2
+KIND_NAMES = {NONE: "none", CROSSED: "crossed", TIP: "tip"}
+"""Name of each cell kind."""
+SAMPLES = 17
+"""Points of the ``phi`` cut at which ``psi`` is sampled."""
+_EPS = np.finfo(np.float64).eps
+
+
+@dataclass(frozen=True)
+class CrackCells:
+    """Kinds of cells for one crack and the tip of each tip cell.
+
+    Attributes:
+        kind: :data:`NONE`, :data:`CROSSED` or :data:`TIP` per cell, ``int8`` ``(ncells,)``.
+        tip_cells: Rows of the tip cells, ``(ntip,)``, sorted.
+        tip: Reference position of the tip in each, ``(ntip, 2)``.
+    """
+
+    kind: npt.NDArray[np.int8]
+    tip_cells: npt.NDArray[np.int64]
+    tip: npt.NDArray[np.float64]
+
+    def cells(self, kind: int) -> npt.NDArray[np.int64]:
+        """Rows of the cells of ``kind`` (:data:`NONE`, :data:`CROSSED`, :data:`TIP`)."""
+        if kind not in KIND_NAMES:
+            raise ValueError(f"kind must be one of {sorted(KIND_NAMES)}, got {kind!r}")
+        return np.flatnonzero(self.kind == kind)
+
+    def physical_tips(
+        self, push_forward: Callable[[np.ndarray, np.ndarray], np.ndarray]
+    ) -> npt.NDArray[np.float64]:
+        """Physical tip positions ``(ntip, gdim)`` (m) through ``push_forward(rows (m,),
+        X (m, 2)) -> (m, gdim)``, the parent maps of the cells (rows of ``phi``)."""
+        return np.asarray(push_forward(self.tip_cells, self.tip), dtype=np.float64)
+
+
+def classify_crack(
+    cell_type: str,
+    degree: int,
+    phi: npt.ArrayLike,
+    psi: npt.ArrayLike,
+    tip_tol: float = 1e-9,
+) -> CrackCells:
+    """Kind of every cell for the crack ``phi = 0, psi < 0`` and its tips.
+
+    Args:
+        cell_type: ``"triangle"`` or ``"quadrilateral"``.
+        degree: Level-set degree, 1 or 2 (both level sets).
+        phi: Normal level set, nodal values ``(ncells, ndofs)``.
+        psi: Tangential level set, nodal values ``(ncells, ndofs)``.
+        tip_tol: Distance (reference units) below which a tip is on an edge or node.
+
+    Returns:
+        The :class:`CrackCells`.
+
+    Raises:
+        ValueError: Bad shapes or values, and the degenerate positions of the module
+            docstring (the message names the case and the cells).
+    """
+    data = cell_data(cell_type, degree)
+    phi, psi = check_values(data, phi), check_values(data, psi)
+    if phi.shape != psi.shape:
+        raise ValueError(f"psi must have the shape of phi {phi.shape}, got {psi.shape}")
+    if not tip_tol > 0:
+        raise ValueError(f"tip_tol must be positive, got {tip_tol!r}")
+    scale = np.ptp(psi, axis=1)
+    _refuse_mesh_aligned(data, phi, psi)
+    neg, flags = topology(data, phi)
+    mixed = neg.any(axis=1) & ~neg.all(axis=1)
+    kind = np.full(phi.shape[0], NONE, dtype=np.int8)
+    _classify_special(data, phi, psi, flags, kind)
+    simple = np.flatnonzero((flags == 0) & mixed)
+    seg = cut_simple(data, phi[simple], neg[simple], None, 1e-15)[4]
+    s = np.linspace(0.0, 1.0, SAMPLES)
+    X = np.einsum("qk,ckd->cqd", seg3_basis(s)[0], seg)
+    values = _values(data, psi[simple], X)
+    below = values < 0
+    changes = (below[:, 1:] != below[:, :-1]).sum(axis=1)
+    if np.any(changes > 1):
+        raise ValueError(
+            f"the crack ends twice in {describe_cells(simple[changes > 1])}: psi changes sign "
+            "more than once along phi = 0 (a crack shorter than a cell); refine the mesh"
+        )
+    ends = np.abs(values[:, [0, -1]]) <= tip_tol * scale[simple, None]
+    touching = np.flatnonzero((changes == 0) & ends.any(axis=1))
+    if touching.size:
+        where = np.where(ends[touching, 0], 0, -1)
+        _refuse_on_boundary(data, simple[touching], X[touching, where], tip_tol)
+    kind[simple] = np.where(changes == 1, TIP, np.where(below[:, 0], CROSSED, NONE))
+    tips = np.flatnonzero(changes == 1)
+    k = np.argmax(below[tips, 1:] != below[tips, :-1], axis=1)
+    v0, v1 = values[tips, k], values[tips, k + 1]
+    t = v0 / (v0 - v1)
+    start = (1 - t)[:, None] * X[tips, k] + t[:, None] * X[tips, k + 1]
+    rows = simple[tips]
+    tip = _newton_tip(data, phi[rows], psi[rows], start, rows)
+    _refuse_on_boundary(data, rows, tip, tip_tol)
+    return CrackCells(kind, rows, tip)
+
+
+def _values(data: CellData, values: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """Interpolant of ``values`` ``(n, ndofs)`` at points ``X`` ``(n, q, 2)`` of each row."""
+    n, q = X.shape[:2]
+    return interpolant(data, np.repeat(values, q, axis=0), X.reshape(-1, 2))[0].reshape(n, q)
+
+
+def _refuse_mesh_aligned(data: CellData, phi: np.ndarray, psi: np.ndarray) -> None:
+    """Refuse cells where ``phi`` vanishes along a whole edge on which ``psi < 0`` somewhere."""
+    zero = zero_edges(data, phi)
+    start = psi[:, data.loop]
+    crack = (start < 0) | (np.roll(start, -1, axis=1) < 0)
+    if data.degree == 2:
+        crack |= psi[:, data.loop_mid] < 0
+    bad = np.flatnonzero((zero & crack).any(axis=1))
+    if bad.size:
+        raise ValueError(
+            f"the crack runs along a mesh edge in {describe_cells(bad)} (phi vanishes on the "
+            "whole edge); shift or rotate the crack off the mesh lines"
+        )
+
+
+def _classify_special(
+    data: CellData, phi: np.ndarray, psi: np.ndarray, flags: np.ndarray, kind: np.ndarray
+) -> None:
+    """Kinds of the cells ``phi`` does not cut simply (``flags != 0``): crossed when
+    ``psi < 0`` at every node and lattice point, none when ``> 0``; else refused."""
+    rows = np.flatnonzero(flags != 0)
+    if rows.size == 0:
+        return
+    inner = interior_values(data, psi, rows)
+    low = np.minimum(psi[rows].min(axis=1), inner.min(axis=1))
+    high = np.maximum(psi[rows].max(axis=1), inner.max(axis=1))
+    kind[rows[high < 0]] = CROSSED
+    bad = (low <= 0) & (high >= 0)
+    if bad.any():
+        raise ValueError(
+            f"a crack tip lies in {describe_cells(rows[bad])}, where the normal level set "
+            f"{describe_kinds(flags[rows[bad]])}; refine the mesh near the tip"
+        )
+
+
+def _newton_tip(
+    data: CellData, phi: np.ndarray, psi: np.ndarray, X: np.ndarray, rows: np.ndarray
+) -> np.ndarray:
+    """Solve ``(phi, psi)(X) = 0`` per row by Newton from ``X`` ``(n, 2)``."""
+    X = X.copy()
+    for _ in range(50):
+        f, gf = interpolant(data, phi, X)
+        g, gg = interpolant(data, psi, X)
+        det = gf[:, 0] * gg[:, 1] - gf[:, 1] * gg[:, 0]
+        size = np.hypot(*gf.T) * np.hypot(*gg.T)
+        tangent = np.abs(det) <= 1e-10 * size
+        if tangent.any():
+            raise ValueError(
+                f"phi and psi are tangent at the crack tip in {describe_cells(rows[tangent])}; "
+                "psi must cross the crack line"
+            )
+        step = np.stack([gg[:, 1] * f - gf[:, 1] * g, gf[:, 0] * g - gg[:, 0] * f], axis=1)
+        step /= det[:, None]
+        X -= step
+        if np.all(np.abs(step) <= 16 * _EPS):
+            break
+    return X
+
+
+def _refuse_on_boundary(data: CellData, rows: np.ndarray, X: np.ndarray, tol: float) -> None:
+    """Refuse tips ``X`` ``(n, 2)`` within ``tol`` of a vertex or an edge of their cells."""
+    if rows.size == 0:
+        return
+    norms = np.hypot(*data.face_normals.T)
+    distance = (data.face_offsets - X @ data.face_normals.T) / norms  # (n, nfaces)
+    close = np.abs(distance) <= tol
+    for count, case in ((2, "a node"), (1, "an edge")):
+        bad = close.sum(axis=1) >= count
+        if bad.any():
+            raise ValueError(
+                f"the crack tip lies on {case} of {describe_cells(rows[bad])} (within "
+                f"tip_tol = {tol:g}); move the tip off the mesh lines (e.g. by 1e-3 h)"
+            )
+    outside = (distance < -tol).any(axis=1)
+    if outside.any():
+        raise ValueError(
+            f"no crack tip found inside {describe_cells(rows[outside])} (Newton on (phi, psi) "
+            "= 0 left the cell); the level sets are too curved for the mesh: refine it"
+        )
+
+
+def polar(
+    phi: npt.ArrayLike,
+    psi: npt.ArrayLike,
+    grad_phi: npt.ArrayLike | None = None,
+    grad_psi: npt.ArrayLike | None = None,
+) -> tuple[np.ndarray, ...]:
+    """The tip's local polar coordinates from the level sets, with their gradients.
+
+    ``r = sqrt(phi^2 + psi^2)`` and ``theta = atan2(phi, psi)``: the crack lies
+    along ``theta = +-pi`` (``+pi`` on the lip ``phi > 0``, the Williams fields'
+    convention), ``theta = 0`` ahead of the tip. Exact for a straight crack with
+    signed-distance level sets. ``grad r = (phi grad phi + psi grad psi) / r``,
+    ``grad theta = (psi grad phi - phi grad psi) / r^2``.
+
+    Args:
+        phi, psi: Level-set values at points, shape ``(m,)`` (m).
+        grad_phi, grad_psi: Their gradients ``(m, gdim)`` (any frame; give both or none).
+
+    Returns:
+        ``(r, theta)`` of shape ``(m,)``, followed by ``(grad_r, grad_theta)`` of shape
+        ``(m, gdim)`` when the gradients are given. At ``r = 0`` the gradients are NaN.
+    """
+    phi, psi = np.asarray(phi, dtype=np.float64), np.asarray(psi, dtype=np.float64)
+    if phi.shape != psi.shape:
+        raise ValueError(f"psi must have the shape of phi {phi.shape}, got {psi.shape}")
+    r, theta = np.hypot(phi, psi), np.arctan2(phi, psi)
+    if grad_phi is None and grad_psi is None:
+        return r, theta
+    if grad_phi is None or grad_psi is None:
+        raise ValueError("grad_phi and grad_psi: give both or none")
+    gphi, gpsi = np.asarray(grad_phi, np.float64), np.asarray(grad_psi, np.float64)
+    if gphi.shape != gpsi.shape or gphi.shape[:1] != phi.shape:
+        raise ValueError(f"grad_phi and grad_psi must have shape ({phi.size}, gdim)")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        grad_r = (phi[:, None] * gphi + psi[:, None] * gpsi) / r[:, None]
+        grad_theta = (psi[:, None] * gphi - phi[:, None] * gpsi) / (r * r)[:, None]
+    return r, theta, grad_r, grad_theta
