@@ -1,0 +1,50 @@
+"""Fracture mechanics post-processing: near-tip fields, exact crack solutions, and the
+stress intensity factors of a crack tip.
+
+:mod:`~.williams` holds the tip's branch functions and the exact mode I / II fields,
+:mod:`~.westergaard` the Griffith crack in an infinite plate, :mod:`~.rings` the
+q-functions of the domain integrals and :mod:`~.interaction` the interaction integral
+(K_I, K_II) and the J-integral.
+"""
+
+from xfem_contact.mechanics.fracture.interaction import (
+    InteractionIntegral,
+    Lip,
+    Piece,
+    RingResult,
+    spread,
+)
+from xfem_contact.mechanics.fracture.rings import Ring, scaled_rings, tip_cell_size
+from xfem_contact.mechanics.fracture.westergaard import GriffithCrack
+from xfem_contact.mechanics.fracture.williams import (
+    NUMPY,
+    UFL,
+    TipFrame,
+    WilliamsField,
+    branch_functions,
+    branch_gradients,
+    effective_modulus,
+    kolosov,
+    tip_frame,
+)
+
+__all__ = [
+    "NUMPY",
+    "UFL",
+    "GriffithCrack",
+    "InteractionIntegral",
+    "Lip",
+    "Piece",
+    "Ring",
+    "RingResult",
+    "TipFrame",
+    "WilliamsField",
+    "branch_functions",
+    "branch_gradients",
+    "effective_modulus",
+    "kolosov",
+    "scaled_rings",
+    "spread",
+    "tip_cell_size",
+    "tip_frame",
+]
