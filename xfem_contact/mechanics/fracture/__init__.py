@@ -12,6 +12,7 @@ from xfem_contact.mechanics.fracture.interaction import (
     Lip,
     Piece,
     RingResult,
+    graded_facet_measure,
     spread,
 )
 from xfem_contact.mechanics.fracture.rings import Ring, scaled_rings, tip_cell_size
@@ -42,6 +43,7 @@ __all__ = [
     "branch_functions",
     "branch_gradients",
     "effective_modulus",
+    "graded_facet_measure",
     "kolosov",
     "scaled_rings",
     "spread",

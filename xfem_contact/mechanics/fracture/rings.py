@@ -87,8 +87,8 @@ def interpolate_ring(q: dolfinx.fem.Function, frame: TipFrame, ring: Ring) -> No
     with duplicated nodes has its lips).
 
     Raises:
-        ValueError: ``r_inf`` smaller than the tip's cells, or ``r_sup`` reaching the
-            boundary of the mesh.
+        ValueError: a tip in no cell, ``r_inf`` smaller than the tip's cells, or
+            ``r_sup`` reaching the boundary of the mesh.
     """
     V = q.function_space
     mesh = V.mesh
@@ -97,6 +97,10 @@ def interpolate_ring(q: dolfinx.fem.Function, frame: TipFrame, ring: Ring) -> No
     q.x.array[:] = ring.q(np.hypot(x1, x2))
 
     cells = _tip_cells(mesh, np.asarray(frame.origin, dtype=np.float64))
+    if mesh.comm.allreduce(len(cells), op=MPI.SUM) == 0:
+        raise ValueError(
+            f"tip {tuple(np.asarray(frame.origin).tolist())} lies in no cell of the mesh"
+        )
     dofs = V.dofmap.list[cells].ravel() if len(cells) else np.zeros(0, np.int32)
     low = mesh.comm.allreduce(float(q.x.array[dofs].min()) if len(dofs) else 1.0, op=MPI.MIN)
     if low < 1.0:

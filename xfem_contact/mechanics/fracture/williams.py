@@ -104,16 +104,26 @@ def polar(x, frame: TipFrame, ops: Ops = NUMPY, side: int = 0) -> tuple:
     return ops.sqrt(x1 * x1 + x2 * x2), side * abs(theta) if side else theta
 
 
-def branch_polar(r, theta, ops: Ops = NUMPY) -> tuple[tuple, tuple, tuple]:
-    """The branch functions ``F_j`` (m^1/2), ``dF_j/dr`` (m^-1/2) and ``dF_j/dtheta``
-    (m^1/2, per rad), each a 4-tuple, at polar coordinates ``(r, theta)``::
+def _angular(theta, ops: Ops) -> tuple[tuple, tuple]:
+    """The angular factors of the branch functions and their ``theta`` derivatives."""
+    s2, c2, s, c = ops.sin(theta / 2), ops.cos(theta / 2), ops.sin(theta), ops.cos(theta)
+    return (s2, c2, s2 * s, c2 * s), (c2 / 2, -s2 / 2, c2 / 2 * s + s2 * c, c2 * c - s2 / 2 * s)
 
-        F = sqrt(r) (sin(t/2), cos(t/2), sin(t/2) sin(t), cos(t/2) sin(t))
+
+def branch_values(r, theta, ops: Ops = NUMPY) -> tuple:
+    """The branch functions ``F_j`` (m^1/2, a 4-tuple) at polar coordinates ``(r, theta)``::
+
+    F = sqrt(r) (sin(t/2), cos(t/2), sin(t/2) sin(t), cos(t/2) sin(t))
     """
     sr = ops.sqrt(r)
-    s2, c2, s, c = ops.sin(theta / 2), ops.cos(theta / 2), ops.sin(theta), ops.cos(theta)
-    angular = (s2, c2, s2 * s, c2 * s)
-    d_angular = (c2 / 2, -s2 / 2, c2 / 2 * s + s2 * c, c2 * c - s2 / 2 * s)
+    return tuple(sr * a for a in _angular(theta, ops)[0])
+
+
+def branch_polar(r, theta, ops: Ops = NUMPY) -> tuple[tuple, tuple, tuple]:
+    """``F_j`` (m^1/2), ``dF_j/dr`` (m^-1/2) and ``dF_j/dtheta`` (m^1/2 per rad), each a
+    4-tuple (:func:`branch_values`), at polar coordinates ``(r, theta)``, ``r > 0``."""
+    sr = ops.sqrt(r)
+    angular, d_angular = _angular(theta, ops)
     return (
         tuple(sr * a for a in angular),
         tuple(a / (2 * sr) for a in angular),
@@ -148,7 +158,7 @@ def to_global_tensor(t: tuple, frame: TipFrame) -> tuple:
 
 def branch_functions(x, frame: TipFrame, ops: Ops = NUMPY, side: int = 0):
     """The four branch functions at ``x`` (m^1/2), ``ops.vector`` of 4."""
-    return ops.vector(branch_polar(*polar(x, frame, ops, side), ops)[0])
+    return ops.vector(branch_values(*polar(x, frame, ops, side), ops))
 
 
 def branch_gradients(x, frame: TipFrame, ops: Ops = NUMPY, side: int = 0):
@@ -215,7 +225,7 @@ class WilliamsField:
 
     def displacement(self, x, ops: Ops = NUMPY, side: int = 0):
         """Displacement (m), global components, ``ops.vector``."""
-        F = branch_polar(*polar(x, self.frame, ops, side), ops)[0]
+        F = branch_values(*polar(x, self.frame, ops, side), ops)
         local = tuple(_dot(row, F) for row in self._coefficients())
         return ops.vector(to_global_vector(local, self.frame))
 
