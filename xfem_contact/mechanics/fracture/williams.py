@@ -111,10 +111,8 @@ def _angular(theta, ops: Ops) -> tuple[tuple, tuple]:
 
 
 def branch_values(r, theta, ops: Ops = NUMPY) -> tuple:
-    """The branch functions ``F_j`` (m^1/2, a 4-tuple) at polar coordinates ``(r, theta)``::
-
-    F = sqrt(r) (sin(t/2), cos(t/2), sin(t/2) sin(t), cos(t/2) sin(t))
-    """
+    """The branch functions ``F_j`` (m^1/2, a 4-tuple) at polar coordinates ``(r, theta)``:
+    ``F = sqrt(r) (sin(t/2), cos(t/2), sin(t/2) sin(t), cos(t/2) sin(t))``."""
     sr = ops.sqrt(r)
     return tuple(sr * a for a in _angular(theta, ops)[0])
 
