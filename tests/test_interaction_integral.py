@@ -265,3 +265,25 @@ def test_bad_input_is_refused():
         graded_facet_measure(ufl.dx)
     with pytest.raises(ValueError, match="ring shape"):
         scaled_rings([(2, 3)], h, shape="cosine")
+
+
+def test_moduli_as_constants():
+    """A bound Moduli enters as Constants: a new E changes K (u fixed) with no new form."""
+    from xfem_contact.fem.forms import compiled_forms
+    from xfem_contact.mechanics.materials import Moduli
+
+    K = CASES["mixed"]
+    mesh, _, _ = slit_square(16, (-2.0, 0.0))
+    moduli = Moduli(MATERIAL, mesh)
+    u = williams(K)(ufl.SpatialCoordinate(mesh))
+    rings = scaled_rings([(2.4, 6.4)], 2.0 / 16)
+    integral = InteractionIntegral(
+        [Piece(u, ufl.dx)], moduli, TIP, DIRECTION, rings, quadrature_degree=DEGREE
+    )
+    assert relative(integral.evaluate(), K) < 1e-8
+    forms = compiled_forms()
+    moduli.E = 2 * MATERIAL.E
+    (doubled,) = integral.evaluate()
+    assert compiled_forms() == forms
+    assert doubled.K_I == pytest.approx(2 * K[0], rel=1e-8)
+    assert doubled.K_II == pytest.approx(2 * K[1], rel=1e-8)
