@@ -194,6 +194,9 @@ def write(folder: pathlib.Path) -> None:
         path = folder / name
         if not path.exists() or path.read_text() != text:  # keep Sphinx's cache valid
             path.write_text(text)
+    for stale in folder.glob("*.md"):  # pages whose source is gone (a renamed result)
+        if stale.name not in pages:
+            stale.unlink()
 
 
 def demo_page(path: pathlib.Path) -> str:
