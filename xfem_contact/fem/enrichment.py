@@ -92,6 +92,7 @@ class EnrichedSpace:
         self.min_support_fraction = min_support_fraction
         self._active = self._active_dofs()
         self._collapsed: dict[int, tuple[dolfinx.fem.FunctionSpace, npt.NDArray]] = {}
+        self._scalar: tuple | None = None  # one displacement component, its nodes
 
     # -- fields -------------------------------------------------------------
     def field_names(self) -> list[str]:
@@ -196,15 +197,40 @@ class EnrichedSpace:
         """Carry ``w`` (on ``W``) from the active dofs ``before`` (a copy of
         :attr:`active` taken before a :meth:`refresh`) onto the current ones: a side's
         dof that became active takes the other side's value at its node where that one
-        was active (the field continued across the old interface); inactive dofs are
-        zeroed. Collective (ghost update)."""
+        was active (the field continued across the old interface); then, where both
+        sides are active, the side a node does not lie on (by the sign of the new level
+        set there) takes the value of the side it lies on, so the carried displacement
+        is one continuous field with no jump across the new interface (the two sides'
+        extensions differ there by a spurious gap and slip that would set wrong contact
+        states); multipliers restart at 0 and inactive dofs are zeroed. Collective
+        (ghost update)."""
         active = self._active
         minus, plus = (self.field_space(i)[1] for i in (0, 1))
         for mine, other in ((minus, plus), (plus, minus)):
             take = active[mine] & ~before[mine] & before[other]
             w.x.array[mine[take]] = w.x.array[other[take]]
+        both = active[minus] & active[plus]
+        on_plus = self._levelset_at_dofs() > 0
+        w.x.array[minus[both & on_plus]] = w.x.array[plus[both & on_plus]]
+        w.x.array[plus[both & ~on_plus]] = w.x.array[minus[both & ~on_plus]]
+        for field, _, _ in self.multiplier_fields:
+            w.x.array[self.field_space(field)[1]] = 0.0
         w.x.array[~active] = 0.0
         w.x.scatter_forward()
+
+    def _levelset_at_dofs(self) -> npt.NDArray[np.float64]:
+        """The level set at the node of each local dof of the displacement field's own
+        space (:meth:`field_space`, owned and ghost). Collective the first time."""
+        if self._scalar is None:
+            V = self.field_space(0)[0]
+            S, dofs = V.sub(0).collapse()  # dofs: the component-0 dof of V of each node
+            self._scalar = (S, np.asarray(dofs).ravel() // V.dofmap.index_map_bs)
+        S, nodes = self._scalar
+        phi = dolfinx.fem.Function(S)
+        phi.interpolate(self.cut.levelset.function)
+        at_node = np.empty(nodes.size)
+        at_node[nodes] = phi.x.array[: nodes.size]
+        return np.repeat(at_node, self.field_space(0)[0].dofmap.index_map_bs)
 
     @property
     def active(self) -> npt.NDArray[np.bool_]:

@@ -155,9 +155,10 @@ class Problem:
         :meth:`~xfem_contact.fem.cutmesh.CutMesh.update`, the same interface names),
         keeping the loads, supports, laws, parameters and ``W``; forms are re-created
         from the compiled ones. The next solve starts from the solution carried onto
-        the new active dofs (:meth:`~xfem_contact.fem.enrichment.EnrichedSpace.carry`;
-        new multipliers start at 0), and so does Coulomb's last accepted state
-        ``w_old``: the slip history stays where the two positions overlap. Collective.
+        the new active dofs (:meth:`~xfem_contact.fem.enrichment.EnrichedSpace.carry`:
+        one continuous displacement, no jump across the new interface; multipliers
+        restart at 0), and so does Coulomb's last accepted state ``w_old``: its slip
+        history restarts at the new interface. Collective.
         """
         before = self.space.active.copy()
         self.cut.update(levelset)
