@@ -1,11 +1,11 @@
 """Moving interface: X-FEM re-cutting one mesh against gmsh remeshing, case 2, P2.
 
 The inclusion of paper case 2 (two materials: inside 300 MPa, nu 0.2; outside 100 MPa,
-nu 0, so the solution depends on where the inclusion is) is moved and resized over
-``POSITIONS`` positions: the centre on a line from (0.42, 0.46) to (0.58, 0.54) m, the
-radius from 0.15 to 0.25 m (a start position before them, solved untimed). Per mesh
-(n x n quadrilaterals, h = 1/n) and law (sticking; Coulomb, friction 0.3, with
-``accept_step`` after each solve so that its history moves along):
+nu 0, so the solution depends on where the inclusion is) is moved and resized over 10
+positions: the centre on a line from (0.42, 0.46) to (0.58, 0.54) m, the radius from
+0.15 to 0.25 m (a start position before them, solved untimed). Per mesh (n x n
+quadrilaterals, h = 1/n) and law (sticking; Coulomb, friction 0.3, with ``accept_step``
+after each solve):
 
 - X-FEM: one problem built once; per position ``update_interface`` then ``solve``
   (timed together: cut, space, Newton set-up, Newton from the carried solution). A
