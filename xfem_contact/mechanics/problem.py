@@ -359,9 +359,8 @@ class Problem:
             coupling.accept(self.w)
 
     def pairing_counts(self) -> dict[str, dict[str, int]]:
-        """Per large-sliding interface, the slave points paired and unpaired and the
-        pairs whose master cell changed since the last accepted step, at the last
-        evaluation (global counts; empty in small sliding)."""
+        """Per large-sliding interface, the global counts of slave points paired, unpaired
+        and changing master cell since the last accepted step (empty in small sliding)."""
         return {name: dict(c.counts) for name, c in self.couplings.items()}
 
     def unpaired_points(self) -> dict[str, np.ndarray]:
