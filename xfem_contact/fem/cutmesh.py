@@ -14,6 +14,8 @@ import numpy.typing as npt
 import ufl
 from mpi4py import MPI
 
+from xfem_contact.fem import cut_boundary
+from xfem_contact.fem.crack_cut import Crack, crack_rules
 from xfem_contact.fem.interface_cells import cell_interfaces, trace_nullity, without_slivers
 from xfem_contact.geometry import cut
 from xfem_contact.geometry.levelset import (
@@ -23,7 +25,6 @@ from xfem_contact.geometry.levelset import (
     interpolate,
     named_interfaces,
 )
-from xfem_contact.quadrature import boundary
 from xfem_contact.quadrature import rules as quadrature
 from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart, marker_space
 
@@ -53,7 +54,12 @@ class CutMesh:
             (:meth:`interface_measure`) and rules.
         degree: Lagrange degree (1 or 2) the level set is interpolated in.
         quadrature_degree: Polynomial degree of the rules on each curved sub-triangle and
-            on each interface segment.
+            on each interface segment; default 6, and 16 for a crack (its branch
+            functions vary steeply in the cells it cuts next to the tip).
+        tangent: For a crack: its tangential level set ``psi`` (a callable or a Function,
+            as ``levelset``); the crack is the zero line of ``levelset`` where
+            ``psi < 0`` (see :mod:`xfem_contact.fem.crack_cut`), :attr:`crack` its data.
+        tip_points: Gauss points per direction of a crack tip cell's Duffy rules.
 
     Example:
         >>> cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 0.5)
@@ -65,13 +71,17 @@ class CutMesh:
         mesh: dolfinx.mesh.Mesh,
         levelset: LevelSetCallable | dolfinx.fem.Function,
         degree: int = 2,
-        quadrature_degree: int = 6,
+        quadrature_degree: int | None = None,
+        tangent: LevelSetCallable | dolfinx.fem.Function | None = None,
+        tip_points: int = 12,
     ):
         cell = mesh.topology.cell_name()
         if cell not in ("triangle", "quadrilateral"):
             raise NotImplementedError(
                 f"CutMesh supports triangle and quadrilateral meshes, not {cell}"
             )
+        if quadrature_degree is None:
+            quadrature_degree = 6 if tangent is None else 16
         if quadrature_degree < 1:
             raise ValueError(f"quadrature_degree must be >= 1, got {quadrature_degree}")
         self.mesh = mesh
@@ -80,14 +90,26 @@ class CutMesh:
         self.id = next(_counter)
         self._boundary_sets: list[tuple[tuple[int, str], np.ndarray]] = []
         self._boundary_parts: dict[int, list[IntegrationPart]] = {}
-        self.update(levelset)
+        self.tip_points = int(tip_points)
+        #: The crack's data on the current cut (None for interfaces)
+        self.crack: Crack | None = None
+        self._is_crack = tangent is not None
+        self.update(levelset, tangent)
 
     def update(
-        self, levelset: LevelSetCallable | dolfinx.fem.Function | Mapping[str, LevelSetCallable]
+        self,
+        levelset: LevelSetCallable | dolfinx.fem.Function | Mapping[str, LevelSetCallable],
+        tangent: LevelSetCallable | dolfinx.fem.Function | None = None,
     ) -> None:
         """Cut the mesh with a new level set (collective). Compiled forms are
         reused: call :func:`xfem_contact.form` again to integrate on the new cut.
-        With several interfaces, give the same names as at construction."""
+        With several interfaces, give the same names as at construction; a crack
+        takes its new ``tangent`` too."""
+        if self._is_crack != (tangent is not None):
+            raise ValueError(
+                "tangent: a crack's cut takes its tangential level set psi (the crack "
+                "is phi = 0 where psi < 0); an interface's none"
+            )
         mesh = self.mesh
         tdim = mesh.topology.dim
         cell_name = mesh.topology.cell_name()
@@ -132,6 +154,8 @@ class CutMesh:
             ),
         }
         rules[_INTERFACE] = without_slivers(mesh, cut_cells, rules[_INTERFACE], maps)
+        if tangent is not None:
+            rules = self._crack_rules(rules, tangent, maps)
         self.rules = rules
         #: Interface (index into ``interface_names``) of every cut cell, shape ``(ncut,)``
         self.cell_interface = cell_interfaces(maps, cut_cells, rules[_INTERFACE], components)
@@ -148,6 +172,21 @@ class CutMesh:
         #: Wall time (s) of the last update: level set + classification +
         #: sub-triangulation ("cut"), and per-cell rules ("quadrature")
         self.timings = {"cut": cut_time, "quadrature": time.perf_counter() - start - cut_time}
+
+    def _crack_rules(self, rules: dict, tangent, maps: CellMaps) -> dict:
+        """The rules of the crack ``phi = 0, psi < 0`` from those of the cut by ``phi``;
+        sets :attr:`crack`. Collective."""
+        previous = None if self.crack is None else self.crack.tangent.function
+        try:
+            psi = interpolate(self.mesh, tangent, self.degree, into=previous)
+        except ValueError as error:
+            raise ValueError(f"Crack tangential level set (tangent): {error}") from None
+        keys = {"minus": _SIDE_MINUS, "plus": _SIDE_PLUS, "interface": _INTERFACE}
+        named = {key: rules[sid] for key, sid in keys.items()}
+        named, self.crack = crack_rules(
+            self.cut_cells, named, maps, psi, self.degree, self.tip_points
+        )
+        return {sid: named[key] for key, sid in keys.items()}
 
     def side_indicator(self) -> dolfinx.fem.Function:
         """DG0 function of each cell's side (-1, 0 for cut, +1), ghosts included. Collective."""
@@ -307,70 +346,14 @@ class CutMesh:
         return CellRules(self.mesh, cells, *args, marker_space=self._marker_space)
 
     def _facet_array(self, facets, value) -> np.ndarray:
-        mesh, fdim = self.mesh, self.mesh.topology.dim - 1
-        if isinstance(facets, dolfinx.mesh.MeshTags):
-            if facets.dim != fdim:
-                raise ValueError(f"Facet tags must have dimension {fdim}, got {facets.dim}")
-            if value is None:
-                raise ValueError("Give the tag value with a MeshTags: cut.ds(side, tags, value)")
-            facets = facets.find(value)
-            found = mesh.comm.allreduce(facets.size, op=MPI.SUM)
-            if found == 0:
-                raise ValueError(f"No facet carries the tag value {value}")
-        facets = np.unique(np.asarray(facets, dtype=np.int32))
-        num_owned = mesh.topology.index_map(fdim).size_local
-        facets = facets[facets < num_owned]  # ghost facets are integrated by their owner
-        mesh.topology.create_connectivity(fdim, fdim + 1)
-        exterior = dolfinx.mesh.exterior_facet_indices(mesh.topology)
-        bad = np.setdiff1d(facets, exterior)
-        if bad.size:
-            raise ValueError(f"Facets {bad[:5].tolist()} are not exterior facets of the mesh")
-        return facets
+        return cut_boundary.facet_array(self.mesh, facets, value)
 
     def _boundary(self, slot: int) -> list[IntegrationPart]:
         """Standard and runtime parts of boundary set ``slot`` on the current cut."""
-        if slot in self._boundary_parts:
-            return self._boundary_parts[slot]
-        (side, _), facets = self._boundary_sets[slot]
-        mesh, tdim = self.mesh, self.mesh.topology.dim
-        cell_name = mesh.topology.cell_name()
-        mesh.topology.create_connectivity(tdim - 1, tdim)
-        mesh.topology.create_connectivity(tdim, tdim - 1)
-        pairs = dolfinx.fem.compute_integration_domains(
-            dolfinx.fem.IntegralType.exterior_facet, mesh.topology, facets
-        ).reshape(-1, 2)
-        keep = self.cell_sides[pairs[:, 0]] == side
-        parts = [IntegrationPart("exterior_facet", entities=pairs[keep].ravel())]
-        # Pieces on cut cells: only those on facets of the set
-        rows, local, ends = boundary.facet_pieces(self.geometry, side, cell_name)
-        c2f = mesh.topology.connectivity(tdim, tdim - 1)
-        cell_facets = c2f.array.reshape(-1, c2f.offsets[1] - c2f.offsets[0])
-        in_set = np.isin(cell_facets[self.cut_cells[rows], local], facets)
-        rows, local, ends = rows[in_set], local[in_set], ends[in_set]
-        _, ref_normals = boundary.reference_facets(cell_name)
-        J = ufl.Jacobian(mesh)
-        # A reference facet no cut cell has on the set, on any rank, gets no integral
-        pieces = mesh.comm.allreduce(np.bincount(local, minlength=len(ref_normals)))
-        for f, n_ref in enumerate(ref_normals):
-            mine = local == f
-            if not pieces[f]:
-                continue
-            cells_rows = np.unique(rows[mine])
-            rule = boundary.facet_rules(
-                np.searchsorted(cells_rows, rows[mine]),
-                ends[mine],
-                cells_rows.size,
-                self.quadrature_degree,
-                lambda r, X, cr=cells_rows: self.maps.jacobian(self.cut_cells[cr[r]], X),
-            )
-            normal = ufl.dot(ufl.inv(J).T, ufl.as_vector(n_ref.tolist()))
-            normal = normal / ufl.sqrt(ufl.inner(normal, normal))
-            rules = self._rules(self.cut_cells[cells_rows], rule)
-            parts.append(
-                IntegrationPart("cell", rules=rules, replace={ufl.FacetNormal(mesh): normal})
-            )
-        self._boundary_parts[slot] = parts
-        return parts
+        if slot not in self._boundary_parts:
+            (side, _), facets = self._boundary_sets[slot]
+            self._boundary_parts[slot] = cut_boundary.boundary_parts(self, side, facets)
+        return self._boundary_parts[slot]
 
     def integration_parts(self, subdomain_id: int) -> list[IntegrationPart]:
         """Standard and runtime parts of a measure id (for :func:`xfem_contact.form`)."""

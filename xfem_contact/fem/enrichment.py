@@ -22,8 +22,10 @@ import numpy.typing as npt
 import ufl
 from mpi4py import MPI
 
+from xfem_contact.fem.branch import UFL, branch_values
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.subspaces import collapse
+from xfem_contact.geometry.crack import CROSSED, TIP
 
 
 class DofCounts(typing.NamedTuple):
@@ -54,6 +56,19 @@ class EnrichedSpace:
         multipliers: Instead of ``multiplier``, one multiplier field per entry
             ``(components, interface name)`` (fields 2, 3, ... of ``W``), each
             active on the cut cells of its interface only (``None``: all).
+        tip_radius: For a cut by a crack (``cut.crack``): the tip enrichment's radius
+            (m), every node within it of a tip carries the four branch functions
+            (geometric enrichment); ``None``: the nodes of the tip cells (topological).
+
+    A crack (see :mod:`xfem_contact.fem.crack_cut`) adds a last field, the branch
+    dofs ``b`` (Lagrange ``degree``, ``4 gdim`` components), and ties the two sides'
+    dofs of every node whose support the crack does not cut completely (it holds a tip
+    or the crack's extension): one unknown for both in the reduced system
+    (:attr:`ties`). The displacement of side ``s`` is then ``u_s + sum_k F_k b_k``
+    (:meth:`displacements`), with the branch functions ``F_k`` of
+    :mod:`xfem_contact.fem.branch` at ``r = sqrt(phi^2 + psi^2)``,
+    ``theta = s |atan2(phi, psi)|`` (``phi``, ``psi``: the crack's level sets, signed
+    distances).
     """
 
     def __init__(
@@ -63,6 +78,7 @@ class EnrichedSpace:
         multiplier: int = 0,
         min_support_fraction: float = 0.0,
         multipliers: Sequence[tuple[int, str | None]] | None = None,
+        tip_radius: float | None = None,
     ):
         if degree not in (1, 2):
             raise ValueError(f"Displacement degree must be 1 or 2, got {degree}")
@@ -88,10 +104,20 @@ class EnrichedSpace:
         self.multiplier_fields = [(2 + k, c, name) for k, (c, name) in enumerate(multipliers)]
         self.multiplier_components = multipliers[0][0] if multipliers else 0
         self.has_multiplier = bool(multipliers)
+        #: The field of the branch dofs (None without a crack)
+        self.branch_field: int | None = None
+        if cut.crack is not None:
+            elements.append(basix.ufl.element("Lagrange", cell, degree, shape=(4 * gdim,)))
+            self.branch_field = len(elements) - 1
+        elif tip_radius is not None:
+            raise ValueError("tip_radius: the cut has no crack (CutMesh(..., tangent=psi))")
+        if tip_radius is not None and not (np.isfinite(tip_radius) and tip_radius > 0):
+            raise ValueError(f"tip_radius must be a positive length (m), got {tip_radius!r}")
+        self.tip_radius = tip_radius
         self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
         self.min_support_fraction = min_support_fraction
-        self._active = self._active_dofs()
         self._collapsed: dict[int, tuple[dolfinx.fem.FunctionSpace, npt.NDArray]] = {}
+        self._active = self._active_dofs()
         self._scalar: tuple | None = None  # one displacement component, its nodes
 
     # -- fields -------------------------------------------------------------
@@ -100,21 +126,47 @@ class EnrichedSpace:
         (``multiplier_NAME`` per interface when several have one)."""
         names = ["u_minus", "u_plus"]
         one = len(self.multiplier_fields) == 1
-        return names + [
+        names += [
             "multiplier" if one else f"multiplier_{name}" for _, _, name in self.multiplier_fields
         ]
+        return names + ([] if self.branch_field is None else ["branch"])
 
     def displacement_sides(self) -> list[tuple[str, int]]:
         """``(label, side)`` of the displacement fields 0 and 1."""
         return [("minus", -1), ("plus", 1)]
 
     def trial(self) -> tuple:
-        """``(u_minus, u_plus[, lambda])`` trial functions."""
-        return ufl.split(ufl.TrialFunction(self.W))
+        """``(u_minus, u_plus[, lambda])`` trial functions (:meth:`split`)."""
+        return self.split(ufl.TrialFunction(self.W))
 
     def test(self) -> tuple:
-        """``(v_minus, v_plus[, mu])`` test functions."""
-        return ufl.split(ufl.TestFunction(self.W))
+        """``(v_minus, v_plus[, mu])`` test functions (:meth:`split`)."""
+        return self.split(ufl.TestFunction(self.W))
+
+    def split(self, w) -> tuple:
+        """The fields of ``w`` (a Function, trial or test function on ``W``), the
+        displacements of both sides enriched by the branch functions with a crack."""
+        return self.displacements(ufl.split(w))
+
+    def displacements(self, fields: Sequence) -> tuple:
+        """``fields`` (of ``ufl.split``) with fields 0 and 1 the displacements of sides
+        -1 and +1: ``u_s + sum_k F_k(s) b_k`` with a crack, else unchanged."""
+        if self.branch_field is None:
+            return tuple(fields)
+        b, gdim = fields[self.branch_field], self.cut.mesh.geometry.dim
+        out = list(fields)
+        for i, side in ((0, -1), (1, 1)):
+            F = self.branch_functions(side)
+            out[i] = fields[i] + ufl.as_vector(
+                [sum(F[k] * b[gdim * k + c] for k in range(4)) for c in range(gdim)]
+            )
+        return tuple(out)
+
+    def branch_functions(self, side: int) -> tuple:
+        """The four branch functions (m^1/2, UFL) on side ``side`` of the crack."""
+        phi, psi = self.cut.levelset.function, self.cut.crack.tangent.function
+        theta = side * abs(ufl.atan2(phi, psi))
+        return branch_values(ufl.sqrt(phi**2 + psi**2), theta, UFL)
 
     def subspace(self, field: int) -> dolfinx.fem.FunctionSpace:
         """Sub-space of field 0 (side -1), 1 (side +1) or 2 (multiplier)."""
@@ -169,7 +221,59 @@ class EnrichedSpace:
             np.add.at(length, rules.point_rows, rules.weights * _abs_det_at(cut, rules))
             carrying = cut.cut_cells[length > 0.0]
             active |= self._mark(field, carrying) > 0
+        if self.branch_field is not None:
+            active |= self._branch_support()
+        self._ties = self._tied(active)
         return active
+
+    def _branch_support(self) -> npt.NDArray[np.bool_]:
+        """Per dof of ``W``: a branch dof within the tip radius (or on a tip cell)."""
+        crack, field = self.cut.crack, self.branch_field
+        if self.tip_radius is None:
+            return self._mark(field, crack.cells(TIP, self.cut.cut_cells)) > 0
+        mesh = self.cut.mesh
+        tip_cells = crack.cells(TIP, self.cut.cut_cells).astype(np.int32)
+        local = float(mesh.h(2, tip_cells).max()) if tip_cells.size else 0.0
+        h = mesh.comm.allreduce(local, op=MPI.MAX)
+        if self.tip_radius < h:
+            raise ValueError(
+                f"tip_radius = {self.tip_radius:.6g} m is smaller than the tip cells "
+                f"(diameter {h:.6g} m): take at least that, or None for the tip cells' nodes"
+            )
+        V, parent = self.field_space(field)
+        x = V.tabulate_dof_coordinates()[:, : crack.tips.shape[1]]
+        distance = np.linalg.norm(x[:, None, :] - crack.tips[None], axis=2).min(axis=1)
+        flags = np.zeros(
+            self.W.dofmap.index_map.size_local + self.W.dofmap.index_map.num_ghosts, bool
+        )
+        flags[parent] = np.repeat(distance <= self.tip_radius, V.dofmap.index_map_bs)
+        return flags
+
+    def _tied(self, active: npt.NDArray[np.bool_]) -> npt.NDArray[np.int64]:
+        """``(kept, follower)`` owned dofs of fields 0 and 1 at the same node and
+        component, both active, whose support the crack does not cut completely."""
+        crack = self.cut.crack
+        if crack is None:
+            return np.zeros((0, 2), dtype=np.int64)
+        cut_cells = self.cut.cut_cells
+        crossed = cut_cells[crack.kind == CROSSED]
+        ends = cut_cells[crack.kind != CROSSED]  # tip cells and the crack's extension
+        heaviside = (self._mark(0, crossed) > 0) & ~(self._mark(0, ends) > 0)
+        minus, plus = (self.field_space(i)[1] for i in (0, 1))
+        both = active[minus] & active[plus] & ~heaviside[minus]
+        n_owned = self.W.dofmap.index_map.size_local * self.W.dofmap.index_map_bs
+        pairs = np.stack([minus[both], plus[both]], axis=1).astype(np.int64)
+        owned = pairs[:, 0] < n_owned
+        if np.any(owned != (pairs[:, 1] < n_owned)):
+            raise RuntimeError("the two sides' dofs of a node have different owners")
+        return pairs[owned]
+
+    @property
+    def ties(self) -> npt.NDArray[np.int64]:
+        """Owned dofs ``(kept, follower)``, shape ``(m, 2)``: the follower (side +1) is
+        the kept dof (side -1) in the reduced system (nodes a crack does not cut
+        completely; none without a crack)."""
+        return self._ties
 
     def _side_fraction(self, field: int, side: int) -> np.ndarray:
         """Per dof: (area of its support on ``side``) / (area of its support)."""
@@ -243,15 +347,18 @@ class EnrichedSpace:
         nowned = imap.size_local * bs
         comm = self.cut.mesh.comm
         counts = []
-        for field in range(2 + len(self.multiplier_fields)):
+        for field in range(self.W.num_sub_spaces):
             of_field = np.zeros(nowned, dtype=bool)
             dofs = self.W.sub(field).dofmap.list.ravel()
             of_field[dofs[dofs < nowned]] = True
             if field == 0:  # a displacement field: the whole mesh's Lagrange space
                 standard = comm.allreduce(int(of_field.sum()), op=MPI.SUM)
             counts.append(comm.allreduce(int(self._active[:nowned][of_field].sum()), op=MPI.SUM))
-        multiplier = sum(counts[2:])
-        return DofCounts(standard, counts[0] + counts[1] - standard, multiplier)
+        fields = [f for f, _, _ in self.multiplier_fields]
+        multiplier = sum(counts[f] for f in fields)
+        ties = comm.allreduce(len(self._ties), op=MPI.SUM)
+        branch = 0 if self.branch_field is None else counts[self.branch_field]
+        return DofCounts(standard, counts[0] + counts[1] - standard - ties + branch, multiplier)
 
 
 def _cell_areas(cut: CutMesh) -> np.ndarray:

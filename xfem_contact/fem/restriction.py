@@ -1,7 +1,8 @@
 """The restriction operator ``R`` from a reduced space to the full mixed space.
 
 Full dofs ``x = R y``: ``R`` selects the active dofs of an
-:class:`~xfem_contact.fem.enrichment.EnrichedSpace` (identity columns) and, where a
+:class:`~xfem_contact.fem.enrichment.EnrichedSpace` (identity columns; a crack's tied
+dofs share their column) and, where a
 multiplier prolongation is given (LBB restriction, :mod:`xfem_contact.mechanics.lbb`),
 expresses multiplier dofs as combinations of fewer reduced unknowns. Both solvers
 use it: the linear solves (:mod:`xfem_contact.solvers.linear`) solve
@@ -66,6 +67,8 @@ def restriction_matrix(
     comm = imap.comm
     n_owned = imap.size_local * bs
     active = space.active[:n_owned].copy()
+    ties = space.ties
+    active[ties[:, 1]] = False  # a follower is its kept dof's column
     if prolongation is not None:
         active[prolongation.dofs] = False
     selected = np.flatnonzero(active)
@@ -80,6 +83,10 @@ def restriction_matrix(
     entries_rows = [selected]
     entries_cols = [np.arange(n_sel) + sel_offset]
     entries_vals = [np.ones(n_sel)]
+    if ties.size:
+        entries_rows.append(ties[:, 1])
+        entries_cols.append(np.searchsorted(selected, ties[:, 0]) + sel_offset)
+        entries_vals.append(np.ones(len(ties)))
     if prolongation is not None and prolongation.vals.size:
         starts = np.cumsum([0] + [n for _, n in owners_offsets])
         global_mult = np.array([o for o, _ in owners_offsets])

@@ -4,8 +4,11 @@ at construction and again when its interfaces move."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import dolfinx.fem
 import numpy as np
+import ufl
 from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
@@ -21,6 +24,7 @@ def interface_context(
     side_indicator: dolfinx.fem.Function,
     cell_size: dolfinx.fem.Function,
     w_old: dolfinx.fem.Function,
+    split: Callable = ufl.split,
 ) -> InterfaceContext:
     """The context of interface ``name`` on the current cut of ``cut``.
 
@@ -32,6 +36,7 @@ def interface_context(
         side_indicator: DG0 side of each cell (-1, 0 cut, +1).
         cell_size: DG0 cell diameters (m).
         w_old: The last accepted state.
+        split: The fields of a Function on ``W`` (the space's ``split``).
 
     Collective.
     """
@@ -50,6 +55,7 @@ def interface_context(
         cut_cells=on_cut_cells,
         field=field,
         w_old=w_old,
+        split=split,
     )
 
 

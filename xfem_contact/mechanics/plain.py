@@ -61,6 +61,10 @@ class PlainSpace:
     def trial(self) -> tuple:
         return (ufl.TrialFunction(self.W),)
 
+    def split(self, w) -> tuple:
+        """The one field of ``w``: ``(w,)``."""
+        return (w,)
+
     def dof_counts(self) -> DofCounts:
         """Global dof counts (all standard)."""
         n = self.W.dofmap.index_map.size_global * self.W.dofmap.index_map_bs

@@ -11,7 +11,6 @@ dofs of the restriction ``R`` (:mod:`xfem_contact.fem.restriction`). SI units (P
 from __future__ import annotations
 
 import time
-import weakref
 from collections.abc import Callable, Mapping
 
 import dolfinx.fem
@@ -33,7 +32,7 @@ from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
 from xfem_contact.solvers.linear import solve_restricted
-from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton
+from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton, weak_method
 from xfem_contact.solvers.options import merged_options
 from xfem_contact.solvers.report import SolveReport
 from xfem_contact.solvers.symmetry import symmetric_options
@@ -61,6 +60,7 @@ class Problem:
             ``pairing`` says).
         slave, pairing: See :class:`~xfem_contact.mechanics.laws.sliding.SlidingFrictionless`
             (``kinematics="large"`` only).
+        tip_radius: A crack's tip enrichment radius (m), see :class:`EnrichedSpace`.
 
     Collective.
     """
@@ -77,6 +77,7 @@ class Problem:
         kinematics: str = DEFAULT.kinematics,
         slave: int = DEFAULT.slave,
         pairing: str = DEFAULT.pairing,
+        tip_radius: float | None = None,
     ):
         if kinematics not in KINEMATICS:
             raise ValueError(f"Unknown kinematics {kinematics!r}; valid: {KINEMATICS}")
@@ -97,6 +98,7 @@ class Problem:
             degree,
             multipliers=[(c, n) for c, n in multipliers if c > 0],
             min_support_fraction=min_support_fraction,
+            tip_radius=tip_radius,
         )
         check_ghosts(self.mesh)
         #: Loads, supports and Dirichlet data (``loads.bcs``), and the pseudo-time
@@ -135,6 +137,7 @@ class Problem:
                 self.side_indicator,
                 self.cell_size,
                 self.w_old,
+                self.space.split,
             )
             for name in self.laws
         }
@@ -229,7 +232,7 @@ class Problem:
 
     def residual(self) -> ufl.Form:
         """The residual ``F(w; v)`` (UFL, linear in the test functions)."""
-        u, v = ufl.split(self.w), self.space.test()
+        u, v = self.space.split(self.w), self.space.test()
         F = sum(self._law_and_spring_terms(u, v), self.bulk.form(u, v))
         if self.loads.has_terms:
             F -= self.loads.linear_form()
@@ -306,7 +309,7 @@ class Problem:
                 self.loads.bcs,
                 self.restriction(),
                 petsc_options,
-                status=_weak_method(self.interface_status),
+                status=weak_method(self.interface_status),
                 log=log,
                 splits=field_splits(self.space) if split else None,
                 near_nullspace=rigid_modes(self.space) if split else None,
@@ -389,12 +392,3 @@ class Problem:
         Collective."""
         name = self._name(name)
         return samples(self.laws[name], self.contexts[name], self.w)
-
-
-def _weak_method(method: Callable) -> Callable:
-    """``method`` called through a weak reference to its object: the Newton solver a
-    problem owns must not keep the problem alive (a reference cycle holds the meshes'
-    MPI communicators until the cyclic collector runs; MPICH runs out of them after
-    about 120 problems on 2 ranks)."""
-    ref = weakref.WeakMethod(method)
-    return lambda *args: ref()(*args)

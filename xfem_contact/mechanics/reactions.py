@@ -51,7 +51,7 @@ def _load_form(problem) -> ufl.Form:
 
 def _springs(problem):
     """The springs' residual terms (UFL, linear in the test of ``W``), or None."""
-    u = ufl.split(problem.w) if len(getattr(problem.space, "fields", (0, 1))) > 1 else (problem.w,)
+    u = problem.space.split(problem.w)
     return problem.loads.spring_terms(u, problem.space.test())
 
 
@@ -178,7 +178,7 @@ def interface_resultants(problem, w: dolfinx.fem.Function | None = None) -> dict
     v = problem.space.test()
     for name, law in problem.laws.items():
         ctx = problem.contexts[name]
-        term = law.residual(ctx, ctx.fields(ufl.split(problem.w)), ctx.fields(v))
+        term = law.residual(ctx, ctx.fields(problem.space.split(problem.w)), ctx.fields(v))
         b = None if term is None else _vector(problem, term)
         coupling = (getattr(problem, "couplings", None) or {}).get(name)
         if coupling is not None:

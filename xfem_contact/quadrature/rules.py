@@ -82,6 +82,32 @@ class RuleSet:
             None if self.normals is None else self.normals[points],
         )
 
+    def replace(self, rows: npt.NDArray[np.int64], other: RuleSet) -> RuleSet:
+        """The same rules with rule ``rows[k]`` replaced by rule ``k`` of ``other``.
+
+        Args:
+            rows: Distinct rule rows, shape ``(other.num_rules,)``.
+            other: The new rules (normals if and only if this set has normals).
+
+        Returns:
+            A :class:`RuleSet` with the same number of rules.
+        """
+        rows = np.asarray(rows, dtype=np.int64)
+        if rows.shape != (other.num_rules,) or np.unique(rows).size != rows.size:
+            raise ValueError(f"rows must be {other.num_rules} distinct rule rows, got {rows}")
+        if (self.normals is None) != (other.normals is None):
+            raise ValueError("replace: both rule sets need normals, or neither")
+        starts, counts = self.offsets[:-1].copy(), np.diff(self.offsets)
+        starts[rows] = self.points.shape[0] + other.offsets[:-1]  # into the concatenation
+        counts[rows] = np.diff(other.offsets)
+        take = np.repeat(starts - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
+        points = np.concatenate([self.points, other.points])[take]
+        weights = np.concatenate([self.weights, other.weights])[take]
+        normals = None
+        if self.normals is not None:
+            normals = np.concatenate([self.normals, other.normals])[take]
+        return RuleSet(points, weights, _offsets(counts), normals)
+
 
 @functools.cache
 def _p2_triangle() -> basix.finite_element.FiniteElement:

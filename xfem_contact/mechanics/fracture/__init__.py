@@ -3,8 +3,9 @@ stress intensity factors of a crack tip.
 
 :mod:`~.williams` holds the tip's branch functions and the exact mode I / II fields,
 :mod:`~.westergaard` the Griffith crack in an infinite plate, :mod:`~.rings` the
-q-functions of the domain integrals and :mod:`~.interaction` the interaction integral
-(K_I, K_II) and the J-integral.
+q-functions of the domain integrals, :mod:`~.interaction` the interaction integral
+(K_I, K_II) and the J-integral, and :mod:`~.tips` those of every tip of a cracked
+problem.
 """
 
 from xfem_contact.mechanics.fracture.interaction import (
@@ -16,6 +17,7 @@ from xfem_contact.mechanics.fracture.interaction import (
     spread,
 )
 from xfem_contact.mechanics.fracture.rings import Ring, scaled_rings, tip_cell_size
+from xfem_contact.mechanics.fracture.tips import TipIntegrals, lip_tractions
 from xfem_contact.mechanics.fracture.westergaard import GriffithCrack
 from xfem_contact.mechanics.fracture.williams import (
     NUMPY,
@@ -39,12 +41,14 @@ __all__ = [
     "Ring",
     "RingResult",
     "TipFrame",
+    "TipIntegrals",
     "WilliamsField",
     "branch_functions",
     "branch_gradients",
     "effective_modulus",
     "graded_facet_measure",
     "kolosov",
+    "lip_tractions",
     "scaled_rings",
     "spread",
     "tip_cell_size",

@@ -28,30 +28,9 @@ import math
 import typing
 
 import numpy as np
-import ufl
 
+from xfem_contact.fem.branch import NUMPY, UFL, Ops, angular, branch_values  # noqa: F401
 
-def _np_vector(components) -> np.ndarray:
-    return np.stack(np.broadcast_arrays(*components))
-
-
-def _np_matrix(rows) -> np.ndarray:
-    return np.stack([_np_vector(row) for row in rows])
-
-
-class Ops(typing.NamedTuple):
-    """Pointwise functions and constructors, so that one definition serves UFL and numpy."""
-
-    sqrt: typing.Callable
-    sin: typing.Callable
-    cos: typing.Callable
-    atan2: typing.Callable
-    vector: typing.Callable
-    matrix: typing.Callable
-
-
-NUMPY = Ops(np.sqrt, np.sin, np.cos, np.arctan2, _np_vector, _np_matrix)
-UFL = Ops(ufl.sqrt, ufl.sin, ufl.cos, ufl.atan2, ufl.as_vector, ufl.as_matrix)
 PLANES = ("strain", "stress")
 
 
@@ -104,28 +83,15 @@ def polar(x, frame: TipFrame, ops: Ops = NUMPY, side: int = 0) -> tuple:
     return ops.sqrt(x1 * x1 + x2 * x2), side * abs(theta) if side else theta
 
 
-def _angular(theta, ops: Ops) -> tuple[tuple, tuple]:
-    """The angular factors of the branch functions and their ``theta`` derivatives."""
-    s2, c2, s, c = ops.sin(theta / 2), ops.cos(theta / 2), ops.sin(theta), ops.cos(theta)
-    return (s2, c2, s2 * s, c2 * s), (c2 / 2, -s2 / 2, c2 / 2 * s + s2 * c, c2 * c - s2 / 2 * s)
-
-
-def branch_values(r, theta, ops: Ops = NUMPY) -> tuple:
-    """The branch functions ``F_j`` (m^1/2, a 4-tuple) at polar coordinates ``(r, theta)``:
-    ``F = sqrt(r) (sin(t/2), cos(t/2), sin(t/2) sin(t), cos(t/2) sin(t))``."""
-    sr = ops.sqrt(r)
-    return tuple(sr * a for a in _angular(theta, ops)[0])
-
-
 def branch_polar(r, theta, ops: Ops = NUMPY) -> tuple[tuple, tuple, tuple]:
     """``F_j`` (m^1/2), ``dF_j/dr`` (m^-1/2) and ``dF_j/dtheta`` (m^1/2 per rad), each a
     4-tuple (:func:`branch_values`), at polar coordinates ``(r, theta)``, ``r > 0``."""
     sr = ops.sqrt(r)
-    angular, d_angular = _angular(theta, ops)
+    factors, d_factors = angular(theta, ops)
     return (
-        tuple(sr * a for a in angular),
-        tuple(a / (2 * sr) for a in angular),
-        tuple(sr * a for a in d_angular),
+        tuple(sr * a for a in factors),
+        tuple(a / (2 * sr) for a in factors),
+        tuple(sr * a for a in d_factors),
     )
 
 

@@ -65,6 +65,8 @@ class InterfaceContext:
             cell's reference coordinates (trace nullity >= 2, see
             :meth:`~xfem_contact.fem.cutmesh.CutMesh.trace_nullity`), DG0; None when
             no process has one.
+        split: The fields of a Function on the mixed space, e.g. ``split(w_old)`` (the
+            space's ``split``: the displacements with a crack's branch functions).
     """
 
     cut: CutMesh
@@ -77,6 +79,7 @@ class InterfaceContext:
     field: int | None
     w_old: dolfinx.fem.Function
     aligned_cells: dolfinx.fem.Function | None = None
+    split: typing.Callable = ufl.split
     #: Point values cached for the fixed rules (basis tables, dofs, the normal)
     _cache: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
 

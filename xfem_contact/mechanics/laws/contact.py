@@ -116,7 +116,7 @@ class ContactLaw(MultiplierLaw):
         mu_n, mu_t = self.multipliers(v)
         slip_jump = u.jump
         if self.incremental:
-            slip_jump = slip_jump - ctx.fields(ufl.split(ctx.w_old)).jump
+            slip_jump = slip_jump - ctx.fields(ctx.split(ctx.w_old)).jump
         P_n, P_t = self.augmented(
             lam_n, lam_t, ufl.dot(u.jump, n), ufl.dot(slip_jump, t), r, UFL_OPS
         )
@@ -131,7 +131,7 @@ class ContactLaw(MultiplierLaw):
             # The tangential law is incremental (slip of the step): its share of the
             # stabilisation is measured from the last accepted step too, so that the
             # steps telescope (sticking in n steps = in one). Jacobian unchanged.
-            old = ctx.fields(ufl.split(ctx.w_old))
+            old = ctx.fields(ctx.split(ctx.w_old))
             _, old_t = self.multipliers(old)
             old_residual = old_t - ufl.dot(self.interface_traction(ctx, old), t)
             F += self.stabilization_scale(ctx) * old_residual * mu_t * ctx.measure

@@ -7,6 +7,8 @@ set, and ``apply(t)`` sets its factor ``history(t)``. Setting a value changes da
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import dolfinx.fem
 import numpy as np
 
@@ -65,22 +67,39 @@ class FormLoad(Load):
 
 
 class DirichletLoad(Load):
-    """A prescribed displacement: functions ``g`` set to ``history(t)`` times their full
-    values (m), the values interpolated from ``value`` on each function's space."""
+    """A prescribed displacement: functions ``g`` (one per side) set to ``history(t)``
+    times their full values (m), the values interpolated from ``value`` on each
+    function's space."""
 
-    def __init__(self, kind, part, history, functions: list[dolfinx.fem.Function], value):
+    def __init__(
+        self, kind, part, history, functions: list[dolfinx.fem.Function], value, sides=(None,)
+    ):
         super().__init__(kind, part, history)
-        self.functions = functions
+        self.functions, self.sides = functions, tuple(sides)
         self.value = value
 
     @property
     def value(self):
-        """The prescribed value (m): a number, a tuple or a callable of ``x``."""
+        """The prescribed value (m): a number, a tuple or a callable of ``x``, or a mapping
+        ``{side: value}`` giving each side's field its own (e.g. the two lips' values
+        where a crack meets the boundary)."""
         return self._value
 
     @value.setter
     def value(self, value) -> None:
-        full = [nodal_values(g.function_space, value, self.kind) for g in self.functions]
+        values = [value] * len(self.functions)
+        if isinstance(value, Mapping):
+            if set(value) != set(self.sides) or None in self.sides:
+                valid = [s for s in self.sides if s is not None]
+                raise ValueError(
+                    f"{self.kind}: a value per side needs exactly the sides {valid}, got "
+                    f"{sorted(value, key=str)}"
+                )
+            values = [value[s] for s in self.sides]
+        full = [
+            nodal_values(g.function_space, v, self.kind)
+            for g, v in zip(self.functions, values, strict=True)
+        ]
         self._value, self._full = value, full
         self.apply(self._t)
 

@@ -154,7 +154,8 @@ class Loads:
         Args:
             part: A part name (see :attr:`parts`), facet indices or a locator.
             value: A number, a tuple (the vector, without ``component``) or a callable
-                of ``x`` (shape (3, n)) returning (n,) for one component, (gdim, n) else.
+                of ``x`` (shape (3, n)) returning (n,) for one component, (gdim, n) else;
+                or ``{-1: value, 1: value}``, each side's own.
             component: The one component prescribed (None: all).
             history: The load path (None: factor ``t``; ``[(t, f), ...]``; a stage name).
         """
@@ -167,7 +168,8 @@ class Loads:
             )
             for side in self.fields.sides
         ]
-        return self._add(DirichletLoad("displacement", part, path, functions, value))
+        load = DirichletLoad("displacement", part, path, functions, value, self.fields.sides)
+        return self._add(load)
 
     def add_point_displacement(
         self, point, value: float, component: int, *, history: Path = None

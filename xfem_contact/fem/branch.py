@@ -1,0 +1,53 @@
+"""The four branch functions of the crack-tip enrichment, for numpy and UFL from one definition.
+
+``F = sqrt(r) (sin(t/2), cos(t/2), sin(t/2) sin(t), cos(t/2) sin(t))`` at the tip's polar
+coordinates ``(r, t)`` (m, rad; ``t`` in ``[-pi, pi]``, the crack at ``t = +-pi``): they
+span the leading term of the Williams expansion of the displacement near a crack tip
+(:mod:`xfem_contact.mechanics.fracture.williams`). An :class:`Ops` (:data:`NUMPY` or
+:data:`UFL`) says which pointwise functions evaluate them.
+"""
+
+from __future__ import annotations
+
+import typing
+
+import numpy as np
+import ufl
+
+__all__ = ["NUMPY", "UFL", "Ops", "angular", "branch_values"]
+
+
+def _np_vector(components) -> np.ndarray:
+    return np.stack(np.broadcast_arrays(*components))
+
+
+def _np_matrix(rows) -> np.ndarray:
+    return np.stack([_np_vector(row) for row in rows])
+
+
+class Ops(typing.NamedTuple):
+    """Pointwise functions and constructors, so that one definition serves UFL and numpy."""
+
+    sqrt: typing.Callable
+    sin: typing.Callable
+    cos: typing.Callable
+    atan2: typing.Callable
+    vector: typing.Callable
+    matrix: typing.Callable
+
+
+NUMPY = Ops(np.sqrt, np.sin, np.cos, np.arctan2, _np_vector, _np_matrix)
+UFL = Ops(ufl.sqrt, ufl.sin, ufl.cos, ufl.atan2, ufl.as_vector, ufl.as_matrix)
+
+
+def angular(theta, ops: Ops) -> tuple[tuple, tuple]:
+    """The angular factors of the branch functions and their ``theta`` derivatives."""
+    s2, c2, s, c = ops.sin(theta / 2), ops.cos(theta / 2), ops.sin(theta), ops.cos(theta)
+    return (s2, c2, s2 * s, c2 * s), (c2 / 2, -s2 / 2, c2 / 2 * s + s2 * c, c2 * c - s2 / 2 * s)
+
+
+def branch_values(r, theta, ops: Ops = NUMPY) -> tuple:
+    """The branch functions ``F_j`` (m^1/2, a 4-tuple) at polar coordinates ``(r, theta)``:
+    ``F = sqrt(r) (sin(t/2), cos(t/2), sin(t/2) sin(t), cos(t/2) sin(t))``."""
+    sr = ops.sqrt(r)
+    return tuple(sr * a for a in angular(theta, ops)[0])

@@ -1,0 +1,123 @@
+"""A crack in a cut mesh: the cut by its normal level set where its tangential one is negative.
+
+A crack is the zero line of ``phi`` where ``psi < 0``
+(:mod:`xfem_contact.geometry.crack`). :class:`~xfem_contact.fem.cutmesh.CutMesh` cuts
+the mesh by ``phi`` as for an interface; :func:`crack_rules` then keeps the interface
+rules of the cells the crack crosses (its *lips*), empties those of the cells cut by
+``phi`` only ahead of a tip (the crack's extension: no discontinuity there; their side
+rules stay, the displacement is continuous across), and gives each tip cell the fan
+rules of :mod:`xfem_contact.quadrature.tip_rules`: graded Duffy rules on both sides
+(the tip's ``1/r`` energy density) and a graded rule on the lip piece up to the tip.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from mpi4py import MPI
+
+from xfem_contact.geometry.crack import CROSSED, NONE, classify_crack
+from xfem_contact.geometry.crack_tip_cell import cut_tip_cells
+from xfem_contact.geometry.levelset import CellMaps, LevelSet
+from xfem_contact.quadrature.rules import RuleSet
+from xfem_contact.quadrature.tip_rules import tip_lip_rule, tip_side_rules
+
+__all__ = ["Crack", "crack_rules"]
+
+
+@dataclass(frozen=True)
+class Crack:
+    """The crack of a cut mesh on its current cut.
+
+    Attributes:
+        tangent: The tangential level set ``psi`` (``psi < 0`` on the crack).
+        kind: Kind of every (owned) cut cell, :data:`~xfem_contact.geometry.crack.NONE`
+            (cut by ``phi`` ahead of a tip), ``CROSSED`` or ``TIP``, ``(ncut,)``.
+        tips: Physical positions (m) of the tips of all processes, ``(ntips, gdim)``,
+            in the order of their tip cells' global indices; the same on every process.
+        directions: Unit direction of the crack ahead of each tip, ``grad psi / |grad
+            psi|`` there, ``(ntips, gdim)``; the same on every process.
+    """
+
+    tangent: LevelSet
+    kind: npt.NDArray[np.int8]
+    tips: npt.NDArray[np.float64]
+    directions: npt.NDArray[np.float64]
+
+    def cells(self, kind: int, cut_cells: npt.NDArray[np.int32]) -> npt.NDArray[np.int32]:
+        """Local indices of the owned cut cells of ``kind``."""
+        return cut_cells[self.kind == kind]
+
+
+def crack_rules(
+    cut_cells: npt.NDArray[np.int32],
+    rules: dict[str, RuleSet],
+    maps: CellMaps,
+    tangent: LevelSet,
+    degree: int,
+    tip_points: int,
+) -> tuple[dict[str, RuleSet], Crack]:
+    """The side and interface rules of a crack from those of the cut by ``phi``.
+
+    Args:
+        cut_cells: Local indices of the owned cells ``phi`` cuts, ``(ncut,)``.
+        rules: ``{"minus": side -1, "plus": side +1, "interface": ...}`` of the cut by
+            ``phi`` (one rule per cut cell).
+        maps: The cell maps and ``phi`` of the cut.
+        tangent: ``psi``, interpolated in the degree of ``phi``.
+        degree: The level sets' degree (1 or 2).
+        tip_points: Gauss points per direction of the Duffy rules of a tip cell's fan
+            triangles (and along its lip piece).
+
+    Returns:
+        The new rules (same keys and rows) and the :class:`Crack`. Collective.
+
+    Raises:
+        ValueError: the degenerate positions refused by
+            :func:`~xfem_contact.geometry.crack.classify_crack` (tip on a node or an
+            edge, a crack along a mesh edge, ...), naming the case.
+    """
+    mesh = maps.mesh
+    cell_name = mesh.topology.cell_name()
+    phi = maps.nodal_values(cut_cells)
+    psi_maps = CellMaps(mesh, tangent)
+    psi = psi_maps.nodal_values(cut_cells)
+    cells = classify_crack(cell_name, degree, phi, psi)
+    rows = cells.tip_cells
+    new = dict(rules)
+    new["interface"] = rules["interface"].select(cells.kind == CROSSED)
+    if rows.size:
+        tip_cut = cut_tip_cells(cell_name, degree, phi[rows], psi[rows], cells.tip)
+
+        def jacobian(r, X):
+            return maps.jacobian(cut_cells[rows[r]], X)
+
+        def grad_phi(r, X):
+            return maps.grad_ref(cut_cells[rows[r]], X)
+
+        lips = tip_lip_rule(tip_cut, tip_points, jacobian, grad_phi)
+        new["interface"] = new["interface"].replace(rows, lips)
+        for key, side in (("minus", -1), ("plus", 1)):
+            new[key] = rules[key].replace(rows, tip_side_rules(tip_cut, side, tip_points))
+    gdim = mesh.geometry.dim
+    tip_cells = cut_cells[rows]
+    local = np.zeros((rows.size, 2 * gdim))
+    if rows.size:
+        J = maps.jacobian(tip_cells, cells.tip)
+        grad_ref = psi_maps.grad_ref(tip_cells, cells.tip)[..., None]
+        grad = np.linalg.solve(np.transpose(J, (0, 2, 1)), grad_ref)[..., 0]
+        local[:, :gdim] = maps.push_forward(tip_cells, cells.tip)
+        local[:, gdim:] = grad / np.linalg.norm(grad, axis=1)[:, None]
+    imap = mesh.topology.index_map(mesh.topology.dim)
+    gathered = mesh.comm.allgather((imap.local_to_global(tip_cells.astype(np.int32)), local))
+    keys = np.concatenate([k for k, _ in gathered])
+    tips = np.concatenate([t for _, t in gathered]).reshape(-1, 2 * gdim)
+    tips = tips[np.argsort(keys, kind="stable")]
+    if mesh.comm.allreduce(int((cells.kind != NONE).sum()), op=MPI.SUM) == 0:
+        raise ValueError(
+            "The crack never enters the mesh: psi >= 0 all along the zero line of phi "
+            "(the crack is phi = 0 where psi < 0)"
+        )
+    return new, Crack(tangent, cells.kind, tips[:, :gdim], tips[:, gdim:])
