@@ -39,12 +39,15 @@ class Crack:
             in the order of their tip cells' global indices; the same on every process.
         directions: Unit direction of the crack ahead of each tip, ``grad psi / |grad
             psi|`` there, ``(ntips, gdim)``; the same on every process.
+        upper_sides: Per tip, the side (+1: ``phi >= 0``, or -1) on the left of its
+            direction: the upper lip (``theta = pi``) of the tip's frame, ``(ntips,)``.
     """
 
     tangent: LevelSet
     kind: npt.NDArray[np.int8]
     tips: npt.NDArray[np.float64]
     directions: npt.NDArray[np.float64]
+    upper_sides: npt.NDArray[np.int64]
 
     def cells(self, kind: int, cut_cells: npt.NDArray[np.int32]) -> npt.NDArray[np.int32]:
         """Local indices of the owned cut cells of ``kind``."""
@@ -103,21 +106,24 @@ def crack_rules(
             new[key] = rules[key].replace(rows, tip_side_rules(tip_cut, side, tip_points))
     gdim = mesh.geometry.dim
     tip_cells = cut_cells[rows]
-    local = np.zeros((rows.size, 2 * gdim))
+    local = np.zeros((rows.size, 2 * gdim + 1))
     if rows.size:
-        J = maps.jacobian(tip_cells, cells.tip)
-        grad_ref = psi_maps.grad_ref(tip_cells, cells.tip)[..., None]
-        grad = np.linalg.solve(np.transpose(J, (0, 2, 1)), grad_ref)[..., 0]
+        J_T = np.transpose(maps.jacobian(tip_cells, cells.tip), (0, 2, 1))
+        grad = np.linalg.solve(J_T, psi_maps.grad_ref(tip_cells, cells.tip)[..., None])[..., 0]
+        normal = np.linalg.solve(J_T, maps.grad_ref(tip_cells, cells.tip)[..., None])[..., 0]
         local[:, :gdim] = maps.push_forward(tip_cells, cells.tip)
-        local[:, gdim:] = grad / np.linalg.norm(grad, axis=1)[:, None]
+        local[:, gdim : 2 * gdim] = grad / np.linalg.norm(grad, axis=1)[:, None]
+        left = -grad[:, 1] * normal[:, 0] + grad[:, 0] * normal[:, 1]  # rot90(d) . grad phi
+        local[:, -1] = np.where(left >= 0, 1, -1)
     imap = mesh.topology.index_map(mesh.topology.dim)
     gathered = mesh.comm.allgather((imap.local_to_global(tip_cells.astype(np.int32)), local))
     keys = np.concatenate([k for k, _ in gathered])
-    tips = np.concatenate([t for _, t in gathered]).reshape(-1, 2 * gdim)
+    tips = np.concatenate([t for _, t in gathered]).reshape(-1, 2 * gdim + 1)
     tips = tips[np.argsort(keys, kind="stable")]
     if mesh.comm.allreduce(int((cells.kind != NONE).sum()), op=MPI.SUM) == 0:
         raise ValueError(
             "The crack never enters the mesh: psi >= 0 all along the zero line of phi "
             "(the crack is phi = 0 where psi < 0)"
         )
-    return new, Crack(tangent, cells.kind, tips[:, :gdim], tips[:, gdim:])
+    upper = tips[:, -1].astype(np.int64)
+    return new, Crack(tangent, cells.kind, tips[:, :gdim], tips[:, gdim : 2 * gdim], upper)

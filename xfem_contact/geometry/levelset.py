@@ -168,6 +168,11 @@ class CellMaps:
         tab = self._cmap.tabulate(1, X)[1:, :, :, 0]  # (tdim, m, ndofs)
         return np.einsum("kpi,pid->pdk", tab, self._geom[cells])
 
+    def values(self, cells, X) -> npt.NDArray[np.float64]:
+        """The interpolated level set at the points, shape ``(m,)``."""
+        tab = self._phi_element.tabulate(0, X)[0, :, :, 0]
+        return np.einsum("pi,pi->p", tab, self._phi[cells])
+
     def grad_ref(self, cells, X) -> npt.NDArray[np.float64]:
         """Reference gradient of the interpolated level set, shape ``(m, tdim)``."""
         tab = self._phi_element.tabulate(1, X)[1:, :, :, 0]

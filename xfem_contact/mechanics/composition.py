@@ -13,7 +13,7 @@ from collections.abc import Mapping
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.mechanics.bulk import SIDES
-from xfem_contact.mechanics.laws import InterfaceLaw, make_law
+from xfem_contact.mechanics.laws import LAW_OPTIONS, InterfaceLaw, make_law
 from xfem_contact.mechanics.materials import Material, MaterialField, Moduli
 
 #: Materials: one for both sides, or ``{-1: m, 1: m}`` where side -1 may map
@@ -22,7 +22,9 @@ Materials = Material | Mapping[int, Material | Mapping[str, Material]]
 
 
 def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
-    """One law object per interface name of ``cut``."""
+    """One law object per interface name of ``cut``. A crack's law given by name keeps
+    the LBB condition by restriction: the Barbosa-Hughes stabilisation squares the
+    traction of the tip's singular stress along the lips (``1/r``, not integrable)."""
     names = cut.interface_names
     if not isinstance(interfaces, Mapping):
         interfaces = {name: interfaces for name in names}
@@ -31,7 +33,10 @@ def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
     laws = {}
     for name in names:
         law = interfaces[name]
-        laws[name] = make_law(law) if isinstance(law, str) else law
+        if isinstance(law, str):
+            crack_lbb = cut.crack is not None and "lbb" in LAW_OPTIONS.get(law, ())
+            law = make_law(law, lbb="restriction" if crack_lbb else None)
+        laws[name] = law
         if not isinstance(laws[name], InterfaceLaw):
             raise ValueError(f"Interface {name!r}: {law!r} is not an interface law")
     return laws

@@ -33,7 +33,7 @@ from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
 from xfem_contact.solvers.linear import solve_restricted
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton, weak_method
-from xfem_contact.solvers.options import merged_options
+from xfem_contact.solvers.options import CRACK_OPTIONS, merged_options
 from xfem_contact.solvers.report import SolveReport
 from xfem_contact.solvers.symmetry import symmetric_options
 
@@ -153,9 +153,10 @@ class Problem:
         self._checked_loads: int | None = None
         self._cut_revision = self.cut.revision
 
-    def update_interface(self, levelset) -> None:
+    def update_interface(self, levelset, tangent=None) -> None:
         """Move the interfaces: cut the mesh with ``levelset`` (as
-        :meth:`~xfem_contact.fem.cutmesh.CutMesh.update`, the same interface names),
+        :meth:`~xfem_contact.fem.cutmesh.CutMesh.update`, the same interface names;
+        a crack with its new ``tangent`` level set too),
         keeping the loads, supports, laws, parameters and ``W``; forms are re-created
         from the compiled ones. The next solve starts from the solution carried onto
         the new active dofs (:meth:`~xfem_contact.fem.enrichment.EnrichedSpace.carry`:
@@ -164,7 +165,7 @@ class Problem:
         history restarts at the new interface. Collective.
         """
         before = self.space.active.copy()
-        self.cut.update(levelset)
+        self.cut.update(levelset, tangent)
         self.space.refresh()
         self._attach_cut()
         for w in (self.w, self.w_old):
@@ -197,7 +198,12 @@ class Problem:
         """The PETSc options (without prefix) :meth:`solve` uses: ``petsc_options``
         over the defaults, the LDL^T of a symmetric problem included. Not collective."""
         solver = "linear" if self.linear else "newton"
-        return merged_options(solver, symmetric_options(petsc_options, self.symmetric))
+        return merged_options(solver, self._options(petsc_options))
+
+    def _options(self, petsc_options: dict | None) -> dict:
+        """``petsc_options`` over the LDL^T of a symmetric problem and a crack's options."""
+        options = symmetric_options(petsc_options, self.symmetric)
+        return options if self.cut.crack is None else {**CRACK_OPTIONS, **options}
 
     def law(self, name: str | None = None) -> InterfaceLaw:
         """The law of interface ``name`` (of the only interface for ``None``)."""
@@ -285,7 +291,7 @@ class Problem:
         if self._checked_loads != self.loads.revision:  # again only when the loads changed
             check_support(self, log)
             self._checked_loads = self.loads.revision
-        petsc_options = symmetric_options(petsc_options, self.symmetric)
+        petsc_options = self._options(petsc_options)
         if self.linear:
             a, L = form(self.bilinear_form()), form(self.loads.linear_form())
             start, residuals = time.perf_counter(), []

@@ -159,7 +159,9 @@ def free_bodies(problem, tol: float = 1e-3) -> list[FreeBody]:
     nb = len(bodies)
     Q = _dirichlet_gram(problem, bodies)
     held = [np.trace(Q[3 * b : 3 * b + 3, 3 * b : 3 * b + 3]) >= tol for b in range(nb)]
-    kinds = {name: law_kind(law) for name, law in problem.laws.items()}
+    # the two sides of a crack are one body: joined ahead of its tips
+    joined = getattr(problem.cut, "crack", None) is not None
+    kinds = {name: "full" if joined else law_kind(law) for name, law in problem.laws.items()}
     for name, kind in kinds.items():
         if kind != "none" and name in inside and plus is not None:
             Q += _interface_gram(problem, bodies, name, inside[name], plus, kind)

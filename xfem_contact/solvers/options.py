@@ -92,6 +92,13 @@ SOLVER_OPTIONS: dict[str, Option] = {
 }
 
 
+#: Options added under a problem's own for a cut with a crack: the geometric tip
+#: enrichment's branch functions are nearly dependent on the polynomials far from the
+#: tip, and MUMPS's delayed pivots then outgrow its default workspace (INFO(1) = -9,
+#: KSP reason -11): 100 % more workspace
+CRACK_OPTIONS: dict[str, OptionValue] = {"mat_mumps_icntl_14": 100}
+
+
 #: Linear-solver presets of the Newton steps (``--solver`` of the demo, ``[solver] linear``
 #: of a scene): option name (without prefix) to value, merged over the defaults. The
 #: iterative one is GMRES(100) preconditioned by

@@ -20,12 +20,13 @@ from xfem_contact.mechanics.fracture.rings import Ring
 __all__ = ["TipIntegrals", "lip_tractions"]
 
 
-def lip_tractions(problem) -> list[Lip]:
+def lip_tractions(problem, upper: int = 1) -> list[Lip]:
     """The tractions ``sigma n`` on the two lips of the crack of ``problem`` (UFL), from
     its law's multipliers: none for a law without (``free``). The law's term
     ``int lambda . [v]`` makes the multiplier vector ``lambda`` the traction on side
     -1's lip (``sigma_- n``, ``n`` from side -1 to +1); side +1's lip carries
-    ``-lambda``."""
+    ``-lambda``. ``upper``: the side (+1 or -1) that is the upper lip (``theta = pi``)
+    in the frame of the tip at hand."""
     name = problem.cut.interface_names[0]
     law, ctx = problem.laws[name], problem.contexts[name]
     if ctx.field is None:
@@ -37,8 +38,8 @@ def lip_tractions(problem) -> list[Lip]:
         traction = fields.multiplier
     measure = ctx.measure
     return [
-        Lip(traction, fields.minus, measure, -1),
-        Lip(-traction, fields.plus, measure, 1),
+        Lip(traction, fields.minus, measure, -upper),
+        Lip(-traction, fields.plus, measure, upper),
     ]
 
 
@@ -69,13 +70,20 @@ class TipIntegrals:
         cut = problem.cut
         pieces = [Piece(u[0], cut.dx(-1)), Piece(u[1], cut.dx(1))]
         material = problem.bulk.materials[1]
-        lips = lip_tractions(problem)
         #: One interaction integral per tip, in the order of ``cut.crack.tips``
         self.integrals = [
             InteractionIntegral(
-                pieces, material, tip, direction, rings, lips, quadrature_degree=quadrature_degree
+                pieces,
+                material,
+                tip,
+                direction,
+                rings,
+                lip_tractions(problem, upper),
+                quadrature_degree=quadrature_degree,
             )
-            for tip, direction in zip(crack.tips, crack.directions, strict=True)
+            for tip, direction, upper in zip(
+                crack.tips, crack.directions, crack.upper_sides, strict=True
+            )
         ]
 
     @property

@@ -174,7 +174,7 @@ class WilliamsField:
         kappa = kolosov(self.nu, self.plane)
         return self.mu * (3 - kappa) / (kappa - 1)
 
-    def _coefficients(self) -> tuple[tuple, tuple]:
+    def coefficients(self) -> tuple[tuple, tuple]:
         """Rows of the 2 x 4 map from the branch functions to the local displacement."""
         kappa, c = kolosov(self.nu, self.plane), 1 / (2 * self.mu * math.sqrt(2 * math.pi))
         K1, K2 = self.K_I, self.K_II
@@ -185,12 +185,12 @@ class WilliamsField:
 
     def _local_gradient(self, x, ops: Ops, side: int) -> tuple:
         g1, g2 = branch_local_gradients(*polar(x, self.frame, ops, side), ops)
-        return tuple((_dot(row, g1), _dot(row, g2)) for row in self._coefficients())
+        return tuple((_dot(row, g1), _dot(row, g2)) for row in self.coefficients())
 
     def displacement(self, x, ops: Ops = NUMPY, side: int = 0):
         """Displacement (m), global components, ``ops.vector``."""
         F = branch_values(*polar(x, self.frame, ops, side), ops)
-        local = tuple(_dot(row, F) for row in self._coefficients())
+        local = tuple(_dot(row, F) for row in self.coefficients())
         return ops.vector(to_global_vector(local, self.frame))
 
     def gradient_components(self, x, ops: Ops = NUMPY, side: int = 0) -> tuple:

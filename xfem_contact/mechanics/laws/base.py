@@ -29,6 +29,7 @@ import ufl
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.evaluation import FieldSampler, rule_cells
+from xfem_contact.geometry.levelset import CellMaps
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.quadrature.rules import RuleSet
 
@@ -119,8 +120,19 @@ class InterfaceContext:
         return self._cache[key][1](w, field)
 
     def jump_at(self, w: dolfinx.fem.Function) -> npt.NDArray[np.float64]:
-        """``[u]`` of ``w`` at the rule points, ``(npoints, gdim)`` (m)."""
-        return self.values_at(w, 1) - self.values_at(w, 0)
+        """``[u]`` of ``w`` at the rule points, ``(npoints, gdim)`` (m); on a crack's
+        lips with the branch functions' jump: ``[F_1] = 2 sqrt(r)`` (``r = |psi|``
+        there), the others vanish at ``theta = +-pi``."""
+        jump = self.values_at(w, 1) - self.values_at(w, 0)
+        crack = self.cut.crack
+        if crack is not None:
+            if "sqrt_r" not in self._cache:
+                cells = self.cut.cut_cells[self.rules.point_rows]
+                psi = CellMaps(self.cut.mesh, crack.tangent).values(cells, self.rules.points)
+                self._cache["sqrt_r"] = np.sqrt(np.abs(psi))[:, None]
+            b = self.values_at(w, w.function_space.num_sub_spaces - 1)  # the branch field
+            jump += 2 * self._cache["sqrt_r"] * b[:, : jump.shape[1]]
+        return jump
 
     def cell_size_at(self) -> npt.NDArray[np.float64]:
         """``h`` (m) of the cell of every rule point, ``(npoints,)``."""

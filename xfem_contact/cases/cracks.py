@@ -1,0 +1,209 @@
+"""Cracks with exact solutions as ready problems: the Williams near-tip field, the Griffith
+crack and the closed inclined crack with Coulomb friction.
+
+Shared by the tests and the benchmarks. SI units; the material is E = 1 Pa, nu = 0.3,
+plane strain unless given. Every crack is straight, turned so that no mesh line follows
+it, and its tips lie inside cells (never on a node or an edge).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable
+
+import dolfinx.mesh
+import numpy as np
+from mpi4py import MPI
+
+from xfem_contact.fem.branch import NUMPY, branch_values
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.io.meshes import ghosted_partitioner
+from xfem_contact.mechanics.fracture import GriffithCrack, WilliamsField, kolosov, tip_frame
+from xfem_contact.mechanics.laws import make_law
+from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.problem import Problem
+
+#: The material of the cases (Pa, 1, plane strain)
+MATERIAL = Material(1.0, 0.3, "strain")
+#: Direction of every crack (rad from the x axis) and the offset of its centre or tip (m
+#: per unit of the case's length): off every mesh line
+ANGLE, OFFSET = 0.3, np.array([0.0123, 0.0271])
+CELLS = {
+    "triangle": dolfinx.mesh.CellType.triangle,
+    "quadrilateral": dolfinx.mesh.CellType.quadrilateral,
+}
+
+
+@dataclasses.dataclass
+class CrackCase:
+    """A cracked problem with its exact solution.
+
+    Attributes:
+        problem: The problem, loads applied, not solved.
+        K: Exact ``(K_I, K_II)`` (Pa m^1/2) of each tip, in the order of
+            ``problem.cut.crack.tips``.
+        displacement: The exact displacement (m) of side ``s``: ``displacement(s)(x)``,
+            ``x`` of shape (3, n), values (2, n).
+        size: The length unit of the case (m): the crack's half length ``a`` or the
+            square's half width.
+    """
+
+    problem: Problem
+    K: list[tuple[float, float]]
+    displacement: Callable[[int], Callable[[np.ndarray], np.ndarray]]
+    size: float
+
+
+def _square(half: float, n: int, cell: str, comm: MPI.Comm) -> dolfinx.mesh.Mesh:
+    if cell not in CELLS:
+        raise ValueError(f"cell must be one of {list(CELLS)}, got {cell!r}")
+    corners = [np.array([-half, -half]), np.array([half, half])]
+    return dolfinx.mesh.create_rectangle(
+        comm, corners, [n, n], CELLS[cell], partitioner=ghosted_partitioner()
+    )
+
+
+def _on_boundary(half: float) -> Callable[[np.ndarray], np.ndarray]:
+    return lambda x: np.isclose(np.abs(x[0]), half) | np.isclose(np.abs(x[1]), half)
+
+
+def _frame() -> tuple[np.ndarray, np.ndarray]:
+    d = np.array([math.cos(ANGLE), math.sin(ANGLE)])
+    return d, np.array([-d[1], d[0]])
+
+
+def williams_case(
+    n: int,
+    degree: int,
+    K: tuple[float, float] = (1.0, 0.5),
+    tip_radius: float | None = 0.3,
+    cell: str = "triangle",
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> CrackCase:
+    """The exact Williams field of ``K = (K_I, K_II)`` on the square ``[-1, 1]^2`` (``n``
+    cells a side) with a crack from its left side to a tip near the centre, imposed on the
+    whole boundary (each lip's value where the crack meets it). Geometric tip enrichment
+    of radius ``tip_radius`` (m; None: topological)."""
+    d, normal = _frame()
+    tip = OFFSET
+    cut = CutMesh(
+        _square(1.0, n, cell, comm),
+        lambda x: (x[0] - tip[0]) * normal[0] + (x[1] - tip[1]) * normal[1],
+        degree=degree,
+        tangent=lambda x: (x[0] - tip[0]) * d[0] + (x[1] - tip[1]) * d[1],
+    )
+    field = WilliamsField(tip_frame(tip, d), K[0], K[1], MATERIAL.E, MATERIAL.nu)
+    problem = Problem(cut, degree, MATERIAL, "free", ghost_penalty=0.0, tip_radius=tip_radius)
+    displacement = _williams_sides(field)
+    problem.loads.add_displacement(_on_boundary(1.0), {-1: displacement(-1), 1: displacement(1)})
+    return CrackCase(problem, [K], displacement, 1.0)
+
+
+def _williams_sides(field: WilliamsField) -> Callable[[int], Callable]:
+    """The Williams displacement continued smoothly across the crack from side ``s``:
+    ``theta`` beyond ``+-pi`` on the other side's part behind the tip."""
+
+    def of_side(side: int) -> Callable[[np.ndarray], np.ndarray]:
+        def u(x: np.ndarray) -> np.ndarray:
+            (c, s), o = field.frame.direction, field.frame.origin
+            x1 = c * (x[0] - o[0]) + s * (x[1] - o[1])
+            x2 = c * (x[1] - o[1]) - s * (x[0] - o[0])
+            theta = np.arctan2(x2, x1)
+            theta = np.where(side * theta < -0.5 * np.pi, theta + side * 2 * np.pi, theta)
+            F = branch_values(np.hypot(x1, x2), theta, NUMPY)
+            rows = field.coefficients()
+            u1, u2 = (sum(a * f for a, f in zip(row, F, strict=True)) for row in rows)
+            return np.stack([c * u1 - s * u2, s * u1 + c * u2])
+
+        return u
+
+    return of_side
+
+
+def griffith_case(
+    N: int,
+    degree: int,
+    beta: float = 0.5 * math.pi,
+    tip_radius: float | None = 0.3,
+    width: float = 2.0,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> CrackCase:
+    """A Griffith crack of half length ``a = 1`` m, inclined at ``beta`` (rad) to a
+    remote tension of 1 Pa, in the square of half width ``width`` (m) meshed with
+    ``h = a / N``; Westergaard's exact displacement on the boundary, so that the plate's
+    size adds no error. Tip enrichment radius ``tip_radius`` (m)."""
+    a, (d, normal) = 1.0, _frame()
+    centre = OFFSET * a
+    crack = GriffithCrack.uniaxial(a, 1.0, beta, center=tuple(centre), direction=tuple(d))
+    cut = CutMesh(
+        _square(width, int(round(2 * width * N / a)), "triangle", comm),
+        lambda x: (x[0] - centre[0]) * normal[0] + (x[1] - centre[1]) * normal[1],
+        degree=degree,
+        tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
+    )
+    problem = Problem(cut, degree, MATERIAL, "free", ghost_penalty=0.0, tip_radius=tip_radius)
+
+    def displacement(side: int) -> Callable:
+        return lambda x: crack.displacement(x, MATERIAL.E, MATERIAL.nu, MATERIAL.plane)
+
+    problem.loads.add_displacement(_on_boundary(width), displacement(1))
+    K = crack.stress_intensity_factors
+    return CrackCase(problem, [K] * len(cut.crack.tips), displacement, a)
+
+
+def frictional_crack_case(
+    N: int,
+    degree: int,
+    friction: float = 0.3,
+    beta: float = 0.25 * math.pi,
+    tip_radius: float | None = 0.3,
+    width: float = 2.0,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> CrackCase:
+    """A closed crack of half length ``a = 1`` m inclined at ``beta`` to a remote
+    compression of 1 Pa, Coulomb friction ``friction`` on its lips, in the square of half
+    width ``width`` meshed with ``h = a / N``. The exact solution (sliding when
+    ``|tau| > friction |sigma_n|``): the uniform stress plus Westergaard's mode II field of
+    the crack loaded by the effective shear ``tau_eff = |tau| - friction |sigma_n|``;
+    imposed on the boundary. ``K_I = 0``, ``K_II = sign(tau) tau_eff sqrt(pi a)``."""
+    a, (d, normal) = 1.0, _frame()
+    centre = OFFSET * a
+    S11, S22, S12 = GriffithCrack.uniaxial(a, -1.0, beta).remote
+    T = math.copysign(max(abs(S12) - friction * abs(S22), 0.0), S12)
+    sliding = GriffithCrack(a, (0.0, 0.0, T), center=tuple(centre), direction=tuple(d))
+    mu, kappa = MATERIAL.E / (2 * (1 + MATERIAL.nu)), kolosov(MATERIAL.nu, MATERIAL.plane)
+    # the uniform stress the sliding field leaves: (S11, S22, S12 - T), strain C^-1 S
+    sxx, syy, sxy = S11, S22, S12 - T
+    exx = ((kappa + 1) * sxx + (kappa - 3) * syy) / (8 * mu)
+    eyy = ((kappa + 1) * syy + (kappa - 3) * sxx) / (8 * mu)
+    exy = sxy / (2 * mu)
+
+    def exact(x: np.ndarray) -> np.ndarray:
+        X = (x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]
+        Y = (x[1] - centre[1]) * d[0] - (x[0] - centre[0]) * d[1]
+        ux, uy = exx * X + exy * Y, exy * X + eyy * Y
+        uniform = np.stack([d[0] * ux - d[1] * uy, d[1] * ux + d[0] * uy])
+        return uniform + sliding.displacement(x, MATERIAL.E, MATERIAL.nu, MATERIAL.plane)
+
+    cut = CutMesh(
+        _square(width, int(round(2 * width * N / a)), "triangle", comm),
+        lambda x: (x[0] - centre[0]) * normal[0] + (x[1] - centre[1]) * normal[1],
+        degree=degree,
+        tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
+    )
+    law = make_law("coulomb", friction=friction, lbb="restriction")
+    problem = Problem(cut, degree, MATERIAL, law, ghost_penalty=0.0, tip_radius=tip_radius)
+    problem.loads.add_displacement(_on_boundary(width), exact)
+    K = (0.0, T * math.sqrt(math.pi * a))
+    return CrackCase(problem, [K] * len(cut.crack.tips), lambda side: exact, a)
+
+
+def frictional_slip(s: np.ndarray, friction: float = 0.3, beta: float = 0.25 * math.pi):
+    """The exact slip ``[u] . t`` (m) of :func:`frictional_crack_case` at the distance
+    ``s`` (m) from the crack's centre along it: ``4 (1 - nu^2) T / E sqrt(a^2 - s^2)``
+    (plane strain), ``T`` the signed effective shear; and the normal traction (Pa)."""
+    _, S22, S12 = GriffithCrack.uniaxial(1.0, -1.0, beta).remote
+    T = math.copysign(max(abs(S12) - friction * abs(S22), 0.0), S12)
+    E, nu = MATERIAL.E, MATERIAL.nu
+    return 4 * (1 - nu**2) * T / E * np.sqrt(np.clip(1.0 - s**2, 0.0, None)), S22
