@@ -245,13 +245,19 @@ def render_folder(
     ``interface*.vtu``), ``pressure.png`` (``lambda_n`` of the interface samples of
     ``summary.json``) and, for friction laws, ``traction.png`` (the tangential traction
     with each point's stick / slip status); one plot per interface when there are
-    several (``pressure_NAME.png``, ``traction_NAME.png``). A picture whose data is
+    several (``pressure_NAME.png``, ``traction_NAME.png``); for a crack ``lips.png``
+    (opening, slip and multipliers along its lips). A picture whose data is
     missing is skipped with a ``log`` line.
 
     Raises:
         FileNotFoundError: if the folder holds no ``result*.vtu``.
     """
-    from xfem_contact.io.plots import interface_abscissa, plot_pressure, plot_traction
+    from xfem_contact.io.plots import (
+        interface_abscissa,
+        plot_lips,
+        plot_pressure,
+        plot_traction,
+    )
 
     say = log or (lambda line: None)
     folder = pathlib.Path(folder)
@@ -334,6 +340,11 @@ def render_folder(
                 applied=samples.get("P_n"),
             )
         )
+    cracks = summary.get("cracks") or {}
+    for crack, entry in cracks.items():
+        file = "lips.png" if len(cracks) == 1 else f"lips_{crack}.png"
+        title = f"{name}: {crack}, opening and slip of the lips"
+        written.append(plot_lips(entry["lips"], folder / file, entry["abscissa"], title))
     for path in written:
         say(f"wrote {path}")
     return written

@@ -153,3 +153,44 @@ def plot_traction(
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     return path
+
+
+def plot_lips(
+    lips: dict, path: str | pathlib.Path, xlabel: str, title: str = "Crack lips"
+) -> pathlib.Path:
+    """PNG of a crack's opening ``[u].n`` and slip ``[u].t`` (m) against the abscissa
+    ``s`` along its lips and, below, the multipliers ``lambda_n``, ``lambda_t`` (Pa) when
+    the law has them.
+
+    Args:
+        lips: ``s``, ``opening``, ``slip`` (and ``lambda_n``, ``lambda_t``), each a list
+            over the points (the ``lips`` of a crack in ``summary.json``).
+        path: The PNG file.
+        xlabel: Label of ``s``.
+        title: Title of the plot.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    s = np.asarray(lips["s"], dtype=np.float64)
+    order = np.argsort(s)
+    panels = [(("opening", "opening [u]·n"), ("slip", "slip [u]·t"), "jump (m)")]
+    if lips.get("lambda_n"):
+        panels.append((("lambda_n", "λₙ"), ("lambda_t", "λₜ"), "multiplier (Pa)"))
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig = Figure(figsize=(6, 2.5 + 2 * len(panels)))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
+    for ax, (*curves, ylabel) in zip(axes, panels, strict=True):
+        for (key, label), style in zip(curves, (".-", "x-"), strict=True):
+            if lips.get(key):
+                ax.plot(s[order], np.asarray(lips[key])[order], style, ms=3, lw=0.8, label=label)
+        ax.axhline(0.0, color="black", lw=0.5)
+        ax.set_ylabel(ylabel)
+        ax.legend(fontsize=8)
+    axes[0].set_title(title)
+    axes[-1].set_xlabel(xlabel)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    return path

@@ -20,7 +20,8 @@ from xfem_contact.mechanics.laws import ContactLaw, make_law
 from xfem_contact.mechanics.loads import annulus_parts, rectangle_parts
 from xfem_contact.mechanics.plain import PlainElasticityProblem
 from xfem_contact.mechanics.problem import Problem
-from xfem_contact.scenes.expressions import compile_expression
+from xfem_contact.scenes.crack_builder import crack_cut, problem_error
+from xfem_contact.scenes.expressions import compile_expression, numpy_field
 from xfem_contact.scenes.scene import InterfaceSpec, Scene, SceneError
 
 
@@ -44,8 +45,7 @@ def levelset(spec: InterfaceSpec) -> Callable[[np.ndarray], np.ndarray]:
         (px, py), (nx, ny) = p["point"], p["normal"]
         norm = np.hypot(nx, ny)
         return lambda x: ((x[0] - px) * nx + (x[1] - py) * ny) / norm
-    f = compile_expression(p["expression"], "interface expression")
-    return lambda x: np.broadcast_to(np.asarray(f(x), dtype=float), x[0].shape).copy()
+    return numpy_field(p["expression"], "interface expression")
 
 
 def scene_parts(scene: Scene, meshed: MeshedDomain) -> dict:
@@ -124,7 +124,7 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
     meshed = create_mesh(scene, comm)
     mesh = meshed.mesh
     material = next(iter(scene.materials.values()))
-    if not scene.interfaces:
+    if not (scene.interfaces or scene.cracks):
         problem = PlainElasticityProblem(mesh, scene.degree, material)
         effects = {
             "interface": None,
@@ -137,38 +137,40 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             "pairing": False,
         }
     else:
-        cut = CutMesh(
-            mesh,
-            interface_levelsets(scene),
-            degree=scene.levelset_degree,
-            quadrature_degree=scene.quadrature_degree,
-        )
-        laws = {
-            spec.name: make_law(
-                spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb
+        if scene.cracks:
+            cut, laws, materials, options = crack_cut(scene, mesh)
+        else:
+            cut = CutMesh(
+                mesh,
+                interface_levelsets(scene),
+                degree=scene.levelset_degree,
+                quadrature_degree=scene.quadrature_degree,
             )
-            for spec in scene.interfaces
-        }
-        materials = {
-            -1: {spec.name: scene.materials[spec.inside] for spec in scene.interfaces},
-            1: scene.materials[scene.interfaces[0].outside],  # shared (see the schema)
-        }
-        first = scene.interfaces[0]  # kinematics, slave side and pairing are shared
-        problem = Problem(
-            cut,
-            scene.degree,
-            materials,
-            laws,
-            kinematics=first.kinematics,
-            slave=first.slave,
-            pairing=first.pairing,
-        )
+            laws = {
+                spec.name: make_law(
+                    spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb
+                )
+                for spec in scene.interfaces
+            }
+            materials = {
+                -1: {spec.name: scene.materials[spec.inside] for spec in scene.interfaces},
+                1: scene.materials[scene.interfaces[0].outside],  # shared (see the schema)
+            }
+            first = scene.interfaces[0]  # kinematics, slave side and pairing are shared
+            options = {"kinematics": first.kinematics, "slave": first.slave}
+            options["pairing"] = first.pairing
+        try:
+            problem = Problem(cut, scene.degree, materials, laws, **options)
+        except ValueError as error:
+            if not scene.cracks:
+                raise
+            raise problem_error(error) from None
         gdim = mesh.geometry.dim
         effects = {
-            "interface": scene.interfaces[0].law if len(laws) == 1 else None,
-            "interfaces": [s.name for s in scene.interfaces],
+            "interface": next(iter(laws.values())).name if len(laws) == 1 else None,
+            "interfaces": list(laws),
             "laws": {name: law.describe() for name, law in problem.laws.items()},
-            "kinematics": first.kinematics,
+            "kinematics": problem.kinematics,
             "cut": True,
             "enrichment": True,
             "multipliers": sum(c for _, c, _ in problem.space.multiplier_fields),
@@ -181,6 +183,8 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             else "SNES (generalized Newton)",
             "pairing": bool(problem.couplings),
         }
+        if scene.cracks:
+            effects["crack"] = {"tips": len(cut.crack.tips), "tip_radius": options["tip_radius"]}
     loads = problem.loads
     loads.parts = scene_parts(scene, meshed)
     for name, (start, end) in scene.stages.items():

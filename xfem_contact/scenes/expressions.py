@@ -279,3 +279,10 @@ def check_expression(text, what: str, target: str = "number") -> Callable:
         reason = " ".join(str(err).split()) or type(err).__name__
         raise ValueError(f"{what}: cannot evaluate {_short(text)}: {reason}") from None
     return f
+
+
+def numpy_field(text: str, what: str = "expression") -> Callable[[np.ndarray], np.ndarray]:
+    """``text`` as a level set or a nodal field: ``f(x)``, ``x`` of shape (>=2, n), returning
+    a float array ``(n,)`` (a constant broadcast). Raises as :func:`compile_expression`."""
+    f = compile_expression(text, what)
+    return lambda x: np.broadcast_to(np.asarray(f(x), dtype=float), x[0].shape).copy()

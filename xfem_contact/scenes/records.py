@@ -1,4 +1,4 @@
-"""The validated scene records: frozen dataclasses of an interface, a load and a scene
+"""The validated scene records: frozen dataclasses of an interface, a crack, a load and a scene
 (:func:`xfem_contact.scenes.scene.load_scene` returns a :class:`Scene`; the keys and
 checks behind them are :mod:`xfem_contact.scenes.schema`'s). SI units."""
 
@@ -25,6 +25,25 @@ class InterfaceSpec:
     kinematics: str = "small"
     slave: int = -1
     pairing: str = "iterate"
+
+
+@dataclasses.dataclass(frozen=True)
+class CrackSpec:
+    """A crack: its shape's parameters (``points``; ``centre``, ``radius``,
+    ``angles_deg``; or ``phi``, ``psi`` expressions), the law of its lips, the tip
+    enrichment radius (m; None: the tip cells' nodes) and the rings of K (m; None:
+    the default, in tip cell sizes)."""
+
+    shape: str
+    params: dict
+    material: str
+    name: str = "crack"
+    law: str = "free"
+    friction: float | None = None
+    augmentation: float | None = None
+    lbb: str | None = None
+    tip_radius: float | None = None
+    rings: tuple | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -57,7 +76,8 @@ class Scene:
     cell: str
     degree: int
     levelset_degree: int
-    quadrature_degree: int
+    #: None: the cut's default (6 for interfaces, 16 for a crack)
+    quadrature_degree: int | None
     materials: dict[str, Material]
     interfaces: tuple[InterfaceSpec, ...]
     parts: dict[str, str]
@@ -70,3 +90,5 @@ class Scene:
     end_time: float | None = None
     #: PETSc options of the solver (SNES/KSP, without prefix)
     petsc_options: dict = dataclasses.field(default_factory=dict)
+    #: The cracks (one at most today; not with interfaces)
+    cracks: tuple[CrackSpec, ...] = ()

@@ -13,6 +13,7 @@ from mpi4py import MPI
 
 from xfem_contact._version import versions
 from xfem_contact.fem import forms
+from xfem_contact.io.crack_data import EnrichedDisplacements
 from xfem_contact.io.interface_data import sample_status
 from xfem_contact.io.output import write_json
 from xfem_contact.io.progress import note, progress
@@ -26,6 +27,7 @@ from xfem_contact.scenes.builder import (  # noqa: F401  (re-exported)
     interface_levelsets,
     levelset,
 )
+from xfem_contact.scenes.crack_outputs import CrackOutputs
 from xfem_contact.scenes.scene import Scene
 from xfem_contact.solvers.newton import NewtonFailure
 
@@ -35,8 +37,10 @@ class Result:
 
     Plain problems have one field ``u``; cut problems ``u_minus``, ``u_plus`` and,
     with an interface law that needs one, ``multiplier`` (``multiplier_NAME`` per
-    interface when several have one). ``stress`` holds the Cauchy and von Mises
-    stresses of each displacement field
+    interface when several have one); with a crack also ``branch``, and each side's
+    displacement includes the branch functions
+    (:class:`~xfem_contact.io.crack_data.EnrichedDisplacements`). ``stress`` holds the
+    Cauchy and von Mises stresses of each displacement field
     (:class:`~xfem_contact.mechanics.stress.StressFields`).
     """
 
@@ -49,6 +53,8 @@ class Result:
             V, dofs = space.field_space(i)
             self.fields.append(dolfinx.fem.Function(V, name=name))
             self._maps.append(dofs)
+        crack = getattr(problem.cut, "crack", None) is not None
+        self._enriched = EnrichedDisplacements(problem, self.fields) if crack else None
         self.stress = _stress_fields(problem, self.fields)
 
     def update(self, solution: dolfinx.fem.Function) -> None:
@@ -56,6 +62,8 @@ class Result:
         for f, dofs in zip(self.fields, self._maps, strict=True):
             f.x.array[:] = solution.x.array[dofs]
             f.x.scatter_forward()
+        if self._enriched is not None:
+            self._enriched.update()
         self.stress.update()
 
 
@@ -106,7 +114,8 @@ def run(
 
     Returns:
         The summary: effects built, fields, dof counts, iterations per step, the
-        contact status, timings (s).
+        contact status, timings (s); with a crack its K_I, K_II, J, G per tip and ring
+        and its lips (``cracks``, see :class:`~xfem_contact.scenes.crack_outputs.CrackOutputs`).
     """
     if log is print:  # printed lines go above the progress bar, not through it
         log = note
@@ -119,6 +128,7 @@ def run(
     problem, effects = build(scene, comm)
     build_time = time.perf_counter() - start
     say(f"scene {scene.name}: effects {effects}")
+    cracks = CrackOutputs(problem, scene) if scene.cracks else None
     result = Result(problem)
     series = _open_series(out, result) if (out is not None and scene.outputs["vtx"]) else []
     end_time = scene.end_time or problem.loads.end_time
@@ -193,6 +203,10 @@ def run(
         }
         if not problem.linear and len(samples) == 1:
             summary["interface_samples"] = next(iter(samples.values()))
+    if cracks is not None:
+        summary["cracks"] = cracks.summary()
+        for line in cracks.lines(summary["cracks"]):
+            say(line)
     forces_start = time.perf_counter()  # reactions, interface resultants, balance (N/m)
     summary["forces"] = balance(problem)
     forces_time = time.perf_counter() - forces_start
@@ -234,8 +248,9 @@ def _open_series(out: str | pathlib.Path, result: Result) -> list:
     out.mkdir(parents=True, exist_ok=True)
     comm = result.fields[0].function_space.mesh.comm
     groups = [("displacement", result.fields[:2])]
-    if len(result.fields) > 2:
-        groups.append(("multiplier", result.fields[2:]))
+    multipliers = [f for f in result.fields[2:] if f.name.startswith("multiplier")]
+    if multipliers:
+        groups.append(("multiplier", multipliers))
     groups.append(("stress", result.stress.stress + result.stress.von_mises))
     return [
         dolfinx.io.VTXWriter(comm, out / f"{name}.bp", fields, engine="BP4")

@@ -39,9 +39,10 @@ import pathlib
 import re
 import tomllib
 
-from xfem_contact.mechanics.laws import LAW_OPTIONS, LINEAR_LAWS, SLIDING_LAWS
+from xfem_contact.mechanics.laws import LINEAR_LAWS, SLIDING_LAWS
 from xfem_contact.mechanics.laws.sliding import SLIDING_LBB
 from xfem_contact.mechanics.materials import Material
+from xfem_contact.scenes.crack_tables import crack_spec
 from xfem_contact.scenes.load_tables import load_spec
 from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
     BUILTIN_PARTS,
@@ -70,6 +71,7 @@ from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
     join,
     stages_table,
 )
+from xfem_contact.scenes.table_keys import law_options, shape_parameters
 from xfem_contact.solvers.options import preset
 
 
@@ -144,6 +146,17 @@ def load_scene(
         for _, k, table in _tables(data.get("interfaces", []), "interfaces", listed=True)
     ]
     _check_shared(interfaces)
+    cracks = [
+        crack_spec(table, k, materials)
+        for _, k, table in _tables(data.get("cracks", []), "cracks", listed=True)
+    ]
+    if len(cracks) > 1:
+        raise NotImplementedError("cracks[1]: one crack per scene for now")
+    if cracks and interfaces:
+        raise NotImplementedError(
+            "cracks: a crack together with [[interfaces]] is not available yet; "
+            "give one or the other"
+        )
 
     parts = {}
     for where, name, table in _tables(data.get("parts", {}), "parts", listed=False):
@@ -169,7 +182,7 @@ def load_scene(
         **mesh,
         degree=disc.get("degree", 2),
         levelset_degree=disc.get("levelset_degree", 2),
-        quadrature_degree=disc.get("quadrature_degree", 6),
+        quadrature_degree=disc.get("quadrature_degree"),
         materials=materials,
         interfaces=tuple(interfaces),
         parts=parts,
@@ -179,6 +192,7 @@ def load_scene(
         stages=stages,
         end_time=solver.get("end_time"),
         petsc_options=_petsc_options(solver),
+        cracks=tuple(cracks),
     )
 
 
@@ -217,16 +231,7 @@ def _interface(table, k: int, materials: dict) -> InterfaceSpec:
     where = f"interfaces[{k}]"
     check_table(table, FIELDS["interface"], where)
     shape = table["shape"]
-    required, optional = SHAPE_KEYS[shape]
-    parameters = ", ".join(required + optional)
-    for key in required:
-        if key not in table:
-            message = f"required for shape {shape!r} (its parameters: {parameters})"
-            raise SceneError(f"{where}.{key}", message)
-    for key in {k for keys in SHAPE_KEYS.values() for k in keys[0] + keys[1]}:
-        if key in table and key not in required + optional:
-            message = f"is not a parameter of shape {shape!r} (its parameters: {parameters})"
-            raise SceneError(f"{where}.{key}", message)
+    params = shape_parameters(table, where, SHAPE_KEYS)
     if "angle" in table and "angle_deg" in table:
         raise SceneError(f"{where}.angle_deg", "give the angle once: angle (rad) or angle_deg")
     if abs(table.get("angle", 0.0)) > 2.0 * math.pi:
@@ -235,14 +240,7 @@ def _interface(table, k: int, materials: dict) -> InterfaceSpec:
     if "normal" in table and not 0.0 < math.hypot(*table["normal"]) < math.inf:
         raise SceneError(f"{where}.normal", f"must be a non-zero vector, got {table['normal']}")
     law = table.get("law", "bonded")
-    if law == "coulomb" and "friction" not in table:
-        raise SceneError(f"{where}.friction", "required for law 'coulomb' (coefficient >= 0)")
-    for key in ("friction", "augmentation", "lbb"):
-        if key in table and key not in LAW_OPTIONS[law]:
-            options = ", ".join(LAW_OPTIONS[law]) or "none"
-            raise SceneError(
-                f"{where}.{key}", f"is not an option of law {law!r} (its options: {options})"
-            )
+    options = law_options(table, where, law)
     kinematics = table.get("kinematics", "small")
     slave = _sides(table, kinematics, where)
     if kinematics == "large":
@@ -264,13 +262,11 @@ def _interface(table, k: int, materials: dict) -> InterfaceSpec:
     return InterfaceSpec(
         shape=shape,
         law=law,
-        params={k: table[k] for k in required + optional if k in table},
+        params=params,
         name=table.get("name", f"interface{k}"),
         inside=table.get("inside", first),
         outside=table.get("outside", first),
-        friction=table.get("friction"),
-        augmentation=table.get("augmentation"),
-        lbb=table.get("lbb"),
+        **options,
         kinematics=kinematics,
         slave=slave,
         pairing=table.get("pairing", "iterate"),

@@ -10,16 +10,27 @@ returns.
 
 from __future__ import annotations
 
-import dataclasses
-import math
-import numbers
-import re
-from collections.abc import Callable
-
 from xfem_contact.mechanics.laws import CONTACT_LAWS, LBB_OPTIONS, LINEAR_LAWS
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
-from xfem_contact.scenes.expressions import check_expression
-from xfem_contact.scenes.records import InterfaceSpec, LoadSpec, Scene  # noqa: F401
+from xfem_contact.scenes.checks import (  # noqa: F401  (re-exported)
+    NAME,
+    Choice,
+    Expression,
+    Field,
+    Number,
+    Scalar,
+    SceneError,
+    Text,
+    Vector,
+    check_table,
+    describe,
+    flag,
+    join,
+    load_path,
+    petsc_table,
+    stages_table,
+)
+from xfem_contact.scenes.records import CrackSpec, InterfaceSpec, LoadSpec, Scene  # noqa: F401
 from xfem_contact.solvers.options import LINEAR_PRESETS, defaults
 
 _NEWTON = defaults("newton")  # the [solver] defaults are the Newton solver's
@@ -60,6 +71,16 @@ SHAPE_KEYS = {
     "half-plane": (("point", "normal"), ()),
     "expression": (("expression",), ()),
 }
+#: The shapes of a crack and their parameters: (required, optional)
+CRACK_SHAPES = ("segment", "polyline", "arc", "expression")
+CRACK_SHAPE_KEYS = {
+    "segment": (("points",), ()),
+    "polyline": (("points",), ()),
+    "arc": (("centre", "radius", "angles_deg"), ()),
+    "expression": (("phi", "psi"), ()),
+}
+#: Default rings of the stress intensity factors, in units of the tip cell size
+CRACK_RINGS = ((2.0, 5.0), (3.0, 7.0))
 #: The keys of each load type besides ``type``: (required, optional)
 LOAD_KEYS = {
     "pressure": (("part", "value"), ("side", "history")),
@@ -72,198 +93,35 @@ LOAD_KEYS = {
 }
 
 
-class SceneError(ValueError):
-    """Bad scene input: one line ``KEY: message`` (``key`` the path, ``interfaces[0].radius``)."""
-
-    def __init__(self, key: str, message: str):
-        self.key, self.message = key, message
-        super().__init__(f"{key}: {message}" if key else message)
-
-
-def join(key: str, name) -> str:
-    """The path of ``name`` in the table at ``key`` (odd names quoted, one line)."""
-    if isinstance(name, int):
-        return f"{key}[{name}]"
-    name = name if re.fullmatch(r"[A-Za-z0-9_-]+", name) else repr(name)
-    return f"{key}.{name}" if key else name
-
-
-def describe(value) -> str:
-    """``value`` in a message: its kind and a short one-line repr."""
-    kinds = ((bool, "boolean"), (numbers.Integral, "integer"), (numbers.Real, "number"))
-    kinds += ((str, "string"), (list | tuple, "list"), (dict, "table"))
-    kind = next((name for t, name in kinds if isinstance(value, t)), type(value).__name__)
-    text = repr(value)
-    return f"{kind} {text if len(text) <= 40 else text[:36] + ' ...'}"
-
-
-@dataclasses.dataclass(frozen=True)
-class Number:
-    """A finite number (integer with ``integer``) in ``low <(=) value <(=) high``."""
-
-    low: float | None = None
-    high: float | None = None
-    open: bool = False  # strict bounds
-    integer: bool = False
-
-    def __call__(self, value, key: str):
-        kind = numbers.Integral if self.integer else numbers.Real
-        if isinstance(value, bool) or not isinstance(value, kind):
-            article = "an integer" if self.integer else "a number"
-            raise SceneError(key, f"expected {article}, got {describe(value)}")
-        if isinstance(value, numbers.Integral) and abs(value) > 2**63:
-            raise SceneError(key, f"{describe(value)} is out of range")
-        if not math.isfinite(value):
-            raise SceneError(key, f"must be a finite number, got {value}")
-        low = self.low is None or (value > self.low if self.open else value >= self.low)
-        high = self.high is None or (value < self.high if self.open else value <= self.high)
-        if not (low and high):
-            raise SceneError(key, f"must be {self.bounds()}, got {value}")
-        return value
-
-    def bounds(self) -> str:
-        if self.low is not None and self.high is not None:
-            brackets = "()" if self.open else "[]"
-            return f"in {brackets[0]}{self.low}, {self.high}{brackets[1]}"
-        if self.high is None:
-            return f"{'>' if self.open else '>='} {self.low}"
-        return f"{'<' if self.open else '<='} {self.high}"
-
-
-@dataclasses.dataclass(frozen=True)
-class Choice:
-    """One of ``choices`` (of their type: ``True`` is not ``1``)."""
-
-    choices: tuple
-
-    def __call__(self, value, key: str):
-        if not any(type(value) is type(c) and value == c for c in self.choices):
-            message = f"{describe(value)} is not valid; choose one of {list(self.choices)}"
-            raise SceneError(key, message)
-        return value
-
-
-@dataclasses.dataclass(frozen=True)
-class Text:
-    """A string, matching ``pattern`` if given (``rule`` says it in words)."""
-
-    pattern: str | None = None
-    rule: str = ""
-
-    def __call__(self, value, key: str):
-        if not isinstance(value, str):
-            raise SceneError(key, f"expected a string, got {describe(value)}")
-        if self.pattern and not re.fullmatch(self.pattern, value):
-            raise SceneError(key, f"{describe(value)}: {self.rule}")
-        return value
-
-
-def flag(value, key: str):
-    if not isinstance(value, bool):
-        raise SceneError(key, f"expected true or false, got {describe(value)}")
-    return value
-
-
-@dataclasses.dataclass(frozen=True)
-class Vector:
-    """A list of ``n`` entries, each checked by ``item``."""
-
-    n: int
-    item: Callable
-
-    def __call__(self, value, key: str):
-        if not isinstance(value, list | tuple) or len(value) != self.n:
-            raise SceneError(key, f"expected a list of {self.n} entries, got {describe(value)}")
-        return tuple(self.item(v, join(key, i)) for i, v in enumerate(value))
-
-
-@dataclasses.dataclass(frozen=True)
-class Scalar:
-    """A number or an expression of x, y for ``target`` (see :func:`check_expression`)."""
-
-    target: str = "number"
-
-    def __call__(self, value, key: str):
-        if isinstance(value, str):
-            check_expression(value, key, self.target)
-            return value
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            message = f"expected a number or an expression string, got {describe(value)}"
-            raise SceneError(key, message)
-        return Number()(value, key)
-
-
-@dataclasses.dataclass(frozen=True)
-class Expression:
-    """An expression string of x, y for ``target`` (see :func:`check_expression`)."""
-
-    target: str = "number"
-
-    def __call__(self, value, key: str):
-        if not isinstance(value, str):
-            raise SceneError(key, f"expected an expression string, got {describe(value)}")
-        check_expression(value, key, self.target)
-        return value
-
-
-def petsc_table(value, key: str):
-    """A table of PETSc options: strings, finite numbers or booleans."""
-    if not isinstance(value, dict):
-        raise SceneError(key, f"expected a table of PETSc options, got {describe(value)}")
-    for name, option in value.items():
-        if not isinstance(option, str | numbers.Real):
-            message = f"expected a string, number or boolean, got {describe(option)}"
-            raise SceneError(join(key, name), message)
-        if isinstance(option, numbers.Real) and not isinstance(option, bool):
-            Number()(option, join(key, name))
-    return value
-
-
-def load_path(value, key: str):
-    """A load path: a stage name, or ``[[time, factor], ...]`` with times increasing."""
-    if isinstance(value, str):
-        return _NAME(value, key)
-    if not isinstance(value, list | tuple) or not value:
-        message = f"expected a stage name or a list of [time, factor] pairs, got {describe(value)}"
-        raise SceneError(key, message)
-    times = [Vector(2, Number())(pair, join(key, i))[0] for i, pair in enumerate(value)]
-    if any(b <= a for a, b in zip(times, times[1:], strict=False)):
-        raise SceneError(key, f"the times must increase strictly, got {times}")
-    return value
-
-
-def stages_table(value, key: str) -> dict[str, tuple[float, float]]:
-    """The [stages] table: ``NAME = [start, end]`` pseudo-times, ``start < end``."""
-    if not isinstance(value, dict):
-        raise SceneError(key, f"expected a table of NAME = [start, end], got {describe(value)}")
-    stages = {}
-    for name, interval in value.items():
-        where = join(key, name)
-        _NAME(name, where)
-        start, end = Vector(2, Number())(interval, where)
-        if not start < end:
-            raise SceneError(where, f"start {start} must be before end {end}")
-        stages[name] = (float(start), float(end))
-    return stages
-
-
-@dataclasses.dataclass(frozen=True)
-class Field:
-    """A key of a table: its check, its meaning, whether it must be given."""
-
-    check: Callable
-    doc: str
-    required: bool = False
-
-
 _POSITIVE = Number(0.0, open=True)
-_NAME = Text(r"[A-Za-z0-9_.-]+", "use letters, digits, '_', '-' or '.'")
 _POINT = Vector(2, Number())
 _DEGREE = Choice((1, 2))
+
+
+def point_list(value, key: str) -> tuple:
+    """A list of at least two points [x, y] (m)."""
+    if not isinstance(value, list | tuple) or len(value) < 2:
+        raise SceneError(key, f"expected a list of at least 2 points [x, y], got {describe(value)}")
+    return tuple(_POINT(p, join(key, i)) for i, p in enumerate(value))
+
+
+def ring_list(value, key: str) -> tuple:
+    """A non-empty list of rings ``[r_inf, r_sup]`` (m), ``0 <= r_inf < r_sup``."""
+    if not isinstance(value, list | tuple) or not value:
+        raise SceneError(key, f"expected a list of [r_inf, r_sup] pairs, got {describe(value)}")
+    rings = []
+    for i, pair in enumerate(value):
+        r_inf, r_sup = Vector(2, Number(0.0))(pair, join(key, i))
+        if not r_inf < r_sup:
+            raise SceneError(join(key, i), f"r_inf must be < r_sup, got {list(pair)}")
+        rings.append((float(r_inf), float(r_sup)))
+    return tuple(rings)
+
+
 #: Every key of every table: its check and meaning (the schema in one place)
 FIELDS = {
     "scene": {
-        "name": Field(_NAME, "scene name (names the default output folder results/NAME)"),
+        "name": Field(NAME, "scene name (names the default output folder results/NAME)"),
         "description": Field(Text(), "free text"),
     },
     "mesh": {
@@ -286,7 +144,7 @@ FIELDS = {
         "quadrature_degree": Field(Number(1, 30, integer=True), ">= 1 and <= 30"),
     },
     "interface": {
-        "name": Field(_NAME, "label (names the multiplier field)"),
+        "name": Field(NAME, "label (names the multiplier field)"),
         "shape": Field(Choice(SHAPES), f"one of {SHAPES}", required=True),
         "centre": Field(_POINT, "[x, y] (m)"),
         "radius": Field(_POSITIVE, "(m) > 0"),
@@ -308,6 +166,40 @@ FIELDS = {
         ),
         "inside": Field(Text(), "material of side -1"),
         "outside": Field(Text(), "material of side +1"),
+    },
+    "crack": {
+        "name": Field(NAME, "label (names the crack's multiplier field and outputs)"),
+        "shape": Field(Choice(CRACK_SHAPES), f"one of {CRACK_SHAPES}", required=True),
+        "points": Field(
+            point_list,
+            "[[x, y], ...] (m): 2 for a segment, >= 2 for a polyline; an end inside the "
+            "body is a tip, one on or beyond its boundary an edge crack's mouth",
+        ),
+        "centre": Field(_POINT, "[x, y] (m), centre of an arc"),
+        "radius": Field(_POSITIVE, "(m) > 0, radius of an arc"),
+        "angles_deg": Field(
+            Vector(2, Number()),
+            "[start, end] polar angles (degrees) of an arc, |end - start| < 360",
+        ),
+        "phi": Field(
+            Expression(), "normal level set phi(x, y): the crack is phi = 0 where psi < 0"
+        ),
+        "psi": Field(Expression(), "tangential level set psi(x, y), 0 at the tips"),
+        "law": Field(Choice(LAWS), f"law of the lips: one of {LAWS} (default free)"),
+        "friction": Field(Number(0.0), "Coulomb coefficient >= 0"),
+        "augmentation": Field(_POSITIVE, "> 0"),
+        "lbb": Field(Choice(LBB_OPTIONS), " | ".join(LBB_OPTIONS)),
+        "tip_radius": Field(
+            _POSITIVE,
+            "tip enrichment radius (m), at least the tip cells' size (default: "
+            "the nodes of the tip cells)",
+        ),
+        "rings": Field(
+            ring_list,
+            "[[r_inf, r_sup], ...] (m) of the K integrals (default: "
+            f"{[list(r) for r in CRACK_RINGS]} tip cell sizes, r_sup kept off the boundary)",
+        ),
+        "material": Field(Text(), "material of the cracked body (default: the first)"),
     },
     "material": {
         "E": Field(_POSITIVE, "Young's modulus (Pa) > 0", required=True),
@@ -369,24 +261,9 @@ TOP_LEVEL = (
     "discretisation",
     "materials",
     "interfaces",
+    "cracks",
     "parts",
     "loads",
     "solver",
     "outputs",
 )
-
-
-def check_table(value, fields: dict[str, Field], key: str) -> dict:
-    """``value`` checked as a table of ``fields``: its type, unknown keys, missing required
-    keys and every given value. Returns ``value``; raises :class:`SceneError`."""
-    if not isinstance(value, dict):
-        raise SceneError(key, f"expected a table, got {describe(value)}")
-    unknown = [name for name in value if name not in fields]
-    if unknown:
-        raise SceneError(join(key, unknown[0]), f"unknown key; valid: {list(fields)}")
-    for name, field in fields.items():
-        if name in value:
-            field.check(value[name], join(key, name))
-        elif field.required:
-            raise SceneError(join(key, name), f"required: {field.doc}")
-    return value

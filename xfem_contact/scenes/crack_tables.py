@@ -1,0 +1,53 @@
+"""The [[cracks]] of a scene: each table checked against its shape's keys and its law's
+options (:func:`crack_spec`); where the crack lies in the mesh is checked when it is
+built (:mod:`xfem_contact.scenes.crack_builder`)."""
+
+from __future__ import annotations
+
+import math
+
+from xfem_contact.scenes.schema import (
+    CRACK_SHAPE_KEYS,
+    FIELDS,
+    CrackSpec,
+    SceneError,
+    check_table,
+)
+from xfem_contact.scenes.table_keys import law_options, shape_parameters
+
+
+def crack_spec(table, k: int, materials: dict) -> CrackSpec:
+    """Crack ``k`` from its table: the parameters of its shape, its law's options, its
+    body's material (default the first of ``materials``)."""
+    where = f"cracks[{k}]"
+    check_table(table, FIELDS["crack"], where)
+    shape = table["shape"]
+    params = shape_parameters(table, where, CRACK_SHAPE_KEYS)
+    if shape == "segment" and len(params["points"]) != 2:
+        message = f"a segment has 2 points, got {len(params['points'])} (use shape 'polyline')"
+        raise SceneError(f"{where}.points", message)
+    if shape in ("segment", "polyline"):
+        points = params["points"]
+        for i, (a, b) in enumerate(zip(points, points[1:], strict=False)):
+            if math.dist(a, b) <= 1e-12 * max(1.0, *map(abs, a + b)):
+                message = f"points {i} and {i + 1} coincide: each segment needs a length"
+                raise SceneError(f"{where}.points", message)
+    if shape == "arc" and not 0.0 < abs(params["angles_deg"][1] - params["angles_deg"][0]) < 360:
+        message = f"the sweep |end - start| must be in (0, 360) degrees, got {params['angles_deg']}"
+        raise SceneError(f"{where}.angles_deg", message)
+    law = table.get("law", "free")
+    options = law_options(table, where, law)
+    material = table.get("material", next(iter(materials)))
+    if material not in materials:
+        message = f"{material!r}: no such material; defined: {sorted(materials)}"
+        raise SceneError(f"{where}.material", message)
+    return CrackSpec(
+        shape=shape,
+        params=params,
+        material=material,
+        name=table.get("name", "crack"),
+        law=law,
+        tip_radius=table.get("tip_radius"),
+        rings=table.get("rings"),
+        **options,
+    )
