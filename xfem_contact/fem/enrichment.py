@@ -107,7 +107,7 @@ class EnrichedSpace:
         #: The field of the branch dofs (None without a crack)
         self.branch_field: int | None = None
         if cut.crack is not None:
-            elements.append(basix.ufl.element("Lagrange", cell, degree, shape=(4 * gdim,)))
+            elements.append(basix.ufl.element("Lagrange", cell, 1, shape=(4 * gdim,)))
             self.branch_field = len(elements) - 1
         elif tip_radius is not None:
             raise ValueError("tip_radius: the cut has no crack (CutMesh(..., tangent=psi))")

@@ -51,7 +51,8 @@ class TipIntegrals:
             crack (``CutMesh(..., tangent=psi)``), homogeneous material around the tips.
         rings: The rings of the q-functions, :class:`Ring` or ``(r_inf, r_sup)`` (m),
             the same for every tip; ``r_inf`` at least the tip cells' size.
-        quadrature_degree: Quadrature degree of the uncut cells (default: estimated).
+        quadrature_degree: Quadrature degree of the uncut cells (default: that of the
+            cut cells, ``cut.quadrature_degree``).
 
     Collective. Raises ValueError without a crack or for a ring the mesh cannot hold.
     """
@@ -66,6 +67,8 @@ class TipIntegrals:
         if crack is None:
             raise ValueError("TipIntegrals: the problem's cut has no crack (CutMesh tangent=psi)")
         self.problem = problem
+        if quadrature_degree is None:
+            quadrature_degree = problem.cut.quadrature_degree
         u = problem.space.split(problem.w)
         cut = problem.cut
         pieces = [Piece(u[0], cut.dx(-1)), Piece(u[1], cut.dx(1))]
