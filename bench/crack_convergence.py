@@ -308,12 +308,13 @@ def main() -> None:
     rank0 = MPI.COMM_WORLD.rank == 0
     say = print if rank0 and not args.no_progress else (lambda *a: None)
     rows = []
-    for part in args.parts:
+    for part in args.parts:  # results saved after each part
         rows += PARTS[part](say, args.quick)
+        if rank0:
+            RESULTS.mkdir(exist_ok=True)
+            (RESULTS / "crack_convergence.json").write_text(json.dumps(rows, indent=1, default=str))
+            (RESULTS / "crack_convergence.md").write_text(markdown(rows))
     if rank0:
-        RESULTS.mkdir(exist_ok=True)
-        (RESULTS / "crack_convergence.json").write_text(json.dumps(rows, indent=1, default=str))
-        (RESULTS / "crack_convergence.md").write_text(markdown(rows))
         print(markdown(rows))
 
 

@@ -178,3 +178,27 @@ def test_lip_term_carries_the_friction(frictional):
             integral = InteractionIntegral(pieces, material, tip, direction, [(0.4, 0.8)], lips)
             (ring,) = integral.evaluate()
             assert (abs(ring.K_I) < 5e-3 * abs(K_II)) == small
+
+
+@pytest.mark.mpi
+@pytest.mark.parallel
+@pytest.mark.parametrize(
+    "build", [griffith_case, frictional_crack_case], ids=["griffith", "friction"]
+)
+def test_cracks_equal_serial(build):
+    """K of every tip and the lips' fields are the same on all ranks as on one."""
+    from parallel import gathered_fields, max_relative_difference
+
+    runs = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        case = build(4, 2, tip_radius=0.5, comm=comm)
+        case.problem.solve()
+        results = TipIntegrals(case.problem, [(0.4, 0.8)]).evaluate()
+        K = np.array([[r.K_I, r.K_II] for (r,) in results])
+        fields = gathered_fields(case.problem) if build is frictional_crack_case else None
+        runs.append((K, fields))
+    (K_all, fields_all), (K_one, fields_one) = runs
+    assert np.abs(K_all - K_one).max() <= 1e-10 * np.abs(K_one).max()
+    if fields_one is not None:
+        differences = max_relative_difference(fields_all, fields_one)
+        assert all(v <= 1e-10 for v in differences.values()), differences

@@ -160,13 +160,15 @@ def frictional_crack_case(
     tip_radius: float | None = 0.3,
     width: float = 2.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
+    lbb: str = "none",
 ) -> CrackCase:
     """A closed crack of half length ``a = 1`` m inclined at ``beta`` to a remote
     compression of 1 Pa, Coulomb friction ``friction`` on its lips, in the square of half
     width ``width`` meshed with ``h = a / N``. The exact solution (sliding when
     ``|tau| > friction |sigma_n|``): the uniform stress plus Westergaard's mode II field of
     the crack loaded by the effective shear ``tau_eff = |tau| - friction |sigma_n|``;
-    imposed on the boundary. ``K_I = 0``, ``K_II = sign(tau) tau_eff sqrt(pi a)``."""
+    imposed on the boundary. ``K_I = 0``, ``K_II = sign(tau) tau_eff sqrt(pi a)``. ``lbb``:
+    the law's LBB treatment."""
     a, (d, normal) = 1.0, _frame()
     centre = OFFSET * a
     S11, S22, S12 = GriffithCrack.uniaxial(a, -1.0, beta).remote
@@ -192,7 +194,7 @@ def frictional_crack_case(
         degree=degree,
         tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
     )
-    law = make_law("coulomb", friction=friction, lbb="restriction")
+    law = make_law("coulomb", friction=friction, lbb=lbb)
     problem = Problem(cut, degree, MATERIAL, law, ghost_penalty=0.0, tip_radius=tip_radius)
     problem.loads.add_displacement(_on_boundary(width), exact)
     K = (0.0, T * math.sqrt(math.pi * a))

@@ -22,9 +22,10 @@ Materials = Material | Mapping[int, Material | Mapping[str, Material]]
 
 
 def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
-    """One law object per interface name of ``cut``. A crack's law given by name keeps
-    the LBB condition by restriction: the Barbosa-Hughes stabilisation squares the
-    traction of the tip's singular stress along the lips (``1/r``, not integrable)."""
+    """One law object per interface name of ``cut``. A crack's law given by name has no
+    LBB term (``lbb="none"``): the Barbosa-Hughes stabilisation squares the traction of
+    the tip's singular stress along the lips (``1/r``, not integrable), and the
+    restriction's vital vertices of the lips depend on the partition."""
     names = cut.interface_names
     if not isinstance(interfaces, Mapping):
         interfaces = {name: interfaces for name in names}
@@ -35,7 +36,7 @@ def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
         law = interfaces[name]
         if isinstance(law, str):
             crack_lbb = cut.crack is not None and "lbb" in LAW_OPTIONS.get(law, ())
-            law = make_law(law, lbb="restriction" if crack_lbb else None)
+            law = make_law(law, lbb="none" if crack_lbb else None)
         laws[name] = law
         if not isinstance(laws[name], InterfaceLaw):
             raise ValueError(f"Interface {name!r}: {law!r} is not an interface law")

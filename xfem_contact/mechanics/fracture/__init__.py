@@ -4,10 +4,11 @@ stress intensity factors of a crack tip.
 :mod:`~.williams` holds the tip's branch functions and the exact mode I / II fields,
 :mod:`~.westergaard` the Griffith crack in an infinite plate, :mod:`~.rings` the
 q-functions of the domain integrals, :mod:`~.interaction` the interaction integral
-(K_I, K_II) and the J-integral, and :mod:`~.tips` those of every tip of a cracked
-problem.
+(K_I, K_II) and the J-integral, :mod:`~.tips` those of every tip of a cracked
+problem, and :mod:`~.growth` quasi-static propagation.
 """
 
+from xfem_contact.mechanics.fracture.growth import CrackPath, GrowthStep, grow, kink_angle
 from xfem_contact.mechanics.fracture.interaction import (
     InteractionIntegral,
     Lip,
@@ -32,6 +33,8 @@ from xfem_contact.mechanics.fracture.williams import (
 )
 
 __all__ = [
+    "CrackPath",
+    "GrowthStep",
     "NUMPY",
     "UFL",
     "GriffithCrack",
@@ -47,6 +50,8 @@ __all__ = [
     "branch_gradients",
     "effective_modulus",
     "graded_facet_measure",
+    "grow",
+    "kink_angle",
     "kolosov",
     "lip_tractions",
     "scaled_rings",
