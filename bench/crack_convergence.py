@@ -11,6 +11,8 @@ Four studies (``--parts``, all by default), on the cases of ``xfem_contact.cases
   ring-to-ring spread, dofs, the time of assembly + solve and of the whole case;
 - ``friction``: the closed crack inclined at 45 degrees under compression, Coulomb
   friction 0.3 on its lips: K_II error, |K_I| / |K_II|, slip error in L2 along the lips;
+- ``edge``: a single-edge crack in a strip under tension against Tada's geometry factor;
+- ``growth``: an inclined crack growing under tension, its path on two meshes;
 - ``conditioning``: the condition number of the scaled reduced stiffness (power and
   inverse iterations) against h at fixed r_e, and against r_e / h at fixed h.
 
@@ -274,7 +276,56 @@ def conditioning(say, quick: bool) -> list[dict]:
     return rows
 
 
+def edge(say, quick: bool) -> list[dict]:
+    """A single-edge crack (a = 0.3013 m) in a strip 1 m wide and 4 m high pulled by 1 Pa
+    at its ends, against Tada's geometry factor F(a/W) (0.5 % accurate for a/W <= 0.6):
+    K_I = sigma sqrt(pi a) F."""
+    import dolfinx.mesh
+
+    from xfem_contact.fem.cutmesh import CutMesh
+    from xfem_contact.io.meshes import ghosted_partitioner
+    from xfem_contact.mechanics.fracture import CrackPath
+    from xfem_contact.mechanics.problem import Problem
+
+    H, a, y0, rows = 2.0, 0.3013, 0.0127, []
+    F = 1.12 - 0.231 * a + 10.55 * a**2 - 21.72 * a**3 + 30.39 * a**4
+    K = math.sqrt(math.pi * a) * F
+    for degree in (1, 2):
+        for nx in (20,) if quick else (20, 40):
+            start = time.perf_counter()
+            path = CrackPath([[-0.1, y0], [a, y0]], moving=(False, True))
+            mesh = dolfinx.mesh.create_rectangle(
+                MPI.COMM_WORLD, [[0, -H], [1, H]], [nx, 4 * nx], partitioner=ghosted_partitioner()
+            )
+            cut = CutMesh(mesh, path.phi, degree=degree, tangent=path.psi)
+            problem = Problem(cut, degree, MATERIAL, "free", ghost_penalty=0.0, tip_radius=0.1)
+            problem.loads.add_traction(lambda x: np.isclose(x[1], H), (0.0, 1.0))
+            problem.loads.add_traction(lambda x: np.isclose(x[1], -H), (0.0, -1.0))
+            for point, component in (((1.0, -H), 0), ((1.0, -H), 1), ((1.0, H), 0)):
+                problem.loads.add_point_displacement(point, 0.0, component)
+            problem.solve()
+            (ring,) = TipIntegrals(problem, [(0.06, 0.18)]).evaluate()[0]
+            row = dict(
+                case="edge",
+                degree=degree,
+                h=1 / nx,
+                dofs=problem.space.dof_counts().total,
+                K_I=ring.K_I,
+                tada=K,
+                relative=(ring.K_I - K) / K,
+                K_II=ring.K_II,
+                time=time.perf_counter() - start,
+            )
+            rows.append(row)
+            say(
+                f"edge crack P{degree} h = 1/{nx}: K_I {ring.K_I:.5f} against Tada's {K:.5f} "
+                f"({row['relative']:+.1e}), K_II {ring.K_II:.1e}, {row['dofs']} dofs, {row['time']:.1f} s"
+            )
+    return rows
+
+
 PARTS = {
+    "edge": edge,
     "williams": williams,
     "griffith": griffith,
     "friction": friction,
