@@ -319,7 +319,8 @@ def edge(say, quick: bool) -> list[dict]:
             rows.append(row)
             say(
                 f"edge crack P{degree} h = 1/{nx}: K_I {ring.K_I:.5f} against Tada's {K:.5f} "
-                f"({row['relative']:+.1e}), K_II {ring.K_II:.1e}, {row['dofs']} dofs, {row['time']:.1f} s"
+                f"({row['relative']:+.1e}), K_II {ring.K_II:.1e}, {row['dofs']} dofs, "
+                f"{row['time']:.1f} s"
             )
     return rows
 
