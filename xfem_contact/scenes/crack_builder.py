@@ -132,10 +132,11 @@ def _boundary_distance(mesh: dolfinx.mesh.Mesh, point: np.ndarray) -> float:
 def default_rings(problem) -> list[tuple[float, float]]:
     """The rings of K (m) for every tip: :data:`CRACK_RINGS` in units of the largest tip
     cell size ``h``, ``r_sup`` kept within 90 % of the distance from every tip to the
-    boundary and to the other tips. Collective.
+    boundary and to the other tips; a ring left narrower than ``h / 2`` is dropped.
+    Collective.
 
     Raises:
-        SceneError: a tip too close to the boundary or another tip for ``r_inf``.
+        SceneError: a tip too close to the boundary or another tip for any ring.
     """
     mesh, tips = problem.mesh, problem.cut.crack.tips
     h = max(tip_cell_size(mesh, tip) for tip in tips)
@@ -144,7 +145,8 @@ def default_rings(problem) -> list[tuple[float, float]]:
         gaps = np.linalg.norm(tips[:, None] - tips[None], axis=2)
         room = min(room, float(gaps[~np.eye(len(tips), dtype=bool)].min()))
     rings = [(a * h, min(b * h, 0.9 * room)) for a, b in CRACK_RINGS]
-    if any(r_sup <= r_inf for r_inf, r_sup in rings):
+    rings = [(r_inf, r_sup) for r_inf, r_sup in rings if r_sup - r_inf >= 0.5 * h]
+    if not rings:
         raise SceneError(
             "cracks[0].rings",
             f"a tip lies {room:.4g} m from the boundary or another tip, too close for the "

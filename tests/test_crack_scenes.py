@@ -1,0 +1,206 @@
+"""Scenes with a crack: the [[cracks]] table, its level sets, its errors and its outputs."""
+
+import json
+import math
+import pathlib
+
+import xfem_contact  # noqa: F401  (before dolfinx)
+
+# isort: split
+import numpy as np
+import pytest
+from mpi4py import MPI
+from test_scenes import to_toml
+
+from xfem_contact.geometry.crack_paths import arc, polyline
+from xfem_contact.scenes import cli
+from xfem_contact.scenes.builder import build
+from xfem_contact.scenes.scene import bundled_scenes, load_scene
+
+SIGMA = 1e6
+
+
+def edge_crack(cells=(12, 24), **crack) -> dict:
+    """A plate 1 x 2 m with an edge crack of length 0.41 m from the left side, pulled by
+    SIGMA on top and bottom; ``crack`` entries change the crack's table."""
+    table = {"shape": "segment", "points": [[-0.1, 1.013], [0.41, 1.013]], **crack}
+    if table["shape"] in ("arc", "expression"):
+        table.pop("points")
+    held = [([0.0, 0.0], 0), ([0.0, 0.0], 1), ([1.0, 0.0], 1)]
+    return {
+        "scene": {"name": "edge"},
+        "mesh": {"corners": [[0, 0], [1, 2]], "cells": list(cells), "cell": "triangle"},
+        "materials": {"steel": {"E": 210e9, "nu": 0.3}},
+        "cracks": [table],
+        "loads": [
+            {"part": "top", "type": "traction", "value": [0.0, SIGMA]},
+            {"part": "bottom", "type": "traction", "value": [0.0, -SIGMA]},
+        ]
+        + [
+            {"type": "point_displacement", "point": p, "component": c, "value": 0.0}
+            for p, c in held
+        ],
+    }
+
+
+def test_paths_are_signed_distances():
+    """phi: the distance to the (extended) curve, negative on its right; psi: along it
+    beyond the nearer end, 0 at the tips; an extended end carries the crack on."""
+    x = np.array([[0.5, 1.5, -0.5, 0.5], [0.2, -0.1, 0.3, -0.4]])
+    phi, psi = polyline([[0, 0], [1, 0]]).levelsets()
+    assert np.allclose(phi(x), [0.2, -0.1, 0.3, -0.4])
+    assert np.allclose(psi(x), [-0.5, 0.5, 0.5, -0.5])
+    phi, psi = polyline([[0, 0], [1, 0]]).levelsets((1.0, 0.0))  # runs on 1 m before 0
+    assert np.allclose(psi(x), [-0.5, 0.5, -0.5, -0.5])  # x = -0.5 is on the crack now
+    bent = polyline([[0, 0], [1, 0], [1, 1]])
+    y = np.array([[1.5, 0.9, 1.2], [-0.1, 0.5, 1.5]])  # the corner, the 2nd leg, beyond
+    phi, psi = bent.levelsets()
+    assert np.allclose(phi(y), [-math.hypot(0.5, 0.1), 0.1, -0.2])
+    assert np.allclose(psi(y), [-1.0, -0.5, 0.5]) and bent.length == 2.0
+    quarter = arc([0, 0], 1.0, [0.0, math.pi / 2])
+    phi, psi = quarter.levelsets()
+    z = np.array([[0.9, 0.0, -1.0], [0.0, 0.5, 0.0]])
+    assert np.allclose(phi(z), [0.1, 0.5, 0.0]) and np.allclose(psi(z), [0.0, 0.0, math.pi / 2])
+    assert np.allclose(quarter.tangents, [[0, -1], [-1, 0]], atol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "crack",
+    [
+        {"shape": "polyline", "points": [[-0.1, 1.013], [0.2, 1.013], [0.41, 1.05]]},
+        {"shape": "arc", "centre": [-0.1, 0.513], "radius": 0.5, "angles_deg": [90, 40]},
+        {"shape": "expression", "phi": "y - 1.013", "psi": "x - 0.41", "law": "frictionless"},
+    ],
+    ids=["polyline", "arc", "expression"],
+)
+def test_crack_shapes_load_and_cut(crack):
+    """Each shape loads, and its cut has one tip inside the plate."""
+    scene = load_scene(edge_crack(**crack))
+    assert scene.cracks[0].shape == crack["shape"] and scene.cracks[0].law == crack.get(
+        "law", "free"
+    )
+    problem, effects = build(scene)
+    assert effects["crack"]["tips"] == 1 and effects["interfaces"] == ["crack"]
+    (tip,) = problem.cut.crack.tips
+    assert 0.2 < tip[0] < 0.43 and 0.8 < tip[1] < 1.1
+
+
+BAD_CRACKS = {
+    "3-point segment": (
+        {"points": [[0, 1], [0.2, 1], [0.3, 1]]},
+        "cracks[0].points: a segment has 2 points, got 3 (use shape 'polyline')",
+    ),
+    "coincident points": (
+        {"shape": "polyline", "points": [[0, 1], [0, 1]]},
+        "cracks[0].points: points 0 and 1 coincide",
+    ),
+    "full turn": (
+        {"shape": "arc", "centre": [0.5, 1], "radius": 0.2, "angles_deg": [0, 360]},
+        "cracks[0].angles_deg: the sweep |end - start| must be in (0, 360) degrees",
+    ),
+    "unknown law": ({"law": "glue"}, "cracks[0].law: string 'glue' is not valid; choose one of"),
+    "coulomb": ({"law": "coulomb"}, "cracks[0].friction: required for law 'coulomb'"),
+    "option": ({"friction": 0.3}, "cracks[0].friction: is not an option of law 'free'"),
+    "unknown key": ({"tip": [0, 0]}, "cracks[0].tip: unknown key; valid: ['name', 'shape'"),
+    "ring": ({"rings": [[0.2, 0.1]]}, "cracks[0].rings[0]: r_inf must be < r_sup"),
+    "tip radius": ({"tip_radius": -1.0}, "cracks[0].tip_radius: must be > 0.0"),
+    "material": ({"material": "glass"}, "cracks[0].material: 'glass': no such material"),
+    "expression": (
+        {"shape": "expression", "phi": "y - 1"},
+        "cracks[0].psi: required for shape 'expression' (its parameters: phi, psi)",
+    ),
+}
+
+
+@pytest.mark.parametrize("change, start", BAD_CRACKS.values(), ids=BAD_CRACKS)
+def test_bad_cracks_are_one_line_naming_the_key(change, start):
+    data = edge_crack(**change)
+    with pytest.raises(ValueError) as error:
+        load_scene(data)
+    assert str(error.value).startswith(start) and "\n" not in str(error.value)
+
+
+def test_one_crack_and_no_interfaces_for_now():
+    data = edge_crack()
+    data["cracks"].append(dict(data["cracks"][0]))
+    with pytest.raises(NotImplementedError, match=r"^cracks\[1\]: one crack per scene"):
+        load_scene(data)
+    data = edge_crack()
+    data["interfaces"] = [{"shape": "circle", "centre": [0.5, 0.5], "radius": 0.1}]
+    with pytest.raises(NotImplementedError, match=r"^cracks: a crack together with"):
+        load_scene(data)
+
+
+BUILD_ERRORS = {
+    "outside": (
+        {"points": [[2.0, 1.013], [3.0, 1.013]]},
+        "cracks[0].points: no end of the crack lies inside the body",
+    ),
+    "through": (
+        {"points": [[-0.1, 1.013], [1.1, 1.013]]},
+        "cracks[0].points: no end of the crack lies inside the body",
+    ),
+    "arc outside": (
+        {"shape": "arc", "centre": [5, 5], "radius": 0.5, "angles_deg": [0, 90]},
+        "cracks[0].angles_deg: no end of the crack lies inside the body",
+    ),
+    "expression outside": (
+        {"shape": "expression", "phi": "y - 1.013", "psi": "x + 5"},
+        "cracks[0]: Crack tangential level set (tangent): The level set never crosses zero",
+    ),
+    "tip radius": ({"tip_radius": 0.01}, "cracks[0].tip_radius: tip_radius = 0.01 m is smaller"),
+    "rings": ({"rings": [[0.01, 0.2]]}, "cracks[0].rings: ring r_inf = 0.01 m does not cover"),
+}
+
+
+@pytest.mark.parametrize("change, start", BUILD_ERRORS.values(), ids=BUILD_ERRORS)
+def test_cracks_refused_when_built_name_the_key(tmp_path, capsys, change, start):
+    """Errors found on the mesh: exit 2 and one line naming the key (``run`` builds
+    the problem and the rings before solving)."""
+    data = edge_crack(**change)
+    path = tmp_path / "scene.toml"
+    path.write_text(to_toml(data))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(f"error: {path}: {start}"), err
+
+
+def test_bundled_crack_scenes_load():
+    for name in ("edge_crack_tension", "griffith_crack"):
+        scene = load_scene(bundled_scenes()[name])
+        assert scene.cracks and scene.cracks[0].law == "free" and scene.degree == 2
+
+
+@pytest.mark.mpi
+def test_edge_crack_run_writes_K_lips_and_opened_fields(tmp_path_factory):
+    """The outputs of a crack scene (1 or 2 ranks): K_I, K_II, J, G per tip and ring in
+    summary.json (K_I near the handbook's 2.45 MPa m^1/2 on this coarse mesh), the
+    lips opening to the tip, lips.png and the lips' grid with the opened displacement."""
+    out = MPI.COMM_WORLD.bcast(
+        str(tmp_path_factory.mktemp("crack")) if MPI.COMM_WORLD.rank == 0 else None, root=0
+    )
+    path = pathlib.Path(out) / "scene.toml"
+    if MPI.COMM_WORLD.rank == 0:
+        path.write_text(to_toml(edge_crack()))
+    MPI.COMM_WORLD.barrier()
+    assert cli.main(["run", str(path), "--out", out, "--quiet"]) == 0
+    MPI.COMM_WORLD.barrier()
+    summary = json.loads((pathlib.Path(out) / "summary.json").read_text())
+    crack = summary["cracks"]["crack"]
+    (tip,) = crack["tips"]
+    assert np.allclose(tip["position"], [0.41, 1.013]) and np.allclose(tip["direction"], [1, 0])
+    assert len(tip["rings"]) >= 1  # those of the default rings that fit
+    for ring in tip["rings"]:
+        assert set(ring) == {"r_inf", "r_sup", "K_I", "K_II", "J", "G"}
+        assert ring["K_I"] == pytest.approx(2.452e6, rel=0.05)
+        assert abs(ring["K_II"]) < 0.02 * ring["K_I"]
+        assert ring["J"] == pytest.approx(ring["G"], rel=0.05)
+    lips = crack["lips"]
+    assert {"x", "y", "s", "opening", "slip"} <= set(lips) and "lambda_n" not in lips
+    s, opening = np.array(lips["s"]), np.array(lips["opening"])
+    assert s.min() >= 0.1 - 1e-9 and s.max() <= 0.51 + 1e-9  # the part inside the plate
+    assert np.all(opening > 0) and opening[np.argmax(s)] < 0.2 * opening.max()
+    if MPI.COMM_WORLD.rank == 0:
+        names = {p.name for p in pathlib.Path(out).iterdir()}
+        assert {"lips.png", "result.png", "displacement.bp", "summary.json"} <= names
+        assert any(n.startswith("result") and n.endswith(".vtu") for n in names)
