@@ -57,6 +57,7 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/accuracy_vs_time.py --no-progress
 	$(PY) bench/moving_interface.py --no-progress
 	$(PY) bench/parameter_sweep.py --no-progress
+	$(PY) bench/crack_convergence.py --no-progress
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check xfem_contact tests demos bench
