@@ -94,7 +94,13 @@ def _cell(text) -> str:
 
 
 def scene_reference() -> str:
-    from xfem_contact.scenes.schema import FIELDS, LOAD_KEYS, SHAPE_KEYS, TOP_LEVEL
+    from xfem_contact.scenes.schema import (
+        CRACK_SHAPE_KEYS,
+        FIELDS,
+        LOAD_KEYS,
+        SHAPE_KEYS,
+        TOP_LEVEL,
+    )
 
     found = _defaults()
     keys = [key for fields in FIELDS.values() for key in fields]
@@ -113,6 +119,7 @@ def scene_reference() -> str:
     ]
     toml = {
         "interface": "[[interfaces]] (each entry)",
+        "crack": "[[cracks]] (one entry)",
         "material": "[materials.NAME] (each material)",
         "part": "[parts.NAME] (each boundary part)",
         "load": "[[loads]] (each entry)",
@@ -139,6 +146,15 @@ def scene_reference() -> str:
         "|---|---|---|",
     ]
     for shape, (required, optional) in SHAPE_KEYS.items():
+        lines.append(f"| `{shape}` | {', '.join(required)} | {', '.join(optional)} |")
+    lines += [
+        "",
+        "## Keys of each crack shape",
+        "",
+        "| shape | required | optional |",
+        "|---|---|---|",
+    ]
+    for shape, (required, optional) in CRACK_SHAPE_KEYS.items():
         lines.append(f"| `{shape}` | {', '.join(required)} | {', '.join(optional)} |")
     lines += [
         "",
