@@ -13,7 +13,12 @@ from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.io.meshes import ghosted_partitioner
-from xfem_contact.mechanics.fracture.growth import CrackPath, grow, kink_angle
+from xfem_contact.mechanics.fracture.growth import (
+    CrackPath,
+    grow,
+    kink_angle,
+    paris_increment,
+)
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.problem import Problem
 
@@ -73,3 +78,12 @@ def test_inclined_crack_turns_towards_mode_one():
     first, last = path.points[0], path.points[-1]
     assert np.linalg.norm((first - centre) + (last - centre)) < 1e-2
     assert len(path.points) == 6
+    with pytest.raises(ValueError, match="out of the body"):
+        grow(problem, path, 5.0, [(0.25, 0.5)])
+    assert len(path.points) == 6  # the path is left as it was
+
+
+def test_paris_increment():
+    assert paris_increment(10.0, 1e-12, 3.0, 1e5) == pytest.approx(1e-4)
+    with pytest.raises(ValueError, match="cycles"):
+        paris_increment(10.0, 1e-12, 3.0, -1.0)

@@ -8,7 +8,13 @@ q-functions of the domain integrals, :mod:`~.interaction` the interaction integr
 problem, and :mod:`~.growth` quasi-static propagation.
 """
 
-from xfem_contact.mechanics.fracture.growth import CrackPath, GrowthStep, grow, kink_angle
+from xfem_contact.mechanics.fracture.growth import (
+    CrackPath,
+    GrowthStep,
+    grow,
+    kink_angle,
+    paris_increment,
+)
 from xfem_contact.mechanics.fracture.interaction import (
     InteractionIntegral,
     Lip,
@@ -52,6 +58,7 @@ __all__ = [
     "graded_facet_measure",
     "grow",
     "kink_angle",
+    "paris_increment",
     "kolosov",
     "lip_tractions",
     "scaled_rings",

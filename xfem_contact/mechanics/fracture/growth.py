@@ -19,10 +19,12 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+from mpi4py import MPI
 
+from xfem_contact.mechanics.fracture.rings import cells_at
 from xfem_contact.mechanics.fracture.tips import TipIntegrals
 
-__all__ = ["CrackPath", "GrowthStep", "grow", "kink_angle"]
+__all__ = ["CrackPath", "GrowthStep", "grow", "kink_angle", "paris_increment"]
 
 
 def kink_angle(K_I: float, K_II: float) -> float:
@@ -32,6 +34,16 @@ def kink_angle(K_I: float, K_II: float) -> float:
     if K_II == 0.0:
         return 0.0
     return 2.0 * math.atan((K_I - math.sqrt(K_I**2 + 8.0 * K_II**2)) / (4.0 * K_II))
+
+
+def paris_increment(delta_K: float, C: float, m: float, cycles: float) -> float:
+    """Paris' law: the advance (m) in ``cycles`` load cycles of stress intensity range
+    ``delta_K`` (Pa m^1/2): ``da = C delta_K^m cycles`` (``C`` in m per cycle per
+    (Pa m^1/2)^m)."""
+    for name, value in (("delta_K", delta_K), ("C", C), ("m", m), ("cycles", cycles)):
+        if not (math.isfinite(value) and value >= 0):
+            raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    return C * delta_K**m * cycles
 
 
 @dataclasses.dataclass
@@ -134,7 +146,17 @@ def grow(problem, path: CrackPath, da: float, rings, solve: bool = True) -> Grow
         ring = results[k][0]
         per_end[end] = (position.copy(), (ring.K_I, ring.K_II))
     angles = [None if e is None else kink_angle(*e[1]) for e in per_end]
+    before = path.points.copy()
     path.advance([0.0 if a is None else a for a in angles], da)
+    mesh = problem.mesh
+    for end in (0, -1):
+        tip = path.points[end]
+        if path.moving[end] and mesh.comm.allreduce(len(cells_at(mesh, tip)), op=MPI.SUM) == 0:
+            path.points = before
+            raise ValueError(
+                f"da = {da:.6g} m takes the tip at {tuple(np.round(before[end], 6))} out of the "
+                "body: take a smaller da (or stop the growth there)"
+            )
     problem.update_interface(path.phi, tangent=path.psi)
     if solve:
         problem.solve()

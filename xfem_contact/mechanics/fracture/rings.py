@@ -57,7 +57,7 @@ def scaled_rings(factors: Iterable[tuple[float, float]], unit: float, shape: str
     return [Ring(a * unit, b * unit, shape) for a, b in factors]
 
 
-def _tip_cells(mesh: dolfinx.mesh.Mesh, point: np.ndarray) -> np.ndarray:
+def cells_at(mesh: dolfinx.mesh.Mesh, point: np.ndarray) -> np.ndarray:
     """Local cells (owned and ghost) whose closure holds ``point`` (2,)."""
     tdim = mesh.topology.dim
     tree = dolfinx.geometry.bb_tree(mesh, tdim)
@@ -72,7 +72,7 @@ def tip_cell_size(mesh: dolfinx.mesh.Mesh, tip) -> float:
     Raises:
         ValueError: if no cell of the mesh holds ``tip``.
     """
-    cells = _tip_cells(mesh, np.asarray(tip, dtype=np.float64))
+    cells = cells_at(mesh, np.asarray(tip, dtype=np.float64))
     local = float(mesh.h(mesh.topology.dim, cells.astype(np.int32)).max()) if len(cells) else 0.0
     h = mesh.comm.allreduce(local, op=MPI.MAX)
     if h == 0.0:
@@ -96,7 +96,7 @@ def interpolate_ring(q: dolfinx.fem.Function, frame: TipFrame, ring: Ring) -> No
     x1, x2 = local_coordinates(x, frame)
     q.x.array[:] = ring.q(np.hypot(x1, x2))
 
-    cells = _tip_cells(mesh, np.asarray(frame.origin, dtype=np.float64))
+    cells = cells_at(mesh, np.asarray(frame.origin, dtype=np.float64))
     if mesh.comm.allreduce(len(cells), op=MPI.SUM) == 0:
         raise ValueError(
             f"tip {tuple(np.asarray(frame.origin).tolist())} lies in no cell of the mesh"
