@@ -42,9 +42,10 @@ def crack_path(spec: CrackSpec) -> CrackPath | None:
 def _extent(mesh: dolfinx.mesh.Mesh) -> float:
     """The diagonal of the mesh's bounding box (m). Collective."""
     x = mesh.geometry.x[:, :2]
-    low = mesh.comm.allreduce(x.min(axis=0) if x.size else np.full(2, np.inf), op=MPI.MIN)
-    high = mesh.comm.allreduce(x.max(axis=0) if x.size else np.full(2, -np.inf), op=MPI.MAX)
-    return float(np.linalg.norm(high - low))
+    local = np.r_[-x.min(axis=0), x.max(axis=0)] if x.size else np.full(4, -np.inf)
+    bounds = np.empty(4)
+    mesh.comm.Allreduce(local, bounds, op=MPI.MAX)  # -xmin, -ymin, xmax, ymax
+    return float(np.linalg.norm(bounds[2:] + bounds[:2]))
 
 
 def inside(mesh: dolfinx.mesh.Mesh, points: np.ndarray) -> np.ndarray:
@@ -53,8 +54,10 @@ def inside(mesh: dolfinx.mesh.Mesh, points: np.ndarray) -> np.ndarray:
     x = np.c_[points, np.zeros(len(points))]
     candidates = dolfinx.geometry.compute_collisions_points(tree, x)
     cells = dolfinx.geometry.compute_colliding_cells(mesh, candidates, x)
-    local = np.array([len(cells.links(i)) > 0 for i in range(len(points))], dtype=np.int8)
-    return mesh.comm.allreduce(local, op=MPI.MAX).astype(bool)
+    local = np.array([len(cells.links(i)) > 0 for i in range(len(points))], dtype=np.int32)
+    found = np.empty_like(local)
+    mesh.comm.Allreduce(local, found, op=MPI.MAX)
+    return found.astype(bool)
 
 
 def crack_levelsets(spec: CrackSpec, mesh: dolfinx.mesh.Mesh, where: str) -> tuple:
