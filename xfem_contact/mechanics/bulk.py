@@ -93,13 +93,22 @@ class SmallStrain:
     def dx(self, side: int) -> ufl.Measure:
         """The measure of ``side``; with a crack, its uncut cells take the cut cells'
         degree (the branch functions' integrands are far from polynomials, and UFL's
-        estimate of their degree, 40 to 60, would cost 1000 points a cell)."""
+        estimate of their degree, 40 to 60, would cost 1000 points a cell; 112 on the
+        ghost penalty's facets, which take that degree too)."""
         if self.cut.crack is None:
             return self.cut.dx(side)
         return self.cut.dx(side, {"quadrature_degree": self.cut.quadrature_degree})
 
     def _ghost_penalty(self, trial, test) -> ufl.Form:
-        dS = ufl.Measure("dS", domain=self.cut.mesh, subdomain_data=ghost_penalty_facets(self.cut))
+        metadata = (
+            {} if self.cut.crack is None else {"quadrature_degree": self.cut.quadrature_degree}
+        )
+        dS = ufl.Measure(
+            "dS",
+            domain=self.cut.mesh,
+            subdomain_data=ghost_penalty_facets(self.cut),
+            metadata=metadata,
+        )
         h = ufl.avg(self.h)
         terms = []
         for i, s in enumerate(SIDES):

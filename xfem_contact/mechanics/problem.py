@@ -3,10 +3,9 @@
 :class:`Problem` owns the enriched space (a displacement per side, one multiplier
 field per law that needs one), the bulk model of each side, the loads and the
 Dirichlet data, and composes the interface laws (:mod:`xfem_contact.mechanics.laws`):
-the residual is the bulk's plus each law's terms minus the loads. Linear laws only:
-one KSP solve; any contact law: generalized Newton (SNES). Both solve on the active
-dofs of the restriction ``R`` (:mod:`xfem_contact.fem.restriction`). SI units (Pa, m).
-"""
+the residual is the bulk's plus each law's terms minus the loads. Linear laws: one KSP
+solve; contact laws: generalized Newton (SNES), on the active dofs of the restriction
+``R`` (:mod:`xfem_contact.fem.restriction`). SI units (Pa, m)."""
 
 from __future__ import annotations
 
@@ -49,17 +48,15 @@ class Problem:
             interfaces ``inside`` may be ``{interface name: Material}``.
         law: A law (object or name) for every interface, or ``{interface name: law}``
             (names of ``cut.interface_names``).
-        ghost_penalty: Weight of the ghost penalty (see :class:`SmallStrain`).
-        min_support_fraction: See :class:`EnrichedSpace`. Default: keep every dof
-            when the ghost penalty is on (it defines the field's extension over empty
-            supports), else drop dofs with no support on their side.
-        kinematics: ``"small"`` (linear elasticity, small sliding) or ``"large"``
-            (Saint Venant-Kirchhoff bulk, and contact laws in large sliding: the
-            slave/master hybrid element of :mod:`xfem_contact.mechanics.sliding`,
-            slave side ``slave``, paired at every Newton iterate or once per step as
-            ``pairing`` says).
+        ghost_penalty: Weight of the ghost penalty (see :class:`SmallStrain`); None:
+            the default's, 0 for a crack (it spoils the tip's field: energy error x3).
+        min_support_fraction: See :class:`EnrichedSpace`. Default: every dof with the
+            ghost penalty (it extends the field), else those with support on their side.
+        kinematics: ``"small"`` (linear elasticity, small sliding) or ``"large"`` (Saint
+            Venant-Kirchhoff bulk, contact laws in large sliding: the slave/master hybrid
+            element of :mod:`xfem_contact.mechanics.sliding`).
         slave, pairing: See :class:`~xfem_contact.mechanics.laws.sliding.SlidingFrictionless`
-            (``kinematics="large"`` only).
+            (``kinematics="large"`` only): the slave side, when pairs are searched.
         tip_radius: A crack's tip enrichment radius (m), see :class:`EnrichedSpace`.
 
     Collective.
@@ -72,7 +69,7 @@ class Problem:
         materials: Materials,
         law: InterfaceLaw | str | Mapping[str, InterfaceLaw | str] = DEFAULT.law,
         *,
-        ghost_penalty: float = DEFAULT.ghost_penalty,
+        ghost_penalty: float | None = None,
         min_support_fraction: float | None = DEFAULT.min_support_fraction,
         kinematics: str = DEFAULT.kinematics,
         slave: int = DEFAULT.slave,
@@ -89,6 +86,8 @@ class Problem:
         # the laws' parameters become Constants of these forms (copied if bound elsewhere)
         self.laws = {n: bound_copy(law, self.mesh) for n, law in self.laws.items()}
         side_materials = side_and_law_materials(cut, materials)
+        if ghost_penalty is None:
+            ghost_penalty = DEFAULT.ghost_penalty if cut.crack is None else 0.0
         if min_support_fraction is None:
             min_support_fraction = 0.0 if ghost_penalty > 0 else 1e-12
         gdim = self.mesh.geometry.dim
