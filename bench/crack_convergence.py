@@ -98,7 +98,21 @@ def williams(say, quick: bool) -> list[dict]:
                 for n in ns:
                     start = time.perf_counter()
                     case = williams_case(n, degree, tip_radius=radius, cell=cell)
-                    case.problem.solve()
+                    try:
+                        case.problem.solve()
+                    except RuntimeError as error:  # the factorisation of an ill-conditioned system
+                        rows.append(
+                            dict(
+                                case="williams",
+                                cell=cell,
+                                degree=degree,
+                                enrichment=enrichment,
+                                n=n,
+                                failed=str(error),
+                            )
+                        )
+                        say(f"Williams {cell} P{degree} {enrichment} n = {n}: {error}")
+                        break
                     errors.append(energy_error(case))
                     row = dict(
                         case="williams",
@@ -345,7 +359,10 @@ def markdown(rows: list[dict]) -> str:
         keys = [k for k in mine[0] if k not in ("case", "peer")]
         lines += [f"## {part}", "", "| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
         for r in mine:
-            cells = [f"{r[k]:.3g}" if isinstance(r[k], float) else str(r[k]) for k in keys]
+            cells = [
+                f"{r[k]:.3g}" if isinstance(r.get(k), float) else str(r.get(k, r.get("failed", "")))
+                for k in keys
+            ]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
     return "\n".join(lines)
