@@ -12,14 +12,17 @@ import dataclasses
 import math
 from collections.abc import Callable
 
+import dolfinx.fem
 import dolfinx.mesh
 import numpy as np
+import ufl
 from mpi4py import MPI
 
 from xfem_contact.fem.branch import NUMPY, branch_values
 from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.forms import form
 from xfem_contact.io.meshes import ghosted_partitioner
-from xfem_contact.mechanics.fracture import GriffithCrack, WilliamsField, kolosov, tip_frame
+from xfem_contact.mechanics.fracture import UFL, GriffithCrack, WilliamsField, kolosov, tip_frame
 from xfem_contact.mechanics.laws import make_law
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.problem import Problem
@@ -98,6 +101,30 @@ def williams_case(
     displacement = _williams_sides(field)
     problem.loads.add_displacement(_on_boundary(1.0), {-1: displacement(-1), 1: displacement(1)})
     return CrackCase(problem, [K], displacement, 1.0)
+
+
+def williams_energy_error(case: CrackCase) -> float:
+    """The relative energy-norm error of a solved :func:`williams_case` against its
+    exact field (both sides, the tip cells' Duffy rules included). Collective."""
+    problem = case.problem
+    cut, u = problem.cut, problem.space.split(problem.w)
+    frame = tip_frame(cut.crack.tips[0], cut.crack.directions[0])
+    K_I, K_II = case.K[0]
+    exact = WilliamsField(frame, K_I, K_II, MATERIAL.E, MATERIAL.nu)
+    G = exact.gradient(ufl.SpatialCoordinate(problem.mesh), UFL)
+    mu, nu = MATERIAL.E / (2 * (1 + MATERIAL.nu)), MATERIAL.nu
+    lmbda = 2 * mu * nu / (1 - 2 * nu)
+
+    def energy(g):
+        e = ufl.sym(g)
+        return ufl.inner(2 * mu * e + lmbda * ufl.tr(e) * ufl.Identity(2), e)
+
+    def total(expr) -> float:
+        local = dolfinx.fem.assemble_scalar(form(expr))
+        return problem.mesh.comm.allreduce(local, op=MPI.SUM)
+
+    error = sum(total(energy(ufl.grad(u[i]) - G) * cut.dx(s)) for i, s in enumerate((-1, 1)))
+    return math.sqrt(error / sum(total(energy(G) * cut.dx(s)) for s in (-1, 1)))
 
 
 def _williams_sides(field: WilliamsField) -> Callable[[int], Callable]:
