@@ -29,7 +29,6 @@ import time
 import xfem_contact  # noqa: F401  (before dolfinx)
 
 # isort: split
-import dolfinx.fem
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -55,10 +54,6 @@ PEER = {
     ("P2", 16): (1.2e-7, 195000, 3.5),
     ("P1", 16): (2.9e-5, 50000, None),
 }
-
-
-def total(expr) -> float:
-    return MPI.COMM_WORLD.allreduce(dolfinx.fem.assemble_scalar(form(expr)), op=MPI.SUM)
 
 
 def rates(errors: list[float]) -> list[float | None]:
