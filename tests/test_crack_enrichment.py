@@ -15,6 +15,7 @@ import xfem_contact  # noqa: F401  (before dolfinx)
 import math
 
 import dolfinx.fem
+import dolfinx.mesh
 import numpy as np
 import pytest
 import ufl
@@ -182,3 +183,13 @@ def test_cracks_equal_serial(build):
     if fields_one is not None:
         differences = max_relative_difference(fields_all, fields_one)
         assert all(v <= 1e-10 for v in differences.values()), differences
+
+
+def test_crack_without_tip_is_refused():
+    from xfem_contact.fem.cutmesh import CutMesh
+
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    with pytest.raises(ValueError, match="no tip in the body"):
+        CutMesh(mesh, lambda x: x[1] - 0.51, degree=1, tangent=lambda x: -1.0 - x[0])
+    with pytest.raises(ValueError, match="tip_radius must be a positive length"):
+        williams_case(8, 1, tip_radius=-1.0)

@@ -180,6 +180,12 @@ class CutMesh:
         try:
             psi = interpolate(self.mesh, tangent, self.degree, into=previous)
         except ValueError as error:
+            if "never crosses zero" in str(error):
+                raise ValueError(
+                    "The crack's tangential level set psi never changes sign on the mesh: "
+                    "the crack has no tip in the body (psi < 0 everywhere: it cuts the body "
+                    "in two, give it as an interface) or no part in it (psi >= 0)"
+                ) from None
             raise ValueError(f"Crack tangential level set (tangent): {error}") from None
         keys = {"minus": _SIDE_MINUS, "plus": _SIDE_PLUS, "interface": _INTERFACE}
         named = {key: rules[sid] for key, sid in keys.items()}
