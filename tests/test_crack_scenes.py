@@ -146,7 +146,7 @@ BUILD_ERRORS = {
     ),
     "expression outside": (
         {"shape": "expression", "phi": "y - 1.013", "psi": "x + 5"},
-        "cracks[0]: Crack tangential level set (tangent): The level set never crosses zero",
+        "cracks[0]: The crack's tangential level set psi never changes sign on the mesh",
     ),
     "tip radius": ({"tip_radius": 0.01}, "cracks[0].tip_radius: tip_radius = 0.01 m is smaller"),
     "rings": ({"rings": [[0.01, 0.2]]}, "cracks[0].rings: ring r_inf = 0.01 m does not cover"),

@@ -21,6 +21,14 @@ from xfem_contact.mechanics.materials import Material, MaterialField, Moduli
 Materials = Material | Mapping[int, Material | Mapping[str, Material]]
 
 
+def crack_law(name: str, **options) -> InterfaceLaw:
+    """:func:`~xfem_contact.mechanics.laws.make_law` with a crack's default LBB treatment,
+    ``lbb="none"`` (see :func:`interface_laws`), for a law that takes one."""
+    if options.get("lbb") is None and "lbb" in LAW_OPTIONS.get(name, ()):
+        options["lbb"] = "none"
+    return make_law(name, **options)
+
+
 def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
     """One law object per interface name of ``cut``. A crack's law given by name has no
     LBB term (``lbb="none"``): the Barbosa-Hughes stabilisation squares the traction of
@@ -35,8 +43,7 @@ def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
     for name in names:
         law = interfaces[name]
         if isinstance(law, str):
-            crack_lbb = cut.crack is not None and "lbb" in LAW_OPTIONS.get(law, ())
-            law = make_law(law, lbb="none" if crack_lbb else None)
+            law = make_law(law) if cut.crack is None else crack_law(law)
         laws[name] = law
         if not isinstance(laws[name], InterfaceLaw):
             raise ValueError(f"Interface {name!r}: {law!r} is not an interface law")

@@ -19,8 +19,8 @@ from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.geometry.crack_paths import CrackPath, arc, polyline
+from xfem_contact.mechanics.composition import crack_law
 from xfem_contact.mechanics.fracture import tip_cell_size
-from xfem_contact.mechanics.laws import make_law
 from xfem_contact.scenes.expressions import numpy_field
 from xfem_contact.scenes.schema import CRACK_RINGS, CrackSpec, Scene, SceneError
 
@@ -101,7 +101,7 @@ def crack_cut(scene: Scene, mesh: dolfinx.mesh.Mesh) -> tuple:
         )
     except ValueError as error:
         raise SceneError(where, " ".join(str(error).split())) from None
-    law = make_law(spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb)
+    law = crack_law(spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb)
     # no ghost penalty: its derivatives of the branch functions make the forms very costly
     options = {"tip_radius": spec.tip_radius, "ghost_penalty": 0.0}
     return cut, {spec.name: law}, scene.materials[spec.material], options
