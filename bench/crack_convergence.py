@@ -315,12 +315,85 @@ def edge(say, quick: bool) -> list[dict]:
     return rows
 
 
+def growth(say, quick: bool) -> list[dict]:
+    """An inclined crack (half length 0.5 m, 0.5 rad) in a plate of half width 2 m under
+    a tension of 1 Pa (tractions top and bottom): three steps of 0.25 m on two meshes;
+    the paths' largest distance apart, and a PNG and JSON of both."""
+    import dolfinx.mesh
+
+    from xfem_contact.fem.cutmesh import CutMesh
+    from xfem_contact.io.meshes import ghosted_partitioner
+    from xfem_contact.mechanics.fracture import CrackPath, grow
+    from xfem_contact.mechanics.problem import Problem
+
+    W, a, angle, da, steps = 2.0, 0.5, 0.5, 0.25, 3
+    centre = np.array([0.0123, 0.0271])
+    d = np.array([math.cos(angle), math.sin(angle)])
+    paths, rows = {}, []
+    for n in (32, 48):
+        start = time.perf_counter()
+        path = CrackPath([centre - a * d, centre + a * d])
+        mesh = dolfinx.mesh.create_rectangle(
+            MPI.COMM_WORLD, [[-W, -W], [W, W]], [n, n], partitioner=ghosted_partitioner()
+        )
+        cut = CutMesh(mesh, path.phi, degree=2, tangent=path.psi)
+        problem = Problem(cut, 2, MATERIAL, "free", tip_radius=0.3)
+        problem.loads.add_traction(lambda x: np.isclose(x[1], W), (0.0, 1.0))
+        problem.loads.add_traction(lambda x: np.isclose(x[1], -W), (0.0, -1.0))
+        for component in (0, 1):
+            problem.loads.add_point_displacement((-W, -W), 0.0, component)
+        problem.loads.add_point_displacement((W, -W), 0.0, 1)
+        problem.solve()
+        for step in range(steps):
+            record = grow(problem, path, da, [(0.2, 0.45)])
+            ratio = max(abs(K[1] / K[0]) for K in record.K)
+            angles = [math.degrees(x) for x in record.angles]
+            rows.append(
+                dict(
+                    case="growth",
+                    n=n,
+                    step=step,
+                    K_II_over_K_I=ratio,
+                    kink_deg=angles,
+                    time=time.perf_counter() - start,
+                )
+            )
+            say(
+                f"growth h = {2 * W / n:.3f} m, step {step}: max |K_II/K_I| {ratio:.3f}, "
+                f"kink angles {', '.join(f'{x:.2f}' for x in angles)} deg"
+            )
+        paths[n] = path.points
+    gap = float(np.abs(paths[32] - paths[48]).max())
+    rows.append(dict(case="growth", n="32 vs 48", path_difference=gap, relative_to_da=gap / da))
+    say(f"growth: the paths on h = 1/8 and 1/12 m are {gap:.1e} m apart ({gap / da:.1e} da)")
+    if MPI.COMM_WORLD.rank == 0:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(5, 3))
+        for n, points in paths.items():
+            ax.plot(points[:, 0], points[:, 1], "o-", label=f"h = {2 * W / n:.3f} m")
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("y (m)")
+        ax.legend()
+        fig.tight_layout()
+        RESULTS.mkdir(exist_ok=True)
+        fig.savefig(RESULTS / "crack_growth_path.png", dpi=120)
+        paths_json = {str(n): p.tolist() for n, p in paths.items()}
+        (RESULTS / "crack_growth_path.json").write_text(json.dumps(paths_json, indent=1))
+    return rows
+
+
 PARTS = {
     "edge": edge,
     "williams": williams,
     "griffith": griffith,
     "friction": friction,
     "conditioning": conditioning,
+    "growth": growth,
 }
 
 
