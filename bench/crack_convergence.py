@@ -281,7 +281,7 @@ def edge(say, quick: bool) -> list[dict]:
     F = 1.12 - 0.231 * a + 10.55 * a**2 - 21.72 * a**3 + 30.39 * a**4
     K = math.sqrt(math.pi * a) * F
     for degree in (1, 2):
-        for nx in (20,) if quick else (20, 40):
+        for nx in (40,) if quick else (40, 60):
             start = time.perf_counter()
             path = CrackPath([[-0.1, y0], [a, y0]], moving=(False, True))
             mesh = dolfinx.mesh.create_rectangle(
