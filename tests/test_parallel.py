@@ -27,6 +27,10 @@ CASES = {
     "case2 P2, bonded (one linear solve)": lambda comm: inclusion_problem(
         10, 2, "bonded", comm=comm
     ),
+    # vital vertices chosen by position (by global vertex number they depend on the ranks)
+    "case2 P2 triangles, Coulomb, LBB restriction": lambda comm: inclusion_problem(
+        10, 2, "coulomb", "triangle", loading="pull", friction=0.3, lbb="restriction", comm=comm
+    ),
     "case3 annulus P2, curved cells": lambda comm: annulus_problem(6, 24, 2, comm=comm),
     "case3 annulus P1": lambda comm: annulus_problem(6, 24, 1, comm=comm),
     # large sliding: masters on the other rank, the inner ring turned by 0.3 rad

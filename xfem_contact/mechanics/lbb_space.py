@@ -3,6 +3,7 @@ multiplier field of an enriched space, in parallel: the prolongation ``R`` uses.
 
 from __future__ import annotations
 
+import dolfinx.mesh
 import numpy as np
 from mpi4py import MPI
 
@@ -54,7 +55,16 @@ def vital_vertex_prolongation(
     global_ends = vmap.local_to_global(ends.ravel()).reshape(-1, 2)
     all_ends = np.concatenate(comm.allgather(global_ends))
     all_sides = np.concatenate(comm.allgather(vertex_side[ends]))
-    vital = lbb_module.vital_vertices(all_ends, all_sides)
+    # The greedy choice breaks ties by vertex label: label the vertices by position (the
+    # global numbers depend on the partition: 2 ranks chose other vital vertices than 1)
+    nodes = dolfinx.mesh.entities_to_geometry(mesh, 0, ends.ravel().astype(np.int32))
+    all_x = np.concatenate(comm.allgather(mesh.geometry.x[nodes.ravel(), :2])).reshape(-1, 2)
+    ids, first = np.unique(all_ends.ravel(), return_index=True)
+    order = np.lexsort((np.round(all_x[first, 1], 12), np.round(all_x[first, 0], 12)))
+    label = np.empty_like(order)
+    label[order] = np.arange(order.size)
+    by_position = label[np.searchsorted(ids, all_ends)]
+    vital = ids[order][lbb_module.vital_vertices(by_position, all_sides)]
     rows, cols, vals, reduced = lbb_module.prolongation(all_ends, vital)
     # Vertices of cut cells on no cut edge (e.g. the far corner of a quadrilateral
     # cut near one vertex) take the mean of the prolongated rows of the cut-edge
