@@ -38,6 +38,7 @@ from xfem_contact.cases.cracks import (
     frictional_crack_case,
     frictional_slip,
     griffith_case,
+    plate_in_tension,
     williams_case,
     williams_energy_error,
 )
@@ -319,12 +320,7 @@ def growth(say, quick: bool) -> list[dict]:
     """An inclined crack (half length 0.5 m, 0.5 rad) in a plate of half width 2 m under
     a tension of 1 Pa (tractions top and bottom): three steps of 0.25 m on two meshes;
     the paths' largest distance apart, and a PNG and JSON of both."""
-    import dolfinx.mesh
-
-    from xfem_contact.fem.cutmesh import CutMesh
-    from xfem_contact.io.meshes import ghosted_partitioner
     from xfem_contact.mechanics.fracture import CrackPath, grow
-    from xfem_contact.mechanics.problem import Problem
 
     W, a, angle, da, steps = 2.0, 0.5, 0.5, 0.25, 3
     centre = np.array([0.0123, 0.0271])
@@ -333,16 +329,7 @@ def growth(say, quick: bool) -> list[dict]:
     for n in (32, 48):
         start = time.perf_counter()
         path = CrackPath([centre - a * d, centre + a * d])
-        mesh = dolfinx.mesh.create_rectangle(
-            MPI.COMM_WORLD, [[-W, -W], [W, W]], [n, n], partitioner=ghosted_partitioner()
-        )
-        cut = CutMesh(mesh, path.phi, degree=2, tangent=path.psi)
-        problem = Problem(cut, 2, MATERIAL, "free", tip_radius=0.3)
-        problem.loads.add_traction(lambda x: np.isclose(x[1], W), (0.0, 1.0))
-        problem.loads.add_traction(lambda x: np.isclose(x[1], -W), (0.0, -1.0))
-        for component in (0, 1):
-            problem.loads.add_point_displacement((-W, -W), 0.0, component)
-        problem.loads.add_point_displacement((W, -W), 0.0, 1)
+        problem = plate_in_tension(path, n, tip_radius=0.3, width=W)
         problem.solve()
         for step in range(steps):
             record = grow(problem, path, da, [(0.2, 0.45)])

@@ -6,21 +6,16 @@ import xfem_contact  # noqa: F401  (before dolfinx)
 # isort: split
 import math
 
-import dolfinx.mesh
 import numpy as np
 import pytest
-from mpi4py import MPI
 
-from xfem_contact.fem.cutmesh import CutMesh
-from xfem_contact.io.meshes import ghosted_partitioner
+from xfem_contact.cases.cracks import plate_in_tension
 from xfem_contact.mechanics.fracture.growth import (
     CrackPath,
     grow,
     kink_angle,
     paris_increment,
 )
-from xfem_contact.mechanics.materials import Material
-from xfem_contact.mechanics.problem import Problem
 
 
 def test_kink_angle():
@@ -53,18 +48,7 @@ def test_inclined_crack_turns_towards_mode_one():
     centre = np.array([0.0123, 0.0271])
     d = np.array([math.cos(angle), math.sin(angle)])
     path = CrackPath([centre - a * d, centre + a * d])
-    mesh = dolfinx.mesh.create_rectangle(
-        MPI.COMM_WORLD, [[-W, -W], [W, W]], [24, 24], partitioner=ghosted_partitioner()
-    )
-    cut = CutMesh(mesh, path.phi, degree=2, tangent=path.psi)
-    problem = Problem(
-        cut, 2, Material(1.0, 0.3, "strain"), "free", ghost_penalty=0.0, tip_radius=0.35
-    )
-    problem.loads.add_traction(lambda x: np.isclose(x[1], W), (0.0, 1.0))
-    problem.loads.add_traction(lambda x: np.isclose(x[1], -W), (0.0, -1.0))
-    for component in (0, 1):
-        problem.loads.add_point_displacement((-W, -W), 0.0, component)
-    problem.loads.add_point_displacement((W, -W), 0.0, 1)
+    problem = plate_in_tension(path, 24, tip_radius=0.35, width=W)
     problem.solve()
     ratios = []
     for _ in range(2):

@@ -236,3 +236,24 @@ def frictional_slip(s: np.ndarray, friction: float = 0.3, beta: float = 0.25 * m
     T = math.copysign(max(abs(S12) - friction * abs(S22), 0.0), S12)
     E, nu = MATERIAL.E, MATERIAL.nu
     return 4 * (1 - nu**2) * T / E * np.sqrt(np.clip(1.0 - s**2, 0.0, None)), S22
+
+
+def plate_in_tension(
+    path,
+    n: int,
+    tip_radius: float,
+    width: float = 2.0,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+) -> Problem:
+    """A square plate of half width ``width`` (m, ``n`` P2 triangles a side) with the crack
+    ``path`` (a :class:`~xfem_contact.mechanics.fracture.CrackPath`, traction-free lips),
+    pulled by 1 Pa on its top and bottom sides, the rigid modes held at two corners (they
+    carry no load). Not solved. For growth: ``grow(problem, path, da, rings)``."""
+    cut = CutMesh(_square(width, n, "triangle", comm), path.phi, degree=2, tangent=path.psi)
+    problem = Problem(cut, 2, MATERIAL, "free", tip_radius=tip_radius)
+    problem.loads.add_traction(lambda x: np.isclose(x[1], width), (0.0, 1.0))
+    problem.loads.add_traction(lambda x: np.isclose(x[1], -width), (0.0, -1.0))
+    for component in (0, 1):
+        problem.loads.add_point_displacement((-width, -width), 0.0, component)
+    problem.loads.add_point_displacement((width, -width), 0.0, 1)
+    return problem
