@@ -216,3 +216,13 @@ def check_table(value, fields: dict[str, Field], key: str) -> dict:
         elif field.required:
             raise SceneError(join(key, name), f"required: {field.doc}")
     return value
+
+
+def material_name(table, key: str, where: str, materials) -> str:
+    """The material a scene table names at ``key`` (default: the first of ``materials``),
+    checked to be one of ``materials``."""
+    name = table.get(key, next(iter(materials)))
+    if name not in materials:
+        message = f"{name!r}: no such material; defined: {sorted(materials)}"
+        raise SceneError(f"{where}.{key}", message)
+    return name

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+from xfem_contact.scenes.checks import material_name
 from xfem_contact.scenes.schema import (
     CRACK_SHAPE_KEYS,
     FIELDS,
@@ -37,10 +38,7 @@ def crack_spec(table, k: int, materials: dict) -> CrackSpec:
         raise SceneError(f"{where}.angles_deg", message)
     law = table.get("law", "free")
     options = law_options(table, where, law)
-    material = table.get("material", next(iter(materials)))
-    if material not in materials:
-        message = f"{material!r}: no such material; defined: {sorted(materials)}"
-        raise SceneError(f"{where}.material", message)
+    material = material_name(table, "material", where, materials)
     return CrackSpec(
         shape=shape,
         params=params,

@@ -42,6 +42,7 @@ import tomllib
 from xfem_contact.mechanics.laws import LINEAR_LAWS, SLIDING_LAWS
 from xfem_contact.mechanics.laws.sliding import SLIDING_LBB
 from xfem_contact.mechanics.materials import Material
+from xfem_contact.scenes.checks import material_name
 from xfem_contact.scenes.crack_tables import crack_spec
 from xfem_contact.scenes.load_tables import load_spec
 from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
@@ -253,19 +254,14 @@ def _interface(table, k: int, materials: dict) -> InterfaceSpec:
         if law in SLIDING_LAWS and table.get("lbb", "stabilized") not in SLIDING_LBB:
             message = f"{table['lbb']!r} is not available in large sliding; valid: {SLIDING_LBB}"
             raise SceneError(f"{where}.lbb", message)
-    first = next(iter(materials))
-    for side_key in ("inside", "outside"):
-        name = table.get(side_key, first)
-        if name not in materials:
-            message = f"{name!r}: no such material; defined: {sorted(materials)}"
-            raise SceneError(f"{where}.{side_key}", message)
+    inside, outside = (material_name(table, key, where, materials) for key in ("inside", "outside"))
     return InterfaceSpec(
         shape=shape,
         law=law,
         params=params,
         name=table.get("name", f"interface{k}"),
-        inside=table.get("inside", first),
-        outside=table.get("outside", first),
+        inside=inside,
+        outside=outside,
         **options,
         kinematics=kinematics,
         slave=slave,
