@@ -41,6 +41,8 @@ class Crack:
             psi|`` there, ``(ntips, gdim)``; the same on every process.
         upper_sides: Per tip, the side (+1: ``phi >= 0``, or -1) on the left of its
             direction: the upper lip (``theta = pi``) of the tip's frame, ``(ntips,)``.
+        tip_names: Per tip, the name of its crack (one of the cut's ``interface_names``;
+            set by the cut, empty until then).
     """
 
     tangent: LevelSet
@@ -48,6 +50,7 @@ class Crack:
     tips: npt.NDArray[np.float64]
     directions: npt.NDArray[np.float64]
     upper_sides: npt.NDArray[np.int64]
+    tip_names: tuple[str, ...] = ()
 
     def cells(self, kind: int, cut_cells: npt.NDArray[np.int32]) -> npt.NDArray[np.int32]:
         """Local indices of the owned cut cells of ``kind``."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import itertools
 import time
@@ -18,6 +19,7 @@ from xfem_contact.fem import cut_boundary
 from xfem_contact.fem.crack_cut import Crack, crack_rules
 from xfem_contact.fem.interface_cells import cell_interfaces, trace_nullity, without_slivers
 from xfem_contact.geometry import cut
+from xfem_contact.geometry.crack_union import CrackUnion, crack_union, interpolate_tangent
 from xfem_contact.geometry.levelset import (
     CellMaps,
     LevelSet,
@@ -59,6 +61,9 @@ class CutMesh:
         tangent: For a crack: its tangential level set ``psi`` (a callable or a Function,
             as ``levelset``); the crack is the zero line of ``levelset`` where
             ``psi < 0`` (see :mod:`xfem_contact.fem.crack_cut`), :attr:`crack` its data.
+            Several disjoint cracks: ``levelset`` and ``tangent`` mappings ``{name: ...}``
+            with the same names, cut as one pair (:mod:`xfem_contact.geometry.crack_union`,
+            :attr:`cracks`), each crack's lips with their own measure.
         tip_points: Gauss points per direction of a crack tip cell's Duffy rules.
 
     Example:
@@ -115,7 +120,14 @@ class CutMesh:
         cell_name = mesh.topology.cell_name()
         start = time.perf_counter()
         known = getattr(self, "interface_names", None)
-        names, components, levelset = named_interfaces(mesh, levelset, self.degree, known)
+        #: The cracks (names, union level sets, zones) of a cut by cracks, else None
+        self.cracks: CrackUnion | None = None
+        if tangent is not None and isinstance(levelset, Mapping):
+            self.cracks = crack_union(mesh, levelset, tangent, self.degree, known)
+            names, components = self.cracks.names, None
+            levelset, tangent = self.cracks.phi, self.cracks.psi
+        else:
+            names, components, levelset = named_interfaces(mesh, levelset, self.degree, known)
         #: Names of the interfaces, in the order of their measure ids
         self.interface_names: tuple[str, ...] = names
         self._components = components
@@ -159,6 +171,8 @@ class CutMesh:
         self.rules = rules
         #: Interface (index into ``interface_names``) of every cut cell, shape ``(ncut,)``
         self.cell_interface = cell_interfaces(maps, cut_cells, rules[_INTERFACE], components)
+        if self.cracks is not None and len(names) > 1:
+            self.cell_interface = self.cracks.cell_crack[cut_cells]
         self._interface_rules = {}
         if getattr(self, "_marker_space", None) is None:  # one for all the rules, all cuts
             self._marker_space = marker_space(mesh)
@@ -177,21 +191,15 @@ class CutMesh:
         """The rules of the crack ``phi = 0, psi < 0`` from those of the cut by ``phi``;
         sets :attr:`crack`. Collective."""
         previous = None if self.crack is None else self.crack.tangent.function
-        try:
-            psi = interpolate(self.mesh, tangent, self.degree, into=previous)
-        except ValueError as error:
-            if "never crosses zero" in str(error):
-                raise ValueError(
-                    "The crack's tangential level set psi never changes sign on the mesh: "
-                    "the crack has no tip in the body (psi < 0 everywhere: it cuts the body "
-                    "in two, give it as an interface) or no part in it (psi >= 0)"
-                ) from None
-            raise ValueError(f"Crack tangential level set (tangent): {error}") from None
+        psi = interpolate_tangent(self.mesh, tangent, self.degree, into=previous)
         keys = {"minus": _SIDE_MINUS, "plus": _SIDE_PLUS, "interface": _INTERFACE}
         named = {key: rules[sid] for key, sid in keys.items()}
-        named, self.crack = crack_rules(
-            self.cut_cells, named, maps, psi, self.degree, self.tip_points
-        )
+        named, crack = crack_rules(self.cut_cells, named, maps, psi, self.degree, self.tip_points)
+        names = self.interface_names
+        at = np.zeros(len(crack.tips), dtype=int)
+        if self.cracks is not None and len(names) > 1:  # the crack of each tip
+            at = self.cracks.nearest(crack.tips)
+        self.crack = dataclasses.replace(crack, tip_names=tuple(names[k] for k in at))
         return {sid: named[key] for key, sid in keys.items()}
 
     def side_indicator(self) -> dolfinx.fem.Function:

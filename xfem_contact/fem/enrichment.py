@@ -115,6 +115,8 @@ class EnrichedSpace:
             raise ValueError("tip_radius: the cut has no crack (CutMesh(..., tangent=psi))")
         if tip_radius is not None and not (np.isfinite(tip_radius) and tip_radius > 0):
             raise ValueError(f"tip_radius must be a positive length (m), got {tip_radius!r}")
+        if cut.cracks is not None:  # several cracks: each tip zone within its crack's
+            cut.cracks.check_tip_radius(tip_radius)
         self.tip_radius = tip_radius
         self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
         self.min_support_fraction = min_support_fraction

@@ -20,14 +20,14 @@ from xfem_contact.mechanics.fracture.rings import Ring
 __all__ = ["TipIntegrals", "lip_tractions"]
 
 
-def lip_tractions(problem, upper: int = 1) -> list[Lip]:
+def lip_tractions(problem, upper: int = 1, name: str | None = None) -> list[Lip]:
     """The tractions ``sigma n`` on the two lips of the crack of ``problem`` (UFL), from
     its law's multipliers: none for a law without (``free``). The law's term
     ``int lambda . [v]`` makes the multiplier vector ``lambda`` the traction on side
     -1's lip (``sigma_- n``, ``n`` from side -1 to +1); side +1's lip carries
     ``-lambda``. ``upper``: the side (+1 or -1) that is the upper lip (``theta = pi``)
-    in the frame of the tip at hand."""
-    name = problem.cut.interface_names[0]
+    in the frame of the tip at hand; ``name``: the tip's crack (default the first)."""
+    name = problem.cut.interface_names[0] if name is None else name
     law, ctx = problem.laws[name], problem.contexts[name]
     if ctx.field is None:
         return []
@@ -73,6 +73,15 @@ class TipIntegrals:
         cut = problem.cut
         pieces = [Piece(u[0], cut.dx(-1)), Piece(u[1], cut.dx(1))]
         material = problem.bulk.materials[1]
+        cracks = cut.cracks
+        if cracks is not None and cracks.pair is not None:  # several: no ring holds two
+            wide = max((r.r_sup if isinstance(r, Ring) else r[1] for r in rings), default=0.0)
+            if wide >= cracks.gap:
+                raise ValueError(
+                    f"rings: r_sup = {wide:.4g} m reaches another crack (cracks "
+                    f"{cracks.pair[0]!r} and {cracks.pair[1]!r} lie {cracks.gap:.4g} m apart)"
+                )
+        names = crack.tip_names or (cut.interface_names[0],) * len(crack.tips)
         #: One interaction integral per tip, in the order of ``cut.crack.tips``
         self.integrals = [
             InteractionIntegral(
@@ -81,11 +90,11 @@ class TipIntegrals:
                 tip,
                 direction,
                 rings,
-                lip_tractions(problem, upper),
+                lip_tractions(problem, upper, name),
                 quadrature_degree=quadrature_degree,
             )
-            for tip, direction, upper in zip(
-                crack.tips, crack.directions, crack.upper_sides, strict=True
+            for tip, direction, upper, name in zip(
+                crack.tips, crack.directions, crack.upper_sides, names, strict=True
             )
         ]
 
