@@ -6,6 +6,10 @@ so the circle passes a hair's breadth from mesh nodes), each case a process of i
 own solved with ``LINEAR_PRESETS["direct"]`` (MUMPS LU) and ``["iterative"]`` (GMRES +
 band multigrid, :mod:`xfem_contact.solvers.band_multigrid`): Newton steps, Krylov iterations per
 step, wall time of the solve, peak resident memory and the contact-pressure error.
+The baseline, measured in the same run: plain DOLFINx P2 elasticity on the same mesh
+solved by CG + GAMG (``bench/plain_elasticity.py --factor gamg``, no cut); the table
+gives the iterative preset's peak memory over the baseline's and its time over MUMPS's.
+A size that fails (memory) is reported as such.
 Writes ``bench/results/iterative.{json,md}``.
 
 Run: ``python bench/iterative.py [--sizes 40 80 160 320 640] [--tiny]`` (``make bench``).
@@ -49,17 +53,28 @@ def case(n: int, solver: str, tiny: bool) -> dict:
 
 
 def run(n: int, solver: str, tiny: bool) -> dict:
-    """:func:`case` in a process of its own, with that process's peak RSS (MB)."""
+    """:func:`case` in a process of its own (``solver == "plain"``: the baseline), with
+    that process's peak RSS (MB); ``{"failed": ...}`` if it failed."""
     command = [sys.executable, __file__, "--case", str(n), solver, str(int(tiny))]
+    if solver == "plain":
+        plain = ROOT / "bench" / "plain_elasticity.py"
+        out = tempfile.mkdtemp()
+        command = [sys.executable, str(plain), "--n", str(n), "--factor", "gamg", "--out", out]
     with tempfile.TemporaryFile("w+") as out:
         proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT)
         _, status, usage = os.wait4(proc.pid, 0)
         out.seek(0)
         text = out.read()
+    rss = usage.ru_maxrss / 1024.0
     if os.waitstatus_to_exitcode(status) != 0:
-        raise RuntimeError(f"{' '.join(command)} failed:\n{text}")
+        reason = text.strip().splitlines()[-1] if text.strip() else "killed (out of memory?)"
+        return {"n": n, "solver": solver, "tiny": tiny, "failed": reason, "rss_mb": rss}
     result = json.loads(text.strip().splitlines()[-1])
-    result["rss_mb"] = usage.ru_maxrss / 1024.0
+    result["rss_mb"] = rss
+    if solver == "plain":
+        timings = result.pop("timings")
+        result |= {"n": n, "solver": solver, "tiny": tiny, "newton": 1, "error": None}
+        result["krylov"], result["solve_s"] = [result["krylov"]], timings["solve"]
     return result
 
 
@@ -77,29 +92,50 @@ def main():
     rows = []
     for tiny in (False, True) if args.tiny else (False,):
         for n in progress(args.sizes, "sizes", not args.no_progress):
-            for solver in ("direct", "iterative"):
+            for solver in ("plain", "direct", "iterative"):
                 r = run(n, solver, tiny)
                 rows.append(r)
+                if "failed" in r:
+                    note(
+                        f"N={n:4d} {solver}: failed ({r['failed']}), peak RSS {r['rss_mb']:.0f} MB"
+                    )
+                    continue
                 note(
                     f"N={n:4d}{' tiny cut' if tiny else ''} {solver:9s} dofs {r['dofs']:9,d}: "
                     f"Newton {r['newton']}, Krylov per step {r['krylov']}, solve "
-                    f"{r['solve_s']:7.2f} s, peak RSS {r['rss_mb']:6.0f} MB, "
-                    f"error {r['error']:.4e}"
+                    f"{r['solve_s']:7.2f} s, peak RSS {r['rss_mb']:6.0f} MB"
+                    + ("" if r["error"] is None else f", error {r['error']:.4e}")
                 )
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "iterative.json").write_text(json.dumps(rows, indent=1))
+    (RESULTS / "iterative.md").write_text(table(rows))
+    print(table(rows))
+
+
+def table(rows: list[dict]) -> str:
+    """The markdown table; ratios against the same N's plain (memory) and direct (time)."""
+    done = {(r["n"], r["tiny"], r["solver"]): r for r in rows if "failed" not in r}
     lines = [
-        "| N | cut | solver | dofs | Newton | Krylov per step | solve (s) | peak RSS (MB) | error |"
+        "| N | cut | solver | dofs | Newton | Krylov per step | solve (s) | peak RSS (MB) "
+        "| RSS / plain | time / direct | error |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    lines.append("|---|---|---|---|---|---|---|---|---|")
     for r in rows:
+        cut = "tiny" if r["tiny"] else "generic"
+        if "failed" in r:
+            lines.append(f"| {r['n']} | {cut} | {r['solver']} | failed: {r['failed']} |" + 7 * " |")
+            continue
+        plain = done.get((r["n"], r["tiny"], "plain"))
+        direct = done.get((r["n"], r["tiny"], "direct"))
+        memory = f"{r['rss_mb'] / plain['rss_mb']:.2f}" if plain else "-"
+        speed = f"{r['solve_s'] / direct['solve_s']:.2f}" if direct else "-"
+        error = "-" if r["error"] is None else f"{r['error']:.4e}"
         lines.append(
-            f"| {r['n']} | {'tiny' if r['tiny'] else 'generic'} | {r['solver']} | {r['dofs']:,} | "
-            f"{r['newton']} | {r['krylov']} | {r['solve_s']:.2f} | {r['rss_mb']:.0f} | "
-            f"{r['error']:.4e} |"
+            f"| {r['n']} | {cut} | {r['solver']} | {r['dofs']:,} | {r['newton']} | "
+            f"{r['krylov']} | {r['solve_s']:.2f} | {r['rss_mb']:.0f} | {memory} | {speed} | "
+            f"{error} |"
         )
-    (RESULTS / "iterative.md").write_text("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":

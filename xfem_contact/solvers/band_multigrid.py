@@ -5,12 +5,14 @@ One application to a residual ``r`` (a petsc4py Python PC, ``pc_type = python``)
 1. ``x_u = MG(A_uu + B^T B) r_u``, zero elsewhere (``B = J_lu``, the multipliers' rows:
    the augmented-Lagrangian coupling of the two sides, which a law without
    augmentation, ``bonded``, does not put into ``A_uu``, leaving the inclusion floating
-   there): the displacement block by one V-cycle of a
-   two-level multigrid, degree 2 on degree 1 (the interpolation from each field's
-   vertex values, :func:`xfem_contact.mechanics.splits.vertex_interpolation`), one
-   forward SOR sweep before and one backward sweep after, the coarse level
-   ``P^T A P`` (of the augmented block) by LU; for degree 1, GAMG on it with the rigid
-   modes;
+   there): the displacement block by one V-cycle of a two-level multigrid, degree 2
+   on degree 1 (the interpolation ``P`` from each field's vertex values,
+   :func:`xfem_contact.mechanics.splits.vertex_interpolation`). The fine level is
+   ``A_uu`` read in place from ``J`` (a virtual sub-matrix: no copy), smoothed by
+   Chebyshev-Jacobi; the coarse level ``P^T A_uu P + (B P)^T (B P)`` (augmented: it
+   holds the floating bodies) by algebraic multigrid (GAMG with the rigid modes), so
+   that memory and time grow linearly with the dofs. For degree 1, GAMG on the
+   augmented block;
 2. ``x_b += J_bb^-1 (r - J x)_b``: an exact (LU) solve on the band ``b``, the
    displacements of the cut cells and their facet neighbours (where the ghost penalty
    acts) and every multiplier.
@@ -20,7 +22,8 @@ split) does not suffice: the ghost-penalty rows make the degree-2 operator hard 
 aggregate, and the multipliers couple only through the band. With the band solved
 exactly and the bulk by the p-multigrid, the Krylov iteration count does not grow with
 the mesh size nor with tiny cuts (measured by ``bench/iterative.py``). The band has
-O(N) unknowns and the coarse level a quarter of the displacements'.
+O(N) unknowns and the coarse level a quarter of the displacements'; the copies made
+are the band's rows, the multipliers' rows ``B`` and the coarse level.
 
 Sub-solver options live under the PC's prefix plus ``bmg_u_`` (the PCMG, or GAMG for
 degree 1) and ``bmg_band_`` (the band's LU); :data:`U_OPTIONS` and
@@ -38,19 +41,12 @@ from xfem_contact.solvers.scaling import gather
 #: Defaults of the displacement solve, degree 2 (PCMG, 2 levels, interpolation set here)
 U_OPTIONS: dict[str, OptionValue] = {
     "ksp_type": "preonly",
-    "mg_levels_ksp_type": "richardson",
-    "mg_levels_pc_type": "sor",
-    "mg_levels_ksp_max_it": 1,
-    "mg_levels_pc_sor_local_forward": "",
-    "mg_distinct_smoothup": "",
-    "mg_levels_up_ksp_type": "richardson",
-    "mg_levels_up_pc_type": "sor",
-    "mg_levels_up_ksp_max_it": 1,
-    "mg_levels_up_pc_sor_local_backward": "",
-    "mg_coarse_ksp_type": "preonly",
-    "mg_coarse_pc_type": "lu",
-    "mg_coarse_pc_factor_mat_solver_type": "mumps",
-    "mg_coarse_mat_mumps_icntl_7": 4,
+    "mg_levels_ksp_type": "chebyshev",
+    "mg_levels_pc_type": "jacobi",
+    "mg_levels_ksp_max_it": 2,
+    "mg_coarse_ksp_type": "richardson",
+    "mg_coarse_ksp_max_it": 3,
+    "mg_coarse_pc_type": "gamg",
 }
 #: Defaults of the displacement solve, degree 1 (algebraic multigrid)
 U_OPTIONS_DEGREE1: dict[str, OptionValue] = {
@@ -80,6 +76,7 @@ class BandMultigrid:
     def __init__(self):
         self.u = self.band = None
         self._interpolation = None
+        self._prolongations: tuple | None = None  # (P, P in J's rows, coarse positions)
         self._modes: list[PETSc.Vec] = []
         self._objects: list = []
         self._built = False
@@ -97,6 +94,13 @@ class BandMultigrid:
         """
         self.u, self.band, self._modes = u, band, list(modes)
         self._interpolation = interpolation
+        self._forget_prolongations()
+
+    def _forget_prolongations(self) -> None:
+        if self._prolongations is not None:
+            for mat in self._prolongations[:2]:
+                mat.destroy()
+        self._prolongations = None
 
     # -- PETSc's callbacks ---------------------------------------------------------
     def setUp(self, pc: PETSc.PC) -> None:
@@ -128,7 +132,7 @@ class BandMultigrid:
 
     def view(self, pc: PETSc.PC, viewer: PETSc.Viewer | None = None) -> None:
         if viewer is not None and self._built:
-            levels = "degree 2 on degree 1, coarse LU" if self.P is not None else "GAMG"
+            levels = "degree 2 on degree 1, coarse GAMG" if self.P is not None else "GAMG"
             viewer.printfASCII(
                 f"  band multigrid: {self.band.getSize()} band unknowns (LU), "
                 f"{self.u.getSize()} displacements ({levels})\n"
@@ -145,31 +149,16 @@ class BandMultigrid:
 
     def destroy(self, pc: PETSc.PC | None = None) -> None:
         self.reset(pc)
-
-    def _augment(self, J: PETSc.Mat) -> None:
-        """``A_uu + B^T B`` with ``B = J_lu`` (scaled unknowns): the multipliers'
-        coupling of the two sides added to the displacement block, as an augmented
-        Lagrangian does (a law without augmentation, ``bonded``, leaves each side
-        floating in ``A_uu``)."""
-        comm = J.getComm()
-        first, last = J.getOwnershipRange()
-        others = np.setdiff1d(np.arange(first, last), self.u.getIndices())
-        multipliers = PETSc.IS().createGeneral(others.astype(PETSc.IntType), comm=comm)
-        B = J.createSubMatrix(multipliers, self.u)
-        Bt = B.transpose(PETSc.Mat())  # (PETSc 3.25: B.transposeMatMult(B) failed on a process
-        BtB = Bt.matMult(B)  # without multiplier rows)
-        self.A.axpy(1.0, BtB, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-        for obj in (multipliers, B, Bt, BtB):
-            obj.destroy()
+        self._forget_prolongations()
 
     # -- construction --------------------------------------------------------------
     def _build(self, J: PETSc.Mat, prefix: str) -> None:
         comm = J.getComm()
         first, last = J.getOwnershipRange()
         self.all_columns = PETSc.IS().createStride(last - first, first, 1, comm=comm)
-        self.A = J.createSubMatrix(self.u, self.u)
-        self._augment(J)
-        self.A.setBlockSize(2)
+        others = np.setdiff1d(np.arange(first, last), self.u.getIndices())
+        multipliers = PETSc.IS().createGeneral(others.astype(PETSc.IntType), comm=comm)
+        self.B = J.createSubMatrix(multipliers, self.u)
         self.J_bb = J.createSubMatrix(self.band, self.band)
         self.J_b = J.createSubMatrix(self.band, self.all_columns)
         self.r_b, self.x_b = self.J_bb.createVecLeft(), self.J_bb.createVecRight()
@@ -178,38 +167,60 @@ class BandMultigrid:
         self.ksp_band.setOperators(self.J_bb)
         self.ksp_u = PETSc.KSP().create(comm)
         self.ksp_u.setOptionsPrefix(prefix + "u_")
-        self.ksp_u.setOperators(self.A)
         space = PETSc.NullSpace().create(vectors=self._modes, comm=comm)
         self.P = self.A_c = None
-        self._objects = [self.all_columns, self.A, self.J_bb, self.J_b, self.r_b, self.x_b]
-        self._objects += [self.ksp_band, self.ksp_u, space]
-        if self._interpolation is None:
+        self._objects = [self.all_columns, multipliers, self.B, self.J_bb, self.J_b]
+        self._objects += [self.r_b, self.x_b, self.ksp_band, self.ksp_u, space]
+        if self._interpolation is None:  # degree 1: GAMG on the augmented block
             self.u_options = U_OPTIONS_DEGREE1
+            self.A = J.createSubMatrix(self.u, self.u)
+            self.A.axpy(1.0, _gram(self.B), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            self.A.setBlockSize(2)
             self.A.setNearNullSpace(space)
-        else:
+            self.ksp_u.setOperators(self.A)
+            self._objects.append(self.A)
+        else:  # degree 2: J's block itself (no copy) smoothed, the coarse level augmented
             self.u_options = U_OPTIONS
-            self.P, coarse = _prolongation(J, self.u, *self._interpolation)
+            if self._prolongations is None:  # the pattern of J does not change them
+                self._prolongations = _prolongation(J, self.u, *self._interpolation)
+            self.P, self.P_full, coarse = self._prolongations
             #: Local positions in ``u`` of the owned coarse (vertex) unknowns
             self.coarse_positions = coarse
-            self.A_c = self.A.PtAP(self.P)
+            self.A = PETSc.Mat().createSubMatrixVirtual(J, self.u, self.u)
+            self.A_c = J.PtAP(self.P_full)
+            BP = self.B.matMult(self.P)
+            self.A_c.axpy(1.0, _gram(BP), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             self.A_c.setBlockSize(2)
             coarse_modes = _orthonormal([_restricted(m, coarse) for m in self._modes])
             coarse_space = PETSc.NullSpace().create(vectors=coarse_modes, comm=comm)
             self.A_c.setNearNullSpace(coarse_space)
+            self.ksp_u.setOperators(self.A)
             mg = self.ksp_u.getPC()
             mg.setType(PETSc.PC.Type.MG)
             mg.setMGLevels(2)
             mg.setMGInterpolation(1, self.P)
             mg.getMGCoarseSolve().setOperators(self.A_c, self.A_c)
             mg.getMGSmoother(1).setOperators(self.A, self.A)
-            self._objects += [self.P, self.A_c, coarse_space, *coarse_modes]
+            self._objects += [self.A, self.A_c, BP, coarse_space, *coarse_modes]
         self._built = True
 
 
-def _prolongation(J: PETSc.Mat, u: PETSc.IS, rows, cols, weights) -> tuple[PETSc.Mat, np.ndarray]:
+def _gram(B: PETSc.Mat) -> PETSc.Mat:
+    """``B^T B`` (a new matrix; the caller destroys it). Collective."""
+    Bt = B.transpose(PETSc.Mat())  # (PETSc 3.25: B.transposeMatMult(B) failed on a process
+    BtB = Bt.matMult(B)  # without multiplier rows)
+    Bt.destroy()
+    return BtB
+
+
+def _prolongation(
+    J: PETSc.Mat, u: PETSc.IS, rows, cols, weights
+) -> tuple[PETSc.Mat, PETSc.Mat, np.ndarray]:
     """``P`` from the coarse unknowns (the distinct ``cols``, numbered process by
-    process in the order of their global index) to the unknowns of ``u``, and the
-    positions in ``u``'s local part of the owned coarse unknowns. Collective."""
+    process in the order of their global index) to the unknowns of ``u``; the same
+    into all of ``J``'s unknowns (zero rows outside ``u``: ``P_full^T J P_full`` is the
+    coarse ``P^T J_uu P`` without extracting ``J_uu``); and the positions in ``u``'s
+    local part of the owned coarse unknowns. Collective."""
     comm = u.getComm()
     owned_u = u.getIndices()
     first, last = J.getOwnershipRange()
@@ -236,9 +247,19 @@ def _prolongation(J: PETSc.Mat, u: PETSc.IS, rows, cols, weights) -> tuple[PETSc
     P = PETSc.Mat().createAIJ(
         ((owned_u.size, PETSc.DETERMINE), (coarse.size, PETSc.DETERMINE)), comm=comm
     )
-    P.setPreallocationCSR((indptr, coarse_cols.astype(PETSc.IntType), weights))
+    columns = coarse_cols.astype(PETSc.IntType)
+    P.setPreallocationCSR((indptr, columns, weights))
     P.assemble()
-    return P, position(coarse)
+    counts = np.zeros(last - first, dtype=PETSc.IntType)  # the same rows, in J's numbering
+    counts[owned_u - first] = np.diff(indptr)
+    full_indptr = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
+    by_row = np.argsort(owned_u[local_rows], kind="stable")
+    P_full = PETSc.Mat().createAIJ(
+        ((last - first, PETSc.DETERMINE), (coarse.size, PETSc.DETERMINE)), comm=comm
+    )
+    P_full.setPreallocationCSR((full_indptr, columns[by_row], weights[by_row]))
+    P_full.assemble()
+    return P, P_full, position(coarse)
 
 
 def _restricted(mode: PETSc.Vec, positions: np.ndarray) -> PETSc.Vec:
