@@ -120,15 +120,68 @@ def test_bad_cracks_are_one_line_naming_the_key(change, start):
     assert str(error.value).startswith(start) and "\n" not in str(error.value)
 
 
-def test_one_crack_and_no_interfaces_for_now():
-    data = edge_crack()
-    data["cracks"].append(dict(data["cracks"][0]))
-    with pytest.raises(NotImplementedError, match=r"^cracks\[1\]: one crack per scene"):
+def two_cracks(inner=((0.3013, 1.5013), (0.7013, 1.5013)), **crack) -> dict:
+    """The edge-crack plate with its crack ``edge`` at y = 0.5013 and a second, ``inner``
+    crack (a segment, rings shared)."""
+    data = edge_crack(points=[[-0.1, 0.5013], [0.41, 0.5013]], name="edge", rings=[[0.12, 0.25]])
+    data["cracks"].append(
+        {"shape": "segment", "points": [list(p) for p in inner], "name": "inner"}
+        | {"rings": [[0.12, 0.25]], **crack}
+    )
+    return data
+
+
+SHARED_KEYS = {
+    "name": ({"name": "edge"}, "cracks[1].name: 'edge' is the name of cracks[0] too"),
+    "material": ({"material": "glass"}, "cracks[1].material: the cracks of a scene share"),
+    "rings": ({"rings": [[0.1, 0.2]]}, "cracks[1].rings: the cracks of a scene share one rings"),
+    "tip radius": ({"tip_radius": 0.3}, "cracks[1].tip_radius: the cracks of a scene share"),
+}
+
+
+@pytest.mark.parametrize("change, start", SHARED_KEYS.values(), ids=SHARED_KEYS)
+def test_several_cracks_share_one_body(change, start):
+    data = two_cracks(**change)
+    data["materials"]["glass"] = {"E": 70e9, "nu": 0.2}
+    with pytest.raises(ValueError) as error:
         load_scene(data)
+    assert str(error.value).startswith(start) and "\n" not in str(error.value)
+
+
+def test_no_cracks_with_interfaces_for_now():
     data = edge_crack()
     data["interfaces"] = [{"shape": "circle", "centre": [0.5, 0.5], "radius": 0.1}]
     with pytest.raises(NotImplementedError, match=r"^cracks: a crack together with"):
         load_scene(data)
+
+
+def test_two_cracks_run_K_and_lips_per_crack(tmp_path):
+    """Two cracks in a scene: the run writes each crack's tips (one for the edge crack, two
+    for the inner one) and lips."""
+    path = tmp_path / "scene.toml"
+    path.write_text(to_toml(two_cracks()))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())["cracks"]
+    assert list(summary) == ["edge", "inner"]
+    (edge,) = summary["edge"]["tips"]
+    assert np.allclose(edge["position"], [0.41, 0.5013])
+    inner = sorted(tip["position"][0] for tip in summary["inner"]["tips"])
+    assert np.allclose(inner, [0.3013, 0.7013])
+    for tip in summary["inner"]["tips"]:  # a central crack of 0.4 m in a 1 m wide plate
+        assert 0.9e6 < tip["rings"][0]["K_I"] < 1.0e6  # 0.94e6, 0.88e6 in a plate alone
+    s = np.array(summary["inner"]["lips"]["s"])
+    assert s.min() >= 0 and s.max() <= 0.4 + 1e-9
+    assert {"lips_edge.png", "lips_inner.png"} <= {p.name for p in (tmp_path / "out").iterdir()}
+
+
+def test_crossing_cracks_exit_2_one_line(tmp_path, capsys):
+    path = tmp_path / "scene.toml"
+    path.write_text(to_toml(two_cracks(inner=((0.2, 0.3), (0.25, 0.9)))))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    start = f"error: {path}: cracks[1]: cracks 'edge' and 'inner' come within"
+    assert len(err) == 1 and err[0].startswith(start), err
+    assert err[0].endswith("touching or crossing cracks are not handled")
 
 
 BUILD_ERRORS = {

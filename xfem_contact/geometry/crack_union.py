@@ -116,6 +116,14 @@ def interpolate_tangent(
 
 def _of(levelsets: Mapping, names: tuple[str, ...], argument: str) -> list:
     """The level sets of ``names`` from the mapping given as ``argument``."""
+    if isinstance(levelsets, Mapping) and set(levelsets) < set(names):
+        missing = [name for name in names if name not in levelsets]
+        raise ValueError(
+            f"{argument}: no psi for {missing}: with a tangent mapping, every entry of "
+            "levelset is a crack (closed interfaces together with cracks are not available "
+            "yet: the interfaces' inside materials and ghost penalty are not handled in a "
+            "cut by cracks)"
+        )
     if not isinstance(levelsets, Mapping) or tuple(levelsets) != names:
         got = list(levelsets) if isinstance(levelsets, Mapping) else type(levelsets).__name__
         raise ValueError(
@@ -153,8 +161,9 @@ def crack_union(
     if len(names) == 1:  # checked by the cut as one crack's
         none = np.zeros((1, 0))
         zeros = np.zeros(num_cells, dtype=np.int32)
-        return CrackUnion(names, phis[0], psis[0], np.inf, np.inf, None, zeros, 0.0, none,
-                          none.T, mesh.comm)
+        return CrackUnion(
+            names, phis[0], psis[0], np.inf, np.inf, None, zeros, 0.0, none, none.T, mesh.comm
+        )
     h = mesh.comm.allreduce(
         float(mesh.h(tdim, np.arange(num_cells, dtype=np.int32)).max(initial=0.0)), op=MPI.MAX
     )

@@ -1,4 +1,4 @@
-"""Build the crack of a scene: its level sets on the mesh, its cut, and the rings of K.
+"""Build the cracks of a scene: their level sets on the mesh, their cut, and the rings of K.
 
 A ``segment``, ``polyline`` or ``arc`` is a :class:`~xfem_contact.geometry.crack_paths.
 CrackPath`; each of its ends is a tip when it lies inside the body (and a point just
@@ -11,6 +11,7 @@ end, out of the body (:meth:`~xfem_contact.geometry.crack_paths.CrackPath.levels
 from __future__ import annotations
 
 import math
+import re
 
 import dolfinx.geometry
 import dolfinx.mesh
@@ -87,24 +88,41 @@ def crack_levelsets(spec: CrackSpec, mesh: dolfinx.mesh.Mesh, where: str) -> tup
 
 
 def crack_cut(scene: Scene, mesh: dolfinx.mesh.Mesh) -> tuple:
-    """``(cut, laws, material, options)`` of a scene's crack for
-    :class:`~xfem_contact.mechanics.problem.Problem`. Collective."""
-    spec, where = scene.cracks[0], "cracks[0]"
-    phi, psi = crack_levelsets(spec, mesh, where)
+    """``(cut, laws, material, options)`` of a scene's cracks (one body: the first
+    crack's material, tip radius) for :class:`~xfem_contact.mechanics.problem.Problem`.
+    Collective."""
+    phis, psis, laws = {}, {}, {}
+    for k, spec in enumerate(scene.cracks):
+        phis[spec.name], psis[spec.name] = crack_levelsets(spec, mesh, f"cracks[{k}]")
+        laws[spec.name] = crack_law(
+            spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb
+        )
+    several = len(scene.cracks) > 1
     try:
         cut = CutMesh(
             mesh,
-            {spec.name: phi},
+            phis,
             degree=scene.levelset_degree,
             quadrature_degree=scene.quadrature_degree,
-            tangent=psi,
+            tangent=psis if several else psis[scene.cracks[0].name],
         )
     except ValueError as error:
-        raise SceneError(where, " ".join(str(error).split())) from None
-    law = crack_law(spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb)
+        message = re.sub(r"^(levelset|tangent)(\[[^]]*\])?: ", "", " ".join(str(error).split()))
+        raise SceneError(crack_key(scene, str(error)), message) from None
+    spec = scene.cracks[0]
     # no ghost penalty: its derivatives of the branch functions make the forms very costly
     options = {"tip_radius": spec.tip_radius, "ghost_penalty": 0.0}
-    return cut, {spec.name: law}, scene.materials[spec.material], options
+    return cut, laws, scene.materials[spec.material], options
+
+
+def crack_key(scene: Scene, message: str) -> str:
+    """The key of the crack an error names (``cracks 'a' and 'b'``: the second's, or
+    ``levelset['a']``, ``tangent['a']``), else ``cracks[0]`` (``cracks`` for several)."""
+    names = [spec.name for spec in scene.cracks]
+    named = re.findall(r"(?:cracks '[^']*' and |\[)'([^']*)'", message)
+    if named and named[0] in names:
+        return f"cracks[{names.index(named[0])}]"
+    return "cracks[0]" if len(names) == 1 else "cracks"
 
 
 def problem_error(error: ValueError) -> SceneError:
@@ -147,6 +165,8 @@ def default_rings(problem) -> list[tuple[float, float]]:
     if len(tips) > 1:
         gaps = np.linalg.norm(tips[:, None] - tips[None], axis=2)
         room = min(room, float(gaps[~np.eye(len(tips), dtype=bool)].min()))
+    if problem.cut.cracks is not None:  # and to the other cracks
+        room = min(room, problem.cut.cracks.gap)
     rings = [(a * h, min(b * h, 0.9 * room)) for a, b in CRACK_RINGS]
     rings = [(r_inf, r_sup) for r_inf, r_sup in rings if r_sup - r_inf >= 0.5 * h]
     if not rings:

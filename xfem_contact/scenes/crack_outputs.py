@@ -1,4 +1,4 @@
-"""The outputs of a scene's crack: K_I, K_II, J and G per tip and ring, and its lips.
+"""The outputs of a scene's cracks: K_I, K_II, J and G per tip and ring, and their lips.
 
 :class:`CrackOutputs` is made before the solve (its rings are checked and its
 interaction integrals compiled then), :meth:`CrackOutputs.summary` after it: the
@@ -17,10 +17,11 @@ from xfem_contact.scenes.schema import Scene, SceneError
 
 
 class CrackOutputs:
-    """The stress intensity factors and lips of the crack of a scene's problem.
+    """The stress intensity factors and lips of the cracks of a scene's problem.
 
     Args:
-        problem: The scene's problem (its cut has the crack ``scene.cracks[0]``).
+        problem: The scene's problem (its cut has the cracks ``scene.cracks``, their
+            rings shared).
         scene: The scene.
 
     Collective. Raises :class:`SceneError` (``cracks[0].rings``) for rings the mesh
@@ -28,8 +29,8 @@ class CrackOutputs:
     """
 
     def __init__(self, problem, scene: Scene):
-        self.problem, self.spec = problem, scene.cracks[0]
-        rings = self.spec.rings or default_rings(problem)
+        self.problem, self.specs = problem, scene.cracks
+        rings = self.specs[0].rings or default_rings(problem)
         try:
             self.integrals = TipIntegrals(problem, rings)
         except ValueError as error:
@@ -42,6 +43,7 @@ class CrackOutputs:
         abscissa}}`` (SI units; ``s`` the arc length from the crack's first point, or
         a coordinate along it for expressions, ``abscissa`` says which). Collective."""
         crack = self.problem.cut.crack
+        names = crack.tip_names
         tips = [
             {
                 "position": position.tolist(),
@@ -62,23 +64,28 @@ class CrackOutputs:
                 crack.tips, crack.directions, self.integrals.evaluate(), strict=True
             )
         ]
-        lips = lip_samples(self.problem, self.spec.name)
-        path = crack_path(self.spec)
-        if path is not None:
-            lips["s"] = path.arclength(np.array([lips["x"], lips["y"]])).tolist()
-            label = "arc length along the crack (m)"
-        else:
-            s, label = interface_abscissa(np.array(lips["x"]), np.array(lips["y"]))
-            lips["s"] = s.tolist()
-        entry = {"law": self.problem.laws[self.spec.name].describe(), "tips": tips}
-        return {self.spec.name: entry | {"lips": lips, "abscissa": label}}
+        summary = {}
+        for spec in self.specs:
+            lips = lip_samples(self.problem, spec.name)
+            path = crack_path(spec)
+            if path is not None:
+                lips["s"] = path.arclength(np.array([lips["x"], lips["y"]])).tolist()
+                label = "arc length along the crack (m)"
+            else:
+                s, label = interface_abscissa(np.array(lips["x"]), np.array(lips["y"]))
+                lips["s"] = s.tolist()
+            mine = [tip for tip, name in zip(tips, names, strict=True) if name == spec.name]
+            entry = {"law": self.problem.laws[spec.name].describe(), "tips": mine}
+            summary[spec.name] = entry | {"lips": lips, "abscissa": label}
+        return summary
 
     def lines(self, summary: dict) -> list[str]:
         """One log line per tip: its position and K on each ring (Pa m^1/2)."""
         lines = []
-        for entry in summary.values():
+        for name, entry in summary.items():
+            label = "crack" if len(summary) == 1 else f"crack {name!r}"
             for k, tip in enumerate(entry["tips"]):
                 ks = ", ".join(f"{r['K_I']:.4g} / {r['K_II']:.4g}" for r in tip["rings"])
                 x, y = tip["position"]
-                lines.append(f"crack tip {k} at ({x:.4g}, {y:.4g}): K_I / K_II per ring {ks}")
+                lines.append(f"{label} tip {k} at ({x:.4g}, {y:.4g}): K_I / K_II per ring {ks}")
         return lines

@@ -1,6 +1,7 @@
 """The [[cracks]] of a scene: each table checked against its shape's keys and its law's
-options (:func:`crack_spec`); where the crack lies in the mesh is checked when it is
-built (:mod:`xfem_contact.scenes.crack_builder`)."""
+options (:func:`crack_spec`), the keys several cracks share (:func:`shared_crack_keys`);
+where the cracks lie in the mesh is checked when they are built
+(:mod:`xfem_contact.scenes.crack_builder`)."""
 
 from __future__ import annotations
 
@@ -43,9 +44,27 @@ def crack_spec(table, k: int, materials: dict) -> CrackSpec:
         shape=shape,
         params=params,
         material=material,
-        name=table.get("name", "crack"),
+        name=table.get("name", "crack" if k == 0 else f"crack{k}"),
         law=law,
         tip_radius=table.get("tip_radius"),
         rings=table.get("rings"),
         **options,
     )
+
+
+def shared_crack_keys(cracks: list[CrackSpec]) -> None:
+    """Several cracks lie in one body: distinct names, and the same ``material``,
+    ``tip_radius`` and ``rings`` (one tip enrichment and one set of rings for all tips)."""
+    for k, spec in enumerate(cracks[1:], start=1):
+        first = cracks[0]
+        names = [c.name for c in cracks[:k]]
+        if spec.name in names:
+            message = f"{spec.name!r} is the name of cracks[{names.index(spec.name)}] too"
+            raise SceneError(f"cracks[{k}].name", message + ": give each crack its own name")
+        for key in ("material", "tip_radius", "rings"):
+            if getattr(spec, key) != getattr(first, key):
+                raise SceneError(
+                    f"cracks[{k}].{key}",
+                    f"the cracks of a scene share one {key} (cracks[0]'s: "
+                    f"{getattr(first, key)!r}), got {getattr(spec, key)!r}",
+                )

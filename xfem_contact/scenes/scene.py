@@ -43,7 +43,7 @@ from xfem_contact.mechanics.laws import LINEAR_LAWS, SLIDING_LAWS
 from xfem_contact.mechanics.laws.sliding import SLIDING_LBB
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.scenes.checks import material_name
-from xfem_contact.scenes.crack_tables import crack_spec
+from xfem_contact.scenes.crack_tables import crack_spec, shared_crack_keys
 from xfem_contact.scenes.load_tables import load_spec
 from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
     BUILTIN_PARTS,
@@ -151,8 +151,7 @@ def load_scene(
         crack_spec(table, k, materials)
         for _, k, table in _tables(data.get("cracks", []), "cracks", listed=True)
     ]
-    if len(cracks) > 1:
-        raise NotImplementedError("cracks[1]: one crack per scene for now")
+    shared_crack_keys(cracks)
     if cracks and interfaces:
         raise NotImplementedError(
             "cracks: a crack together with [[interfaces]] is not available yet; "

@@ -133,9 +133,16 @@ def grow(problem, path: CrackPath, da: float, rings, solve: bool = True) -> Grow
     Raises:
         ValueError: ``da`` not positive, or an advance that leaves the mesh (the cut
             refuses a tip outside the body).
+        NotImplementedError: a cut with several cracks.
     """
     if not (da > 0 and math.isfinite(da)):
         raise ValueError(f"da must be a positive length (m), got {da!r}")
+    names = problem.cut.interface_names
+    if len(names) > 1:
+        raise NotImplementedError(
+            f"problem: grow() moves one crack; this cut has the cracks {list(names)} "
+            "(growing several is not available yet)"
+        )
     results = TipIntegrals(problem, rings).evaluate()
     tips = problem.cut.crack.tips
     per_end: list = [None, None]
