@@ -119,6 +119,7 @@ def rotating_annulus_problem(
     outer: str = "point",
     comm: MPI.Comm = MPI.COMM_WORLD,
     quadrature_degree: int = 6,
+    segments: bool = True,
     **options,
 ) -> Problem:
     """Case 3 turned by ``alpha`` (rad) at load factor 1, in large kinematics.
@@ -132,13 +133,13 @@ def rotating_annulus_problem(
         law: ``frictionless`` (or ``coulomb`` with ``friction``) in large sliding.
         outer: ``"point"`` (``u_y = 0`` at (20, 0)) or ``"tangential"`` (``u_t = 0``
             along ``r = 20``, a spring of 1000 E / h).
-        quadrature_degree: Of the cut's rules (the cut's default 6). The master feet of
-            a slave piece's points cross master-piece ends, where the master field's
-            derivative jumps, and Gauss points over such a kink lose accuracy; a
-            higher degree reduces the error, but more points then sit near kinks,
-            where the pairing is not smooth, and Newton can stall (see the docs'
-            large-sliding page). Segment-to-segment integration would remove both;
-            not built.
+        quadrature_degree: Of the cut's rules (the cut's default 6), i.e. of each
+            slave (sub-)segment's Gauss rule.
+        segments: Segment-to-segment integration of the hybrid elements (the slave
+            pieces split where their feet cross master-piece ends, where the master
+            field's derivative jumps); False: the cut's interface rule, whose Gauss
+            points then integrate across those kinks (see the docs' large-sliding
+            page).
         options: Passed to :class:`~xfem_contact.mechanics.problem.Problem` (e.g.
             ``pairing``, ``slave``, ``ghost_penalty``) or to the law (``lbb``, ...).
     """
@@ -161,6 +162,8 @@ def rotating_annulus_problem(
     problem = Problem(
         cut, degree, Material(ANNULUS_E, 0.0), interface, kinematics="large", **problem_options
     )
+    for sliding in problem.laws.values():
+        sliding.segments = segments
     tol = 1e-6 * r_out
     problem.loads.add_rotation(lambda x: np.abs(np.hypot(x[0], x[1]) - r_in) < tol, angle=alpha)
     outside = lambda x: np.abs(np.hypot(x[0], x[1]) - r_out) < tol  # noqa: E731

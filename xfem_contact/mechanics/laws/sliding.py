@@ -42,6 +42,10 @@ class SlidingContact(ContactLaw):
         pairing: ``"iterate"`` (pair at every Newton iterate) or ``"step"`` (pair at
             the start of each load step).
         radius: Search radius of the pairing (m); default the largest cut-cell size.
+        segments: Segment-to-segment integration: each slave piece split where the
+            feet of its points cross master-piece ends, a Gauss rule per sub-segment
+            (:mod:`~xfem_contact.mechanics.sliding.segments`); False: the interface
+            rule's points. An attribute, settable between solves.
         augmentation, lbb, multiplier_stabilization, multiplier_extension: As for
             :class:`~xfem_contact.mechanics.laws.contact.Frictionless` (``lbb``:
             ``"stabilized"`` or ``"none"``).
@@ -55,6 +59,7 @@ class SlidingContact(ContactLaw):
         slave: int = DEFAULT.slave,
         pairing: str = DEFAULT.pairing,
         radius: float | None = None,
+        segments: bool = True,
         **options,
     ):
         super().__init__(**options)
@@ -67,12 +72,14 @@ class SlidingContact(ContactLaw):
         if pairing not in PAIRING_UPDATES:
             raise ValueError(f"pairing must be one of {PAIRING_UPDATES}, got {pairing!r}")
         self.slave, self.pairing, self.radius = slave, pairing, radius
+        self.segments = bool(segments)
 
     def describe(self) -> dict:
         return super().describe() | {
             "kinematics": "large",
             "slave": self.slave,
             "pairing": self.pairing,
+            "segments": self.segments,
         }
 
     def coupling(self, ctx: InterfaceContext) -> SlidingCoupling:

@@ -17,12 +17,20 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from xfem_contact.fem.evaluation import cell_dofs, lagrange_element, rule_cells
+from xfem_contact.fem.evaluation import rule_cells
+from xfem_contact.mechanics.sliding.blocks import BlockMatrix
 from xfem_contact.mechanics.sliding.element import PairTerms, frictionless_terms
 from xfem_contact.mechanics.sliding.friction import PointData
 from xfem_contact.mechanics.sliding.friction import terms as friction_terms
 from xfem_contact.mechanics.sliding.lips import MasterLip, global_dofs
+from xfem_contact.mechanics.sliding.points import PointMaker, SlavePoints, positions
 from xfem_contact.mechanics.sliding.projection import Pairing, closest_points
+from xfem_contact.mechanics.sliding.segments import (
+    Segments,
+    SlavePieces,
+    split,
+    split_gradient,
+)
 
 #: When the master lip is paired: at every Newton iterate, or once per load step
 PAIRING_UPDATES = ("iterate", "step")
@@ -31,22 +39,38 @@ PAIRING_UPDATES = ("iterate", "step")
 class SlidingCoupling:
     """Slave points of one interface, their pairing and their hybrid elements.
 
+    The state (:meth:`evaluate`: gaps, multipliers, pairing counts) is at the points
+    of the interface's rule. The terms added to the Newton system are integrated, when
+    the law's ``segments`` is true, by segment-to-segment rules
+    (:mod:`~xfem_contact.mechanics.sliding.segments`): the slave pieces split where
+    their feet cross master-piece ends, the split points taken at the iterate and
+    held fixed in its Jacobian (their motion enters only through the discontinuity of
+    the integrand at a split, which vanishes with the master's kink); else by the
+    rule's own points.
+
     Args:
         ctx: The interface's :class:`~xfem_contact.mechanics.laws.base.InterfaceContext`.
         W: The problem's mixed space.
-        law: The large-sliding law (its ``augmentation_coefficient``).
+        law: The large-sliding law (its ``augmentation_coefficient``, ``friction``
+            and ``segments``, read at every evaluation).
         slave: Slave side (-1 or +1); the master is the other.
         radius: Search radius (m); default the largest cut-cell size of the
             interface.
         update: ``"iterate"`` (pair at every Newton iterate) or ``"step"`` (pair at
-            the start of each solve and keep the master pieces; the feet still move
-            along them).
+            the start of each solve and keep the master pieces, and the split points;
+            the feet still move along them).
 
     Construction is collective; the solver then calls :meth:`bind`.
     """
 
     def __init__(
-        self, ctx, W, law, slave: int = -1, radius: float | None = None, update: str = "iterate"
+        self,
+        ctx,
+        W,
+        law,
+        slave: int = -1,
+        radius: float | None = None,
+        update: str = "iterate",
     ):
         if slave not in (-1, 1):
             raise ValueError(f"slave must be -1 or +1 (a side), got {slave!r}")
@@ -59,40 +83,54 @@ class SlidingCoupling:
         self.comm = cut.mesh.comm
         rules = ctx.rules
         cells = rule_cells(cut, rules)
-        X = rules.points
         self.rows = np.flatnonzero(np.diff(rules.offsets) > 0)  # cut-cell rows with a rule
-        J = cut.maps.jacobian(cells, X)
-        self.weights = rules.weights * np.abs(np.linalg.det(J))
-        self.x_ref = cut.maps.push_forward(cells, X)
-        V_s, V_l = W.sub(self.slave_field), W.sub(ctx.field)
-        self.phi_s = lagrange_element(V_s).tabulate(0, X)[0, :, :, 0]
-        self.lam_basis = lagrange_element(V_l).tabulate(0, X)[0, :, :, 0]
-        self.slave_dofs = _flat(cell_dofs(V_s, cells))  # (m, nodes x components)
-        self.lam_dofs = _flat(cell_dofs(V_l, cells))
-        h = ctx.cell_size_at()
-        self._materials, self._h = ctx.materials, h
+        J = cut.maps.jacobian(cells, rules.points)
+        V_s = W.sub(self.slave_field)
+        self._points = PointMaker(cut.maps, V_s, W.sub(ctx.field), ctx.cell_size)
+        #: The rule's points (where the state is reported)
+        self.points = self._points(cells, rules.points, rules.weights * np.abs(np.linalg.det(J)))
+        self.pieces = SlavePieces(cut, V_s, self.rows, cut.quadrature_degree)
+        self._materials = ctx.materials
+        h = self.points.h
         self.radius = radius or self.comm.allreduce(float(h.max(initial=0.0)), op=MPI.MAX)
-        tdim = cut.mesh.topology.dim
-        self.slave_cells = cut.mesh.topology.index_map(tdim).local_to_global(cells)
         self.lip: MasterLip | None = None
         self._evaluated: tuple[np.ndarray, Pairing, PairTerms] | None = None
+        self._integrated: tuple | None = None
         self._frozen: np.ndarray | None = None
+        self._frozen_segments: Segments | None = None
         self._accepted_cells: np.ndarray | None = None
-        self._merged: set = set()
+        self._blocks = BlockMatrix()
+        #: Linearise the motion of the split points (iterate pairing): the jump of
+        #: the integrand at each split point times the point's derivative
+        self.split_linearisation = True
         #: Frictionless through the complex-step element too (a cross-check)
         self.complex_step = False
         #: ``(slip increment (m), lambda_t, P_t (Pa))`` at the points (Coulomb)
         self.tangential = None
-        self._old_slave = self._old_master = None
-        self._coo: tuple | None = None
+        self._old_w = self._old_master = None
         #: Pairing counts of the last evaluation (global): paired, unpaired, changed
         self.counts: dict[str, int] = {}
 
     @property
+    def x_ref(self) -> np.ndarray:
+        """Reference positions (m) of the rule's points, ``(npoints, 2)``."""
+        return self.points.x_ref
+
+    @property
+    def weights(self) -> np.ndarray:
+        """Reference arc-length weights (m) of the rule's points, ``(npoints,)``."""
+        return self.points.weights
+
+    @property
     def r(self) -> np.ndarray:
-        """The augmentation ``r`` (Pa/m) at the slave points, ``(npoints,)``, from the
+        """The augmentation ``r`` (Pa/m) at the rule's points, ``(npoints,)``, from the
         law's current parameters."""
-        return self.law.augmentation_coefficient(self._materials, self._h)
+        return self.law.augmentation_coefficient(self._materials, self.points.h)
+
+    @property
+    def segments(self) -> bool:
+        """Whether the Newton system gets segment-to-segment integration (the law's)."""
+        return bool(getattr(self.law, "segments", False))
 
     @property
     def friction(self) -> float | None:
@@ -109,46 +147,28 @@ class SlidingCoupling:
             columns[bc.dof_indices()[0]] = -1
         self.lip = MasterLip(self.cut, self.W, self.master_field, self.rows, columns)
         if self._old_master is None or self._old_master.shape != self.lip.dofs.shape:
-            self._old_slave = np.zeros(self.slave_dofs.shape)
+            self._old_w = np.zeros(columns.size)
             self._old_master = np.zeros(self.lip.dofs.shape)
-        local = np.concatenate([self.slave_dofs, self.lam_dofs], axis=1)
-        self._rows_local = global_dofs(self.W, local)
-        self._columns_local = columns[local]
-        self._merged.clear()
-        self._coo = None
+        self._columns = columns
+        self._blocks.reset()
+        self._integrated = None
 
     # -- evaluation ------------------------------------------------------------------
     def evaluate(self, w) -> tuple[Pairing, PairTerms]:
-        """Pair and evaluate at the state ``w`` (a Function on ``W``); cached for the
-        same values. Collective."""
+        """Pair and evaluate at the state ``w`` (a Function on ``W``) at the rule's
+        points; cached for the same values. Collective."""
         if self._evaluated is not None and np.array_equal(self._evaluated[0], w.x.array):
             return self._evaluated[1], self._evaluated[2]
         lip = self.lip
         lip.refresh(w)
-        m, n = self.slave_dofs.shape
-        u_s = w.x.array[self.slave_dofs].reshape(m, n // 2, 2)
-        x_s = self.x_ref + np.einsum("mi,mid->md", self.phi_s, u_s)
+        x_s = positions(w, self.points)
         pairing = closest_points(lip, x_s, self.radius, only=self._frozen)
-        pieces = np.where(pairing.paired, pairing.piece, 0)
-        curve = lip.curve(pieces, pairing.s)
-        if self.friction is None and not self.complex_step:
-            terms = frictionless_terms(
-                x_s,
-                self.phi_s,
-                self.lam_basis,
-                w.x.array[self.lam_dofs],
-                curve,
-                lip.orientation[pieces],
-                self.weights,
-                self.r,
-                pairing.paired,
-            )
-        else:
-            terms, self.tangential = self._complex_step_terms(w, pairing, pieces, curve)
+        terms, self.tangential = self._terms(w, self.points, x_s, pairing)
         self._evaluated = (w.x.array.copy(), pairing, terms)
         paired = int(pairing.paired.sum())
         changed = 0
         if self._accepted_cells is not None:
+            pieces = np.where(pairing.paired, pairing.piece, 0)
             cells = np.where(pairing.paired, lip.cells[pieces], -1)
             changed = int(np.sum(cells != self._accepted_cells))
         counts = np.array([paired, pairing.piece.size - paired, changed])
@@ -156,36 +176,115 @@ class SlidingCoupling:
         self.counts = dict(zip(("paired", "unpaired", "changed"), map(int, counts), strict=True))
         return pairing, terms
 
-    def _complex_step_terms(self, w, pairing, pieces, curve):
-        """The element of :mod:`~xfem_contact.mechanics.sliding.friction` (Coulomb,
-        or frictionless with ``complex_step``): terms and ``(slip increment,
-        lambda_t, P_t)``."""
-        X3, dddphi = self.lip.third_derivatives(pieces, pairing.s)
+    def integrate(self, w) -> tuple[SlavePoints, Pairing, PairTerms]:
+        """The points, pairing and terms the Newton system gets at ``w``: the
+        segment-to-segment ones, or the rule's (:meth:`evaluate`). Collective."""
+        if not self.segments:
+            return (self.points, *self.evaluate(w))
+        cached = self._integrated
+        if cached is not None and np.array_equal(cached[0], w.x.array):
+            return cached[1:4]
+        self.lip.refresh(w)
+        segments = self._frozen_segments
+        if segments is None:
+            segments = split(self.pieces, w.x.array, self.lip, self.radius)
+        piece, X, weights = self.pieces.rule(segments)
+        points = self._points(self.pieces.cells[piece], X, weights)
+        x_s = positions(w, points)
+        master = np.repeat(segments.master, self.pieces.gauss[0].size)
+        pairing = closest_points(self.lip, x_s, self.radius, only=master)
+        terms, _ = self._terms(w, points, x_s, pairing)
+        motion = None
+        if self._frozen_segments is None and self.split_linearisation:
+            motion = self._split_terms(w, segments)
+        self._integrated = (w.x.array.copy(), points, pairing, terms, motion)
+        return points, pairing, terms
+
+    def _split_terms(self, w, segments: Segments):
+        """The Jacobian block of the split points' motion: at each split point, the
+        integrand's jump (left sub-segment's minus right's, per unit ``t``) times the
+        point's derivative. ``(rows (b, 2 nz), cols (b, nc), values (b, 2 nz, nc),
+        pairs of global cells)``, None without splits."""
+        lip = self.lip
+        k, grad = split_gradient(self.pieces, w.x.array, lip, segments)
+        if k.size == 0:
+            return None
+        piece = segments.piece[k]
+        X, speed = self.pieces.at(piece, segments.t0[k])
+        cells = self.pieces.cells[piece]
+        points = self._points(np.tile(cells, 2), np.tile(X, (2, 1)), np.tile(speed, 2))
+        x_s = positions(w, points)
+        sides = np.concatenate([segments.master[k - 1], segments.master[k]])
+        pairing = closest_points(lip, x_s, self.radius, only=sides)
+        terms, _ = self._terms(w, points, x_s, pairing)
+        b = k.size
+        index = np.concatenate(
+            [self._columns[self._local(points)], self._indices(pairing, lip.columns)], axis=1
+        )
+        rows = np.concatenate([index[:b], index[b:]], axis=1)
+        jump = np.concatenate([terms.residual[:b], -terms.residual[b:]], axis=1)
+        source = segments.start_master[k]
+        cols = np.concatenate([self._columns[points.slave_dofs[:b]], lip.columns[source]], axis=1)
+        masters = np.where(sides >= 0, lip.cells[np.maximum(sides, 0)], -1)
+        tdim = self.cut.mesh.topology.dim
+        slave = self.cut.mesh.topology.index_map(tdim).local_to_global(cells)
+        pairs = {
+            ("split", a, c)
+            for r in (slave, masters[:b], masters[b:])
+            for c_cells in (slave, lip.cells[source])
+            for a, c in zip(r.tolist(), c_cells.tolist(), strict=True)
+        }
+        return rows, cols, jump[:, :, None] * grad[:, None, :], pairs
+
+    def _terms(self, w, points: SlavePoints, x_s, pairing: Pairing):
+        """The hybrid element's terms at ``points`` and the tangential state (None
+        when frictionless)."""
+        lip = self.lip
+        pieces = np.where(pairing.paired, pairing.piece, 0)
+        curve = lip.curve(pieces, pairing.s)
+        r = self.law.augmentation_coefficient(self._materials, points.h)
+        if self.friction is None and not self.complex_step:
+            terms = frictionless_terms(
+                x_s,
+                points.phi_s,
+                points.lam_basis,
+                w.x.array[points.lam_dofs],
+                curve,
+                lip.orientation[pieces],
+                points.weights,
+                r,
+                pairing.paired,
+            )
+            return terms, None
+        X3, dddphi = lip.third_derivatives(pieces, pairing.s)
         data = PointData(
-            self.x_ref,
-            self.phi_s,
-            self.lam_basis,
-            self.weights,
-            self.r,
-            self.lip.orientation[pieces],
+            points.x_ref,
+            points.phi_s,
+            points.lam_basis,
+            points.weights,
+            r,
+            lip.orientation[pieces],
             ((*curve.geometry, X3), (curve.phi, curve.dphi, curve.ddphi, dddphi)),
-            (self._old_slave, self._old_master[pieces]),
+            (self._old_w[points.slave_dofs], self._old_master[pieces]),
             pairing.paired,
         )
         z = np.concatenate(
-            [w.x.array[self.slave_dofs], w.x.array[self.lam_dofs], self.lip.values[pieces]],
+            [w.x.array[points.slave_dofs], w.x.array[points.lam_dofs], lip.values[pieces]],
             axis=1,
         )
         return friction_terms(z, data, self.friction)
 
     def begin_step(self, w) -> None:
-        """At the start of a solve: with ``update="step"``, pair now and keep the
-        master pieces over the solve. Collective."""
+        """At the start of a solve: with ``update="step"``, pair (and split) now and
+        keep the master pieces (and split points) over the solve. Collective."""
         if self.update_mode == "step":
-            self._frozen = None
+            self._frozen = self._frozen_segments = None
             pairing, _ = self.evaluate(w)
             self._frozen = pairing.piece.copy()
-            self._evaluated = None
+            self._evaluated = self._integrated = None
+            if self.segments:
+                self.lip.refresh(w)
+                self._frozen_segments = split(self.pieces, w.x.array, self.lip, self.radius)
 
     def accept(self, w) -> None:
         """The end of an accepted load step: pairs whose master cell changes are
@@ -193,8 +292,9 @@ class SlidingCoupling:
         pairing, _ = self.evaluate(w)
         pieces = np.where(pairing.paired, pairing.piece, 0)
         self._accepted_cells = np.where(pairing.paired, self.lip.cells[pieces], -1)
-        self._old_slave = w.x.array[self.slave_dofs]  # slips are measured from here
+        self._old_w = w.x.array.copy()  # slips are measured from here
         self._old_master = self.lip.gather(w)
+        self._integrated = None
 
     def unpaired_points(self, w) -> np.ndarray:
         """Reference coordinates (m) of the unpaired slave points of all processes,
@@ -209,11 +309,16 @@ class SlidingCoupling:
         pieces = np.where(pairing.paired, pairing.piece, 0)
         return np.where(pairing.paired[:, None], master[pieces], -1)
 
+    def _local(self, points: SlavePoints) -> np.ndarray:
+        """Local dofs of ``W`` of each point's slave cell: displacement, multiplier."""
+        return np.concatenate([points.slave_dofs, points.lam_dofs], axis=1)
+
     def add_residual(self, w, b: PETSc.Vec) -> None:
         """Add the hybrid elements' residual at ``w`` to ``b`` (a vector of ``W``,
         global numbering; before the Dirichlet rows are set). Collective."""
-        pairing, terms = self.evaluate(w)
-        rows = np.concatenate([self._rows_local, self._indices(pairing, self.lip.dofs)], axis=1)
+        points, pairing, terms = self.integrate(w)
+        slave = global_dofs(self.W, self._local(points))
+        rows = np.concatenate([slave, self._indices(pairing, self.lip.dofs)], axis=1)
         keep = rows >= 0
         b.setValues(
             rows[keep].astype(PETSc.IntType), terms.residual[keep], addv=PETSc.InsertMode.ADD_VALUES
@@ -224,48 +329,27 @@ class SlidingCoupling:
     def add_jacobian(self, w, J: PETSc.Mat) -> None:
         """Add the hybrid elements' Jacobian at ``w`` to ``J`` (reduced numbering, not
         yet scaled), merging new slave-master pairs into its pattern. Collective."""
-        pairing, terms = self.evaluate(w)
+        points, pairing, terms = self.integrate(w)
         cols = np.concatenate(
-            [self._columns_local, self._indices(pairing, self.lip.columns)], axis=1
+            [self._columns[self._local(points)], self._indices(pairing, self.lip.columns)], axis=1
         )
-        key = tuple(np.where(pairing.paired, pairing.piece, -1))
-        if self._coo is None or self._coo[0] != key:
-            if self._coo is not None:
-                self._coo[1].destroy()
-            nz = cols.shape[1]
-            Ic = np.repeat(cols, nz, axis=1).ravel().astype(PETSc.IntType)
-            Jc = np.tile(cols, (1, nz)).ravel().astype(PETSc.IntType)
-            C = PETSc.Mat().create(comm=J.getComm())
-            C.setSizes(J.getSizes())
-            C.setType(PETSc.Mat.Type.AIJ)
-            C.setPreallocationCOO(Ic, Jc)
-            self._coo = (key, C)
-        C = self._coo[1]
-        C.setValuesCOO(terms.jacobian.ravel(), addv=PETSc.InsertMode.INSERT_VALUES)
-        C.assemble()
+        blocks = [(cols, cols, terms.jacobian)]
+        master = np.where(pairing.paired, pairing.piece, -1)
+        key = [points.cells, master]
+        tdim = self.cut.mesh.topology.dim
+        to_global = self.cut.mesh.topology.index_map(tdim).local_to_global
+        slave_cells = to_global(points.cells)
         pieces = np.where(pairing.paired, pairing.piece, 0)
-        pairs = set(
-            zip(
-                self.slave_cells[pairing.paired].tolist(),
-                self.lip.cells[pieces][pairing.paired].tolist(),
-                strict=True,
-            )
-        )
-        new = not pairs <= self._merged
-        if self.comm.allreduce(new, op=MPI.LOR):
-            self._merged |= pairs
-            J.axpy(1.0, C, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-        else:
-            J.axpy(1.0, C, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        paired = pairing.paired
+        masters = self.lip.cells[pieces][paired].tolist()
+        pairs = set(zip(slave_cells[paired].tolist(), masters, strict=True))
+        motion = self._integrated[-1] if self.segments else None
+        if motion is not None:
+            blocks.append(motion[:3])
+            key += [np.asarray(motion[0].shape), motion[0].ravel(), motion[1].ravel()]
+            pairs |= motion[3]
+        self._blocks.add_to(J, np.concatenate(key).tobytes(), blocks, pairs)
 
     def destroy(self) -> None:
         """Destroy the COO matrix. Collective."""
-        if self._coo is not None:
-            self._coo[1].destroy()
-            self._coo = None
-
-
-def _flat(dofs: np.ndarray) -> np.ndarray:
-    """``(m, nodes, components)`` dofs as ``(m, nodes x components)``, node by node
-    (explicit sizes: a process may hold no point of the interface)."""
-    return dofs.reshape(dofs.shape[0], dofs.shape[1] * dofs.shape[2])
+        self._blocks.destroy()
