@@ -31,25 +31,35 @@ from xfem_contact.cases.rotation import pressure_errors, rotating_annulus_proble
 from xfem_contact.io.progress import progress
 from xfem_contact.solvers.newton import NewtonFailure
 
-ANGLES = {"0": (0.0, 1), "pi/4": (np.pi / 4, 2), "pi/2": (np.pi / 2, 4), "0.3": (0.3, 1)}
+ANGLES = {
+    "0": (0.0, 1),
+    "pi/4": (np.pi / 4, 2),
+    "pi/2": (np.pi / 2, 4),
+    "0.3": (0.3, 4),
+    "1": (1.0, 4),
+}
+#: Angles that map the mesh onto itself (segmentation changes nothing there)
+ALIGNED = ("0", "pi/4", "pi/2")
 RESULTS = pathlib.Path(__file__).parent / "results"
 
 
-def small_sliding_time(n_radial, n_angular, degree) -> float:
-    """Wall time (s) of the small-sliding case-3 solve at alpha = 0 (the baseline)."""
+def small_sliding_time(n_radial, n_angular, degree) -> tuple[float, float]:
+    """Wall time (s) of the small-sliding case-3 solve at alpha = 0 (the baseline),
+    and of one of its Newton iterations."""
     start = time.perf_counter()
     problem = annulus_problem(n_radial, n_angular, degree, 2 if degree == 2 else 1)
-    problem.solve()
-    return time.perf_counter() - start
+    report = problem.solve()
+    return time.perf_counter() - start, report.total_time / max(report.iterations, 1)
 
 
-def run(n_radial, n_angular, degree, angle_name) -> dict:
+def run(n_radial, n_angular, degree, angle_name, segments) -> dict:
     alpha, steps = ANGLES[angle_name]
     start = time.perf_counter()
-    problem = rotating_annulus_problem(n_radial, degree, alpha, n_angular)
+    problem = rotating_annulus_problem(n_radial, degree, alpha, n_angular, segments=segments)
     row = {"n": n_radial, "n_angular": n_angular, "degree": degree, "alpha": angle_name}
+    row["segments"] = segments
     row["dofs"] = problem.space.dof_counts().total
-    iterations, ends = [], []
+    iterations, ends, solve_time = [], [], 0.0
     try:
         for k in range(1, steps + 1):
             problem.loads.set_time(k / steps)
@@ -57,11 +67,13 @@ def run(n_radial, n_angular, degree, angle_name) -> dict:
             problem.accept_step()
             iterations.append(report.iterations)
             ends.append(report.residuals[-3:])
+            solve_time += report.total_time
     except NewtonFailure as failure:
         row["failure"] = str(failure).splitlines()[0]
     row["time_s"] = time.perf_counter() - start
     row["newton_per_step"] = iterations
     row["last_residuals"] = ends
+    row["iteration_s"] = solve_time / max(sum(iterations), 1)
     if "failure" not in row:
         row |= pressure_errors(problem)
     return row
@@ -69,21 +81,22 @@ def run(n_radial, n_angular, degree, angle_name) -> dict:
 
 def table(rows) -> str:
     lines = [
-        "| mesh | degree | alpha | dofs | error (same model) | error (Lame) | oscillation "
-        "| Newton per step | time (s) | x small sliding |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| mesh | degree | alpha | segments | dofs | error (same model) | error (Lame) "
+        "| oscillation | Newton per step | s per iteration | x small sliding | time (s) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
+        head = (
+            f"| {r['n']}x{r['n_angular']} | {r['degree']} | {r['alpha']} | "
+            f"{'yes' if r['segments'] else 'no'} | {r['dofs']} |"
+        )
         if "failure" in r:
-            lines.append(
-                f"| {r['n']}x{r['n_angular']} | {r['degree']} | {r['alpha']} | "
-                f"{r['dofs']} | failed: {r['failure']} | | | | | |"
-            )
+            lines.append(f"{head} failed: {r['failure']} | | | {r['newton_per_step']} | | | |")
             continue
         lines.append(
-            f"| {r['n']}x{r['n_angular']} | {r['degree']} | {r['alpha']} | {r['dofs']} | "
-            f"{r['error']:.2e} | {r['lame_error']:.2e} | {r['oscillation']:.1e} | "
-            f"{r['newton_per_step']} | {r['time_s']:.2f} | {r['ratio']:.2f} |"
+            f"{head} {r['error']:.2e} | {r['lame_error']:.2e} | {r['oscillation']:.1e} | "
+            f"{r['newton_per_step']} | {r['iteration_s']:.3f} | {r['iteration_ratio']:.2f} | "
+            f"{r['time_s']:.2f} |"
         )
     return "\n".join(lines)
 
@@ -94,49 +107,68 @@ def rates(rows) -> list[str]:
     for family in ("4n", "n"):
         for degree in (1, 2):
             for angle in ANGLES:
-                chosen = [
-                    r
-                    for r in rows
-                    if r["degree"] == degree
-                    and r["alpha"] == angle
-                    and "error" in r
-                    and (r["n_angular"] == 4 * r["n"]) == (family == "4n")
-                ]
-                for a, b in zip(chosen, chosen[1:], strict=False):
-                    rate = np.log(a["error"] / b["error"]) / np.log(b["n"] / a["n"])
-                    out.append(
-                        f"degree {degree}, alpha {angle}, {family}: n {a['n']} -> "
-                        f"{b['n']}: rate {rate:.2f}"
-                    )
+                for segments in (True, False):
+                    chosen = [
+                        r
+                        for r in rows
+                        if r["degree"] == degree
+                        and r["alpha"] == angle
+                        and r["segments"] == segments
+                        and "error" in r
+                        and (r["n_angular"] == 4 * r["n"]) == (family == "4n")
+                    ]
+                    for a, b in zip(chosen, chosen[1:], strict=False):
+                        rate = np.log(a["error"] / b["error"]) / np.log(b["n"] / a["n"])
+                        out.append(
+                            f"degree {degree}, alpha {angle}, segments "
+                            f"{'yes' if segments else 'no'}, {family}: n {a['n']} -> "
+                            f"{b['n']}: rate {rate:.2f}"
+                        )
     return out
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tiny", action="store_true", help="n = 10, 20 only (a quick check)")
+    parser.add_argument("--meshes", help="e.g. 10x40,20x80 (n radial x n around)")
+    parser.add_argument("--degrees", default="1,2")
+    parser.add_argument("--angles", default=",".join(ANGLES), help=f"of {list(ANGLES)}")
     parser.add_argument("--json", default=str(RESULTS / "rotating_inclusion.json"))
     parser.add_argument("--no-progress", action="store_true")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
-    meshes = (
-        [(10, 40), (20, 80)]
-        if args.tiny
-        else [(10, 40), (20, 80), (40, 160), (20, 20), (40, 40), (80, 80)]
-    )
-    cases = [(m, d, a) for m in meshes for d in (1, 2) for a in ANGLES]
+    if args.meshes:
+        meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
+    elif args.tiny:
+        meshes = [(10, 40), (20, 80)]
+    else:
+        meshes = [(10, 40), (20, 80), (40, 160), (20, 20), (40, 40), (80, 80)]
+    degrees = [int(d) for d in args.degrees.split(",")]
+    angles = args.angles.split(",")
+    cases = [
+        (m, d, a, s)
+        for m in meshes
+        for d in degrees
+        for a in angles
+        for s in ((True,) if a in ALIGNED else (True, False))
+    ]
     baselines, rows = {}, []
-    for (n, nc), degree, angle in progress(cases, "case 3 rotated", not args.no_progress, comm):
+    for (n, nc), degree, angle, segments in progress(
+        cases, "case 3 rotated", not args.no_progress, comm
+    ):
         if (n, nc, degree) not in baselines:
             baselines[(n, nc, degree)] = small_sliding_time(n, nc, degree)
-        row = run(n, nc, degree, angle)
-        row["small_sliding_time_s"] = baselines[(n, nc, degree)]
+        row = run(n, nc, degree, angle, segments)
+        row["small_sliding_time_s"], row["small_sliding_iteration_s"] = baselines[(n, nc, degree)]
         row["ratio"] = row["time_s"] / row["small_sliding_time_s"]
+        row["iteration_ratio"] = row["iteration_s"] / row["small_sliding_iteration_s"]
         rows.append(row)
         if comm.rank == 0 and "error" in row:
             print(
-                f"{n}x{nc} P{degree} alpha {angle}: error {row['error']:.3e}, oscillation "
-                f"{row['oscillation']:.2e}, Newton {row['newton_per_step']}, "
-                f"{row['time_s']:.2f} s ({row['ratio']:.2f} x small sliding)",
+                f"{n}x{nc} P{degree} alpha {angle} segments {segments}: error "
+                f"{row['error']:.3e}, oscillation {row['oscillation']:.2e}, Newton "
+                f"{row['newton_per_step']}, {row['iteration_s']:.3f} s per iteration "
+                f"({row['iteration_ratio']:.2f} x small sliding), {row['time_s']:.2f} s",
                 flush=True,
             )
     if comm.rank == 0:

@@ -128,7 +128,7 @@ class SlidingContact(ContactLaw):
         master foot (unpaired points: the distance to the lip, beyond the search
         radius), ``paired`` (1.0 or 0.0); tangential entries zero. Collective."""
         coupling = self.coupling(ctx)
-        pairing, terms = coupling.evaluate(w)
+        pairing, terms = coupling.evaluate(w, jacobian=False)
         zero = np.zeros(pairing.piece.size)
         slip, lam_t, P_t = coupling.tangential if self.tangential else (zero, zero, zero)
         gap = np.where(pairing.paired, terms.gap, pairing.distance)

@@ -21,6 +21,7 @@ from xfem_contact.fem.evaluation import rule_cells
 from xfem_contact.mechanics.sliding.blocks import BlockMatrix
 from xfem_contact.mechanics.sliding.element import PairTerms, frictionless_terms
 from xfem_contact.mechanics.sliding.friction import PointData
+from xfem_contact.mechanics.sliding.friction import residual as friction_residual
 from xfem_contact.mechanics.sliding.friction import terms as friction_terms
 from xfem_contact.mechanics.sliding.lips import MasterLip, global_dofs
 from xfem_contact.mechanics.sliding.points import PointMaker, SlavePoints, positions
@@ -154,16 +155,19 @@ class SlidingCoupling:
         self._integrated = None
 
     # -- evaluation ------------------------------------------------------------------
-    def evaluate(self, w) -> tuple[Pairing, PairTerms]:
+    def evaluate(self, w, jacobian: bool = True) -> tuple[Pairing, PairTerms]:
         """Pair and evaluate at the state ``w`` (a Function on ``W``) at the rule's
-        points; cached for the same values. Collective."""
-        if self._evaluated is not None and np.array_equal(self._evaluated[0], w.x.array):
-            return self._evaluated[1], self._evaluated[2]
+        points (``jacobian`` False: its ``jacobian`` may be None); cached for the same
+        values. Collective."""
+        cached = self._evaluated
+        if cached is not None and np.array_equal(cached[0], w.x.array):
+            if cached[2].jacobian is not None or not jacobian:
+                return cached[1], cached[2]
         lip = self.lip
         lip.refresh(w)
         x_s = positions(w, self.points)
         pairing = closest_points(lip, x_s, self.radius, only=self._frozen)
-        terms, self.tangential = self._terms(w, self.points, x_s, pairing)
+        terms, self.tangential = self._terms(w, self.points, x_s, pairing, jacobian)
         self._evaluated = (w.x.array.copy(), pairing, terms)
         paired = int(pairing.paired.sum())
         changed = 0
@@ -188,11 +192,10 @@ class SlidingCoupling:
         segments = self._frozen_segments
         if segments is None:
             segments = split(self.pieces, w.x.array, self.lip, self.radius)
-        piece, X, weights = self.pieces.rule(segments)
-        points = self._points(self.pieces.cells[piece], X, weights)
+        segment, X, weights = self.pieces.rule(segments)
+        points = self._points(self.pieces.cells[segments.piece[segment]], X, weights)
         x_s = positions(w, points)
-        master = np.repeat(segments.master, self.pieces.gauss[0].size)
-        pairing = closest_points(self.lip, x_s, self.radius, only=master)
+        pairing = closest_points(self.lip, x_s, self.radius, only=segments.master[segment])
         terms, _ = self._terms(w, points, x_s, pairing)
         motion = None
         if self._frozen_segments is None and self.split_linearisation:
@@ -216,7 +219,7 @@ class SlidingCoupling:
         x_s = positions(w, points)
         sides = np.concatenate([segments.master[k - 1], segments.master[k]])
         pairing = closest_points(lip, x_s, self.radius, only=sides)
-        terms, _ = self._terms(w, points, x_s, pairing)
+        terms, _ = self._terms(w, points, x_s, pairing, jacobian=False)
         b = k.size
         index = np.concatenate(
             [self._columns[self._local(points)], self._indices(pairing, lip.columns)], axis=1
@@ -236,9 +239,9 @@ class SlidingCoupling:
         }
         return rows, cols, jump[:, :, None] * grad[:, None, :], pairs
 
-    def _terms(self, w, points: SlavePoints, x_s, pairing: Pairing):
-        """The hybrid element's terms at ``points`` and the tangential state (None
-        when frictionless)."""
+    def _terms(self, w, points: SlavePoints, x_s, pairing: Pairing, jacobian: bool = True):
+        """The hybrid element's terms at ``points`` (``jacobian`` False: without their
+        Jacobian) and the tangential state (None when frictionless)."""
         lip = self.lip
         pieces = np.where(pairing.paired, pairing.piece, 0)
         curve = lip.curve(pieces, pairing.s)
@@ -254,6 +257,7 @@ class SlidingCoupling:
                 points.weights,
                 r,
                 pairing.paired,
+                jacobian,
             )
             return terms, None
         X3, dddphi = lip.third_derivatives(pieces, pairing.s)
@@ -272,14 +276,18 @@ class SlidingCoupling:
             [w.x.array[points.slave_dofs], w.x.array[points.lam_dofs], lip.values[pieces]],
             axis=1,
         )
-        return friction_terms(z, data, self.friction)
+        if jacobian:
+            return friction_terms(z, data, self.friction)
+        R, (g, s_t, lam_n, lam_t, P_n, P_t) = friction_residual(z, data, self.friction)
+        terms = PairTerms(R, None, np.where(pairing.paired, g, np.nan), lam_n, P_n)
+        return terms, (s_t, lam_t, P_t)
 
     def begin_step(self, w) -> None:
         """At the start of a solve: with ``update="step"``, pair (and split) now and
         keep the master pieces (and split points) over the solve. Collective."""
         if self.update_mode == "step":
             self._frozen = self._frozen_segments = None
-            pairing, _ = self.evaluate(w)
+            pairing, _ = self.evaluate(w, jacobian=False)
             self._frozen = pairing.piece.copy()
             self._evaluated = self._integrated = None
             if self.segments:
@@ -289,7 +297,7 @@ class SlidingCoupling:
     def accept(self, w) -> None:
         """The end of an accepted load step: pairs whose master cell changes are
         counted from here. Collective."""
-        pairing, _ = self.evaluate(w)
+        pairing, _ = self.evaluate(w, jacobian=False)
         pieces = np.where(pairing.paired, pairing.piece, 0)
         self._accepted_cells = np.where(pairing.paired, self.lip.cells[pieces], -1)
         self._old_w = w.x.array.copy()  # slips are measured from here
@@ -299,7 +307,7 @@ class SlidingCoupling:
     def unpaired_points(self, w) -> np.ndarray:
         """Reference coordinates (m) of the unpaired slave points of all processes,
         ``(k, 2)``. Collective."""
-        pairing, _ = self.evaluate(w)
+        pairing, _ = self.evaluate(w, jacobian=False)
         return np.concatenate(self.comm.allgather(self.x_ref[~pairing.paired]))
 
     # -- assembly --------------------------------------------------------------------

@@ -90,7 +90,7 @@ def gap_derivatives(x_s, phi_s, curve, orientation):
 
 
 def frictionless_terms(
-    x_s, phi_s, lam_basis, lam_values, curve, orientation, weights, r, paired
+    x_s, phi_s, lam_basis, lam_values, curve, orientation, weights, r, paired, jacobian=True
 ) -> PairTerms:
     """The hybrid element's terms at ``m`` slave points, unknowns ordered ``(a, l, b)``.
 
@@ -104,6 +104,7 @@ def frictionless_terms(
         weights: Reference arc-length weights (m), ``(m,)``.
         r: Augmentation coefficients (Pa/m), ``(m,)``.
         paired: Which points have a master foot, ``(m,)``; the others carry no contact.
+        jacobian: False: the residual and state only (``jacobian`` None).
     """
     m, nn = phi_s.shape
     nl = lam_basis.shape[1]
@@ -120,6 +121,8 @@ def frictionless_terms(
     L = np.zeros((m, nz))
     L[:, 2 * nn : 2 * nn + nl] = lam_basis
     residual = weights[:, None] * (P[:, None] * grad - ((lam - P) / r)[:, None] * L)
+    if not jacobian:
+        return PairTerms(residual, None, np.where(paired, g, np.nan), lam, P)
     K = np.where(
         contact[:, None, None],
         np.einsum("mi,mj->mij", grad, L)

@@ -44,16 +44,26 @@ class Pairing(typing.NamedTuple):
 
 def _newton(lip, x: np.ndarray, pieces: np.ndarray, s: np.ndarray, iterations: int = 30):
     """Newton on ``f(s) = 0`` for each (point, piece), started from ``s``; the
-    parameter is kept in ``[-0.5, 1.5]`` (the polynomial piece extended a little)."""
+    parameter is kept in ``[-0.5, 1.5]`` (the polynomial piece extended a little).
+    Only the pairs not yet converged are iterated on; a pair held at a bound twice
+    in a row stays there (its foot is off the piece)."""
+    s = s.copy()
+    active = np.arange(s.size)
+    bound = np.zeros(s.size, dtype=bool)
     for _ in range(iterations):
-        c = lip.curve(pieces, s)
-        r = x - c.x
+        if active.size == 0:
+            break
+        c = lip.curve(pieces[active], s[active])
+        r = x[active] - c.x
         f = -np.sum(r * c.t, axis=1)
         df = np.sum(c.t * c.t, axis=1) - np.sum(r * c.t2, axis=1)
         step = np.where(df > 0.0, f / np.where(df > 0.0, df, 1.0), 0.0)
-        s = np.clip(s - step, -0.5, 1.5)
-        if np.all(np.abs(step) < 1e-14):
-            break
+        new = s[active] - step
+        held = (new < -0.5) | (new > 1.5)
+        s[active] = np.clip(new, -0.5, 1.5)
+        keep = (np.abs(step) >= 1e-14) & ~(held & bound[active])
+        bound[active] = held
+        active = active[keep]
     return s
 
 

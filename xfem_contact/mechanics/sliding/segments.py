@@ -34,6 +34,10 @@ from xfem_contact.mechanics.sliding.projection import closest_points
 SAMPLES = np.linspace(0.0, 1.0, 5)
 #: Sub-segments shorter than this (in ``t``) are dropped (two roots at one point)
 MIN_LENGTH = 1e-12
+#: Sub-segments shorter than this (in ``t``; between the two crossings of one master
+#: corner) get one point: the midpoint rule's error, ``SHORT^3 / 24`` of the piece's
+#: integrand scale, is below round-off of the Newton residual
+SHORT = 1e-4
 
 
 class Segments(typing.NamedTuple):
@@ -120,15 +124,24 @@ class SlavePieces:
         return X, np.linalg.norm(np.einsum("mdk,mk->md", J, dX), axis=1)
 
     def rule(self, segments: Segments):
-        """Gauss points of the sub-segments: ``(piece (m,), X (m, 2) reference
-        coordinates in the piece's cell, weights (m,) reference arc length (m))``,
-        sub-segment by sub-segment."""
+        """Gauss points of the sub-segments: ``(segment (m,) index into segments,
+        X (m, 2) reference coordinates in the piece's cell, weights (m,) reference
+        arc length (m))``. Sub-segments shorter than :data:`SHORT` get the midpoint
+        rule."""
         s, w_hat = self.gauss
         length = segments.t1 - segments.t0
-        t = (segments.t0[:, None] + length[:, None] * s[None]).ravel()
-        pieces = np.repeat(segments.piece, s.size)
-        X, speed = self.at(pieces, t)
-        return pieces, X, (length[:, None] * w_hat[None]).ravel() * speed
+        short = length < SHORT
+        full = np.flatnonzero(~short)
+        segment = np.concatenate([np.repeat(full, s.size), np.flatnonzero(short)])
+        t = np.concatenate(
+            [
+                (segments.t0[full, None] + length[full, None] * s[None]).ravel(),
+                segments.t0[short] + 0.5 * length[short],
+            ]
+        )
+        w = np.concatenate([(length[full, None] * w_hat[None]).ravel(), length[short]])
+        X, speed = self.at(segments.piece[segment], t)
+        return segment, X, w * speed
 
     def whole(self) -> Segments:
         """Every piece unsplit, without master pieces (the cut's own rule)."""
@@ -215,6 +228,10 @@ def split(pieces: SlavePieces, values: np.ndarray, lip, radius: float) -> Segmen
     master = np.where(corner & ~before & later, np.roll(master, -1), master)
     # past a crossing into a piece the foot is on it (no tie near a concave corner)
     master = np.where(entering & (source >= 0) & (master >= 0), source, master)
+    # between the two crossings of one corner: the previous sub-segment's master
+    # (its foot stays on that piece or its end; whichever way the corner turns)
+    short = (t1 - t0 < SHORT) & (master >= 0)
+    master = np.where(short & before, np.roll(master, 1), master)
     return Segments(piece, t0, t1, master, source, end)
 
 
