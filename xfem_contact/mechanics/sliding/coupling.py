@@ -2,13 +2,17 @@
 
 :class:`SlidingCoupling` is what a large-sliding law hands the Newton solver
 (:meth:`~xfem_contact.mechanics.laws.base.InterfaceLaw.coupling`): at every residual
-evaluation it pairs the slave points with the deformed master lip
+evaluation it splits the slave pieces at the master-piece ends their feet cross
+(:mod:`~xfem_contact.mechanics.sliding.segments`), pairs the sub-segments' Gauss
+points with the deformed master lip
 (:mod:`~xfem_contact.mechanics.sliding.projection`) and adds the hybrid element terms
 (:mod:`~xfem_contact.mechanics.sliding.element`) to the residual of the mixed space,
 by global dof (a master dof may live on another process: PETSc sends it there); at
 every Jacobian it adds their matrix, in the reduced numbering, through a COO matrix
 whose pattern (slave cell x master cell pairs) is merged into the Jacobian's when a
-pair appears that the Jacobian has not held yet. SI units (m, Pa).
+pair appears that the Jacobian has not held yet
+(:mod:`~xfem_contact.mechanics.sliding.blocks`), with the motion of the split points.
+SI units (m, Pa).
 """
 
 from __future__ import annotations

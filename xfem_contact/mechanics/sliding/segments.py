@@ -123,11 +123,10 @@ class SlavePieces:
         J = self.maps.jacobian(self.cells[pieces], X)[:, :2, :]
         return X, np.linalg.norm(np.einsum("mdk,mk->md", J, dX), axis=1)
 
-    def rule(self, segments: Segments):
-        """Gauss points of the sub-segments: ``(segment (m,) index into segments,
-        X (m, 2) reference coordinates in the piece's cell, weights (m,) reference
-        arc length (m))``. Sub-segments shorter than :data:`SHORT` get the midpoint
-        rule."""
+    def parameters(self, segments: Segments):
+        """The sub-segments' Gauss points on their pieces: ``(segment (m,) index into
+        segments, t (m,), weights (m,) in t)``. Sub-segments shorter than
+        :data:`SHORT` get the midpoint rule."""
         s, w_hat = self.gauss
         length = segments.t1 - segments.t0
         short = length < SHORT
@@ -140,6 +139,13 @@ class SlavePieces:
             ]
         )
         w = np.concatenate([(length[full, None] * w_hat[None]).ravel(), length[short]])
+        return segment, t, w
+
+    def rule(self, segments: Segments):
+        """Gauss points of the sub-segments (see :meth:`parameters`): ``(segment (m,),
+        X (m, 2) reference coordinates in the piece's cell, weights (m,) reference arc
+        length (m))``."""
+        segment, t, w = self.parameters(segments)
         X, speed = self.at(segments.piece[segment], t)
         return segment, X, w * speed
 
