@@ -148,11 +148,46 @@ def test_several_cracks_share_one_body(change, start):
     assert str(error.value).startswith(start) and "\n" not in str(error.value)
 
 
-def test_no_cracks_with_interfaces_for_now():
-    data = edge_crack()
-    data["interfaces"] = [{"shape": "circle", "centre": [0.5, 0.5], "radius": 0.1}]
-    with pytest.raises(NotImplementedError, match=r"^cracks: a crack together with"):
-        load_scene(data)
+def with_inclusion(**interface) -> dict:
+    """The edge-crack plate (crack at y = 0.5013) with a stiff bonded circular inclusion."""
+    data = edge_crack(points=[[-0.1, 0.5013], [0.41, 0.5013]], rings=[[0.12, 0.25]])
+    data["materials"]["stiff"] = {"E": 2100e9, "nu": 0.3}
+    circle = {"shape": "circle", "centre": [0.5013, 1.5013], "radius": 0.2}
+    data["interfaces"] = [circle | {"law": "bonded", "inside": "stiff", "name": "inc"}]
+    data["interfaces"][0].update(interface)
+    return data
+
+
+INTERFACE_KEYS = {
+    "outside": ({"outside": "stiff"}, "interfaces[0].outside: 'stiff': the cracks lie in"),
+    "kinematics": ({"kinematics": "large"}, "interfaces[0].kinematics: 'large': with cracks"),
+    "name": ({"name": "crack"}, "interfaces[0].name: 'crack' names a crack too"),
+}
+
+
+@pytest.mark.parametrize("change, start", INTERFACE_KEYS.values(), ids=INTERFACE_KEYS)
+def test_interfaces_among_cracks_share_the_body(change, start):
+    with pytest.raises(ValueError) as error:
+        load_scene(with_inclusion(**change))
+    assert str(error.value).startswith(start) and "\n" not in str(error.value)
+
+
+def test_crack_and_interface_run(tmp_path, capsys):
+    """A crack and a closed interface in one scene: K of the crack, the interface's
+    samples; an interface the crack enters: exit 2, one line naming both."""
+    path = tmp_path / "scene.toml"
+    path.write_text(to_toml(with_inclusion()))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    (tip,) = summary["cracks"]["crack"]["tips"]
+    assert np.allclose(tip["position"], [0.41, 0.5013])
+    assert summary["effects"]["interfaces"] == ["crack", "inc"]
+    assert "inc" in summary["interfaces"]
+    path.write_text(to_toml(with_inclusion(centre=[0.3, 0.5013], radius=0.15)))
+    assert cli.main(["run", str(path), "--out", str(tmp_path / "out2"), "--quiet"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    start = f"error: {path}: cracks[0]: crack 'crack' enters the inside of interface 'inc'"
+    assert len(err) == 1 and err[0].startswith(start), err
 
 
 def test_two_cracks_run_K_and_lips_per_crack(tmp_path):

@@ -22,6 +22,7 @@ from xfem_contact.geometry.crack import TIP
 from xfem_contact.geometry.crack_paths import arc, polyline
 from xfem_contact.mechanics.fracture import TipIntegrals
 from xfem_contact.mechanics.fracture.growth import grow
+from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.problem import Problem
 
 COMM = MPI.COMM_WORLD
@@ -128,23 +129,38 @@ def test_crossing_and_near_cracks_are_refused(mesh):
     with pytest.raises(ValueError, match="touching or crossing cracks are not handled"):
         CutMesh(mesh, {"a": pa, "c": near[0]}, 2, tangent={"a": sa, "c": near[1]})
     circle = lambda x: np.hypot(x[0] - 1.0, x[1] - 1.0) - 0.3  # noqa: E731
-    with pytest.raises(ValueError, match=r"^tangent: no psi for \['inclusion'\]"):
+    with pytest.raises(ValueError, match=r"^tangent: several cracks take a mapping"):
         CutMesh(mesh, {"a": pa, "inclusion": circle}, 2, tangent={"a": sa})
+    around = lambda x: np.hypot(x[0] + 0.2, x[1] + 0.6) - 1.5  # noqa: E731
+    with pytest.raises(ValueError, match=r"^levelset: crack 'a' enters the inside of interf"):
+        CutMesh(mesh, {"a": pa, "inclusion": around}, 2, tangent={"a": sa, "inclusion": None})
 
 
 # -- mechanics: two collinear cracks of half length A centred at (+-XC, Y0) ---------------
 A, XC, Y0, W = 0.4, 1.0, 0.0271, 2.0
+
+
+def CIRCLE(x):
+    """An inclusion of radius 0.5 m left of the crack at XC (1.3 m between them)."""
+    return np.hypot(x[0] + 1.2013, x[1] - 0.0187) - 0.5
+
+
 RINGS = [(0.15, 0.35)]
 
 
-def plate(centres, law="free", tip_radius=0.25, n=32):
+def plate(centres, law="free", tip_radius=0.25, n=32, inclusion=None):
     """The plate of half width W (crossed triangles: mirror symmetric about x = 0) with
-    horizontal cracks at ``centres``, pulled by 1 Pa on top and bottom; solved."""
+    horizontal cracks at ``centres``, pulled by 1 Pa on top and bottom; solved. With an
+    ``inclusion`` material: the circle :data:`CIRCLE` of it, named ``inc``."""
     mesh = square(n, W, dolfinx.mesh.DiagonalType.crossed)
     phi = {f"c{i}": (lambda x: x[1] - Y0) for i, _ in enumerate(centres)}
     psi = {f"c{i}": (lambda x, c=c: np.abs(x[0] - c) - A) for i, c in enumerate(centres)}
+    materials = MATERIAL
+    if inclusion is not None:
+        phi["inc"], psi["inc"] = CIRCLE, None
+        materials = {-1: {**dict.fromkeys(psi, MATERIAL), "inc": inclusion}, 1: MATERIAL}
     cut = CutMesh(mesh, phi, 2, tangent=psi)
-    problem = Problem(cut, 2, MATERIAL, law, tip_radius=tip_radius)
+    problem = Problem(cut, 2, materials, law, tip_radius=tip_radius)
     problem.loads.add_traction(lambda x: np.isclose(x[1], W), (0.0, 1.0))
     problem.loads.add_traction(lambda x: np.isclose(x[1], -W), (0.0, -1.0))
     for component in (0, 1):
@@ -224,3 +240,33 @@ def test_tip_zones_rings_and_growth_refused_for_several(two):
         TipIntegrals(problem, [(0.3, 1.5)])
     with pytest.raises(NotImplementedError, match=r"^problem: grow\(\) moves one crack"):
         grow(problem, polyline([(0.6, Y0), (1.4, Y0)]), 0.1, RINGS)
+
+
+def test_a_closed_interface_among_cracks(single):
+    """A circular inclusion (``psi = None``) bonded next to crack c0: of the body's own
+    material it is no inclusion (K as the crack alone, 5e-10 measured), ten times stiffer
+    it moves K (by 0.4 and 1.2 %: its material is where it should be, which the cells'
+    regions check too)."""
+    K = K_by_tip(plate([XC], law={"c0": "free", "inc": "bonded"}, inclusion=MATERIAL))
+    for key, (K_I, _) in single.items():
+        assert K[key][0] == pytest.approx(K_I, rel=1e-8)
+    stiff = Material(10 * MATERIAL.E, MATERIAL.nu, MATERIAL.plane)
+    problem = plate([XC], law={"c0": "free", "inc": "bonded"}, inclusion=stiff)
+    cut = problem.cut
+    assert cut.interface_names == ("c0", "inc") and cut.cracks.interfaces == ("inc",)
+    assert cut.crack.tip_names == ("c0", "c0")
+    K = K_by_tip(problem)
+    for key, (K_I, _) in single.items():
+        assert abs(K[key][0] / K_I - 1) > 3e-3
+    owned = np.arange(cut.cell_sides.size, dtype=np.int32)
+    x = dolfinx.mesh.compute_midpoints(cut.mesh, 2, owned).T
+    regions = cut.cell_regions()
+    region = regions.x.array[regions.function_space.dofmap.list[owned, 0]]
+    minus = cut.cell_sides == -1
+    assert np.array_equal(region[minus] == 1, CIRCLE(x)[minus] < 0)
+    # cells cut away from the circle (the crack's, and those between the circle's zone and
+    # the crack's where phi changes sign): their side -1 is the body's
+    away = (cut.cell_sides == 0) & (np.abs(CIRCLE(x)) > 0.3)
+    assert np.count_nonzero(away & (np.abs(x[1] - Y0) > 0.3)) > 0  # between the zones
+    assert np.all(region[away] == 0)
+    assert total(1 * cut.interface_measure("inc")) == pytest.approx(math.pi, rel=1e-4)

@@ -62,8 +62,9 @@ class CutMesh:
             as ``levelset``); the crack is the zero line of ``levelset`` where
             ``psi < 0`` (see :mod:`xfem_contact.fem.crack_cut`), :attr:`crack` its data.
             Several disjoint cracks: ``levelset`` and ``tangent`` mappings ``{name: ...}``
-            with the same names, cut as one pair (:mod:`xfem_contact.geometry.crack_union`,
-            :attr:`cracks`), each crack's lips with their own measure.
+            with the same names (``psi = None``: a closed interface), cut as one pair
+            (:mod:`xfem_contact.geometry.crack_union`, :attr:`cracks`), each with its
+            own measure.
         tip_points: Gauss points per direction of a crack tip cell's Duffy rules.
 
     Example:
@@ -250,14 +251,16 @@ class CutMesh:
         it (owned and ghost cells). Collective."""
         V0 = dolfinx.fem.functionspace(self.mesh, ("DG", 0))
         regions = dolfinx.fem.Function(V0, name="region")
-        if self._components is not None and len(self._components) > 1:
-            owned = np.arange(self.cell_sides.size, dtype=np.int32)
+        owned = np.arange(self.cell_sides.size, dtype=np.int32)
+        if self.cracks is not None and len(self.interface_names) > 1:  # of their side -1
+            regions.x.array[V0.dofmap.list[owned, 0]] = self.cracks.cell_crack
+        elif self._components is not None and len(self._components) > 1:
             x = dolfinx.mesh.compute_midpoints(self.mesh, self.mesh.topology.dim, owned).T
             phi = np.array([np.asarray(f(x), dtype=np.float64) for f in self._components.values()])
             index = np.argmin(phi, axis=0)
             index[self.cut_cells] = self.cell_interface
             regions.x.array[V0.dofmap.list[owned, 0]] = index
-            regions.x.scatter_forward()
+        regions.x.scatter_forward()
         return regions
 
     def interface_measure(self, name: str | None = None) -> ufl.Measure:

@@ -17,10 +17,17 @@ cut ahead of a tip, no discontinuity there), and at the edge of a zone, where ``
 jumps, ``|phi_k| >= zone - h > 0`` cuts nothing. Cracks closer than :data:`MIN_CELLS`
 cells (touching, crossing) are refused, naming them; so are tip enrichments that reach
 beyond the zone (:meth:`CrackUnion.check_tip_radius`).
+
+A closed interface among the cracks is given with ``psi = None``: a crack with
+``psi = -zone`` in its zone (every cell it cuts is crossed, it has no tip). The cracks
+must lie outside it (their body is its outside); several interfaces are checked as by
+:func:`~xfem_contact.geometry.levelset.union`.
 """
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
@@ -30,7 +37,7 @@ import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
-from xfem_contact.geometry.levelset import LevelSet, interpolate
+from xfem_contact.geometry.levelset import LevelSet, interpolate, union
 
 __all__ = ["MIN_CELLS", "CrackUnion", "crack_union", "interpolate_tangent"]
 
@@ -66,6 +73,8 @@ class CrackUnion:
     _distances: npt.NDArray[np.float64]  # (K, local nodes) d_k at the nodes
     _nodes: npt.NDArray[np.float64]  # (local nodes, gdim)
     _comm: MPI.Comm
+    #: The closed interfaces among ``names`` (given with ``psi = None``)
+    interfaces: tuple[str, ...] = ()
 
     def nearest(self, points: npt.ArrayLike) -> npt.NDArray[np.int64]:
         """Index of the crack nearest to each point ``(n, gdim)``: the smallest
@@ -116,19 +125,12 @@ def interpolate_tangent(
 
 def _of(levelsets: Mapping, names: tuple[str, ...], argument: str) -> list:
     """The level sets of ``names`` from the mapping given as ``argument``."""
-    if isinstance(levelsets, Mapping) and set(levelsets) < set(names):
-        missing = [name for name in names if name not in levelsets]
-        raise ValueError(
-            f"{argument}: no psi for {missing}: with a tangent mapping, every entry of "
-            "levelset is a crack (closed interfaces together with cracks are not available "
-            "yet: the interfaces' inside materials and ghost penalty are not handled in a "
-            "cut by cracks)"
-        )
     if not isinstance(levelsets, Mapping) or tuple(levelsets) != names:
         got = list(levelsets) if isinstance(levelsets, Mapping) else type(levelsets).__name__
         raise ValueError(
             f"{argument}: several cracks take a mapping {{name: psi}} with the names of "
-            f"levelset's, in the same order ({list(names)}), got {got}"
+            f"levelset's, in the same order ({list(names)}; None for a closed interface), "
+            f"got {got}"
         )
     return [levelsets[name] for name in names]
 
@@ -156,6 +158,9 @@ def crack_union(
     if len(names) == 1 and not isinstance(tangents, Mapping):
         tangents = {names[0]: tangents}
     phis, psis = _of(levelsets, names, "levelset"), _of(tangents, names, "tangent")
+    interfaces = tuple(name for name, psi in zip(names, psis, strict=True) if psi is None)
+    if len(interfaces) == len(names):
+        raise ValueError("tangent: no crack (every psi is None): cut interfaces without tangent")
     tdim = mesh.topology.dim
     num_cells = mesh.topology.index_map(tdim).size_local
     if len(names) == 1:  # checked by the cut as one crack's
@@ -174,16 +179,24 @@ def crack_union(
         except ValueError as error:
             raise ValueError(f"levelset[{name!r}]: {error}") from None
         try:
-            S.append(interpolate_tangent(mesh, psi, degree).function)
+            S.append(None if psi is None else interpolate_tangent(mesh, psi, degree).function)
         except ValueError as error:
             raise ValueError(f"tangent[{name!r}]: {error}") from None
     V = P[0].function_space
     phi_n = np.array([f.x.array for f in P])
-    psi_n = np.array([f.x.array for f in S])
+    pairs = zip(P, S, strict=True)
+    psi_n = np.array([-np.ones_like(f.x.array) if g is None else g.x.array for f, g in pairs])
     D = np.hypot(phi_n, np.maximum(psi_n, 0.0))
     nodes = V.tabulate_dof_coordinates()[:, : mesh.geometry.dim]
+    if interfaces:
+        _check_interfaces(mesh, names, interfaces, phis, phi_n, D, degree, h)
+    nearest = np.argmin(D, axis=0)
+    at = np.arange(D.shape[1])
+    # a cell's crack: that of its node of the smallest union phi, the one of its side -1
+    # part (its material: a cell cut between two cracks' zones is -1 on one's side only)
     cells = V.dofmap.list[:num_cells]
-    cell_crack = np.argmin(D[:, cells].min(axis=2), axis=0).astype(np.int32)
+    lowest = np.argmin(phi_n[nearest[cells], cells], axis=1)
+    cell_crack = nearest[cells[np.arange(num_cells), lowest]].astype(np.int32)
     gap, pair = np.inf, None
     for i, a in enumerate(names):
         for j in range(i + 1, len(names)):
@@ -199,17 +212,40 @@ def crack_union(
             "handled"
         )
     zone = max(gap / 3.0, gap / 2.0 - 2.0 * h)
-    if pair is None:
-        phi, psi = phis[0], psis[0]
-    elif all(callable(f) and not isinstance(f, dolfinx.fem.Function) for f in phis + psis):
+    for k, name in enumerate(names):  # a closed interface: psi = -zone around it
+        if name in interfaces:
+            psi_n[k] = -zone
+            psis[k] = functools.partial(_constant, -zone)
+    if all(callable(f) and not isinstance(f, dolfinx.fem.Function) for f in phis + psis):
         phi, psi = _union_callables(phis, psis, zone)
     else:
-        k = np.argmin(D, axis=0)
-        at = np.arange(D.shape[1])
         phi, psi = (dolfinx.fem.Function(V) for _ in range(2))
-        phi.x.array[:] = phi_n[k, at]
-        psi.x.array[:] = np.where(D[k, at] < zone, psi_n[k, at], zone)
-    return CrackUnion(names, phi, psi, zone, gap, pair, cell_crack, h, D, nodes, mesh.comm)
+        phi.x.array[:] = phi_n[nearest, at]
+        psi.x.array[:] = np.where(D[nearest, at] < zone, psi_n[nearest, at], zone)
+    union = CrackUnion(names, phi, psi, zone, gap, pair, cell_crack, h, D, nodes, mesh.comm)
+    return dataclasses.replace(union, interfaces=interfaces)
+
+
+def _constant(value: float, x: np.ndarray) -> np.ndarray:
+    return np.full(x.shape[1], value)
+
+
+def _check_interfaces(mesh, names, interfaces, phis, phi_n, D, degree, h) -> None:
+    """Refuse closed interfaces that overlap or cut common cells (as
+    :func:`~xfem_contact.geometry.levelset.union`) and cracks that enter an interface's
+    inside (their body is the interfaces' outside). Collective."""
+    if len(interfaces) > 1:
+        union(mesh, {n: phis[names.index(n)] for n in interfaces}, degree)
+    for i, crack in enumerate(names):
+        if crack in interfaces:
+            continue
+        for inside in interfaces:
+            local = int(np.count_nonzero((D[i] < h) & (phi_n[names.index(inside)] < 0)))
+            if mesh.comm.allreduce(local, op=MPI.SUM):
+                raise ValueError(
+                    f"levelset: crack {crack!r} enters the inside of interface {inside!r}: "
+                    "cracks must lie in the body outside the closed interfaces"
+                )
 
 
 def _union_callables(phis: list, psis: list, zone: float) -> tuple[Callable, Callable]:

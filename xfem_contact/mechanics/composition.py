@@ -40,14 +40,16 @@ def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
     if set(interfaces) != set(names):
         raise ValueError(f"Give a law for each interface {list(names)}; got {sorted(interfaces)}")
     laws = {}
+    closed = () if cut.cracks is None else cut.cracks.interfaces  # interfaces among cracks
     for name in names:
         law = interfaces[name]
+        crack = cut.crack is not None and name not in closed
         if isinstance(law, str):
-            law = make_law(law) if cut.crack is None else crack_law(law)
+            law = crack_law(law) if crack else make_law(law)
         laws[name] = law
         if not isinstance(laws[name], InterfaceLaw):
             raise ValueError(f"Interface {name!r}: {law!r} is not an interface law")
-        if cut.crack is not None and getattr(law, "lbb", "none") == "stabilized":
+        if crack and getattr(law, "lbb", "none") == "stabilized":
             raise ValueError(
                 f"Crack {name!r}: lbb='stabilized' squares the tip's singular traction on "
                 "the lips (K_I of a closed crack 30 % off); give the law lbb='none'"

@@ -138,7 +138,7 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
         }
     else:
         if scene.cracks:
-            cut, laws, materials, options = crack_cut(scene, mesh)
+            cut, laws, materials, options = crack_cut(scene, mesh, interface_levelsets(scene))
         else:
             cut = CutMesh(
                 mesh,

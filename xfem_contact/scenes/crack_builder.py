@@ -22,6 +22,7 @@ from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.geometry.crack_paths import CrackPath, arc, polyline
 from xfem_contact.mechanics.composition import crack_law
 from xfem_contact.mechanics.fracture import tip_cell_size
+from xfem_contact.mechanics.laws import make_law
 from xfem_contact.scenes.expressions import numpy_field
 from xfem_contact.scenes.schema import CRACK_RINGS, CrackSpec, Scene, SceneError
 
@@ -87,9 +88,10 @@ def crack_levelsets(spec: CrackSpec, mesh: dolfinx.mesh.Mesh, where: str) -> tup
     return path.levelsets([0.0 if tip else min(size, room) for tip in tips])
 
 
-def crack_cut(scene: Scene, mesh: dolfinx.mesh.Mesh) -> tuple:
-    """``(cut, laws, material, options)`` of a scene's cracks (one body: the first
-    crack's material, tip radius) for :class:`~xfem_contact.mechanics.problem.Problem`.
+def crack_cut(scene: Scene, mesh: dolfinx.mesh.Mesh, interfaces: dict | None = None) -> tuple:
+    """``(cut, laws, materials, options)`` of a scene's cracks (one body: the first
+    crack's material, tip radius) and closed ``interfaces`` (their level sets by name,
+    in the body's material outside) for :class:`~xfem_contact.mechanics.problem.Problem`.
     Collective."""
     phis, psis, laws = {}, {}, {}
     for k, spec in enumerate(scene.cracks):
@@ -97,7 +99,14 @@ def crack_cut(scene: Scene, mesh: dolfinx.mesh.Mesh) -> tuple:
         laws[spec.name] = crack_law(
             spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb
         )
-    several = len(scene.cracks) > 1
+    body = scene.materials[scene.cracks[0].material]
+    inside = {name: body for name in phis}
+    for spec in scene.interfaces:  # psi None: a closed interface among the cracks
+        phis[spec.name], psis[spec.name] = (interfaces or {})[spec.name], None
+        options = {"friction": spec.friction, "augmentation": spec.augmentation}
+        laws[spec.name] = make_law(spec.law, lbb=spec.lbb, **options)
+        inside[spec.name] = scene.materials[spec.inside]
+    several = len(phis) > 1
     try:
         cut = CutMesh(
             mesh,
@@ -109,19 +118,23 @@ def crack_cut(scene: Scene, mesh: dolfinx.mesh.Mesh) -> tuple:
     except ValueError as error:
         message = re.sub(r"^(levelset|tangent)(\[[^]]*\])?: ", "", " ".join(str(error).split()))
         raise SceneError(crack_key(scene, str(error)), message) from None
-    spec = scene.cracks[0]
     # no ghost penalty: its derivatives of the branch functions make the forms very costly
-    options = {"tip_radius": spec.tip_radius, "ghost_penalty": 0.0}
-    return cut, laws, scene.materials[spec.material], options
+    options = {"tip_radius": scene.cracks[0].tip_radius, "ghost_penalty": 0.0}
+    materials = body if not scene.interfaces else {-1: inside, 1: body}
+    return cut, laws, materials, options
 
 
 def crack_key(scene: Scene, message: str) -> str:
     """The key of the crack an error names (``cracks 'a' and 'b'``: the second's, or
     ``levelset['a']``, ``tangent['a']``), else ``cracks[0]`` (``cracks`` for several)."""
     names = [spec.name for spec in scene.cracks]
-    named = re.findall(r"(?:cracks '[^']*' and |\[)'([^']*)'", message)
+    if scene.interfaces:
+        names += [spec.name for spec in scene.interfaces]
+    named = re.findall(r"(?:cracks '[^']*' and |\[|crack )'([^']*)'", message)
     if named and named[0] in names:
-        return f"cracks[{names.index(named[0])}]"
+        k = names.index(named[0])
+        n = len(scene.cracks)
+        return f"cracks[{k}]" if k < n else f"interfaces[{k - n}]"
     return "cracks[0]" if len(names) == 1 else "cracks"
 
 

@@ -52,9 +52,21 @@ def crack_spec(table, k: int, materials: dict) -> CrackSpec:
     )
 
 
-def shared_crack_keys(cracks: list[CrackSpec]) -> None:
+def shared_crack_keys(cracks: list[CrackSpec], interfaces: list | None = None) -> None:
     """Several cracks lie in one body: distinct names, and the same ``material``,
-    ``tip_radius`` and ``rings`` (one tip enrichment and one set of rings for all tips)."""
+    ``tip_radius`` and ``rings`` (one tip enrichment and one set of rings for all tips);
+    closed ``interfaces`` among them: other names, the body's material outside, small
+    kinematics."""
+    for k, spec in enumerate(interfaces or () if cracks else ()):
+        where, body = f"interfaces[{k}]", cracks[0].material
+        if spec.name in [c.name for c in cracks]:
+            raise SceneError(f"{where}.name", f"{spec.name!r} names a crack too")
+        if spec.outside != body:
+            message = f"{spec.outside!r}: the cracks lie in the body outside, of {body!r}"
+            raise SceneError(f"{where}.outside", message + " (cracks[0].material)")
+        if spec.kinematics != "small":
+            message = f"{spec.kinematics!r}: with cracks, interfaces slide small only for now"
+            raise SceneError(f"{where}.kinematics", message)
     for k, spec in enumerate(cracks[1:], start=1):
         first = cracks[0]
         names = [c.name for c in cracks[:k]]

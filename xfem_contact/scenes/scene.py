@@ -151,12 +151,7 @@ def load_scene(
         crack_spec(table, k, materials)
         for _, k, table in _tables(data.get("cracks", []), "cracks", listed=True)
     ]
-    shared_crack_keys(cracks)
-    if cracks and interfaces:
-        raise NotImplementedError(
-            "cracks: a crack together with [[interfaces]] is not available yet; "
-            "give one or the other"
-        )
+    shared_crack_keys(cracks, interfaces)
 
     parts = {}
     for where, name, table in _tables(data.get("parts", {}), "parts", listed=False):
