@@ -10,6 +10,8 @@ block for algebraic multigrid (GAMG). Used by
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import basix
 import dolfinx.fem
 import numpy as np
@@ -92,20 +94,18 @@ def vertex_interpolation(space: EnrichedSpace):
     return rows[keep][first], cols[keep][first], weights[keep][first]
 
 
-def rigid_modes(space: EnrichedSpace) -> list[dolfinx.fem.Function]:
+def rigid_modes(space: EnrichedSpace) -> Iterator[dolfinx.fem.Function]:
     """The rigid motions of each side separately (2D: two translations and the
-    rotation about the origin, per side field), as Functions on ``space.W`` (m).
-    Collective."""
-    modes = []
-    motions = (
-        lambda x: np.vstack([np.ones_like(x[0]), np.zeros_like(x[0])]),
-        lambda x: np.vstack([np.zeros_like(x[0]), np.ones_like(x[0])]),
-        lambda x: np.vstack([-x[1], x[0]]),
-    )
+    rotation about the origin, per side field) on ``space.W`` (m): one Function,
+    refilled with the next mode at each step of the iteration (a Function on ``W`` is
+    large; use each mode before taking the next). Collective iteration."""
+    W = space.W
+    mode = dolfinx.fem.Function(W)
     for field in SIDE_FIELDS:
-        for motion in motions:
-            mode = dolfinx.fem.Function(space.W)
-            mode.sub(field).interpolate(motion)
-            mode.x.scatter_forward()
-            modes.append(mode)
-    return modes
+        V, dofs = W.sub(field).collapse()  # dofs: the W dof of each (unrolled) V dof
+        x = V.tabulate_dof_coordinates()[:, :2]  # (nodes, 2), a node's components together
+        one, zero = np.ones(x.shape[0]), np.zeros(x.shape[0])
+        for motion in ((one, zero), (zero, one), (-x[:, 1], x[:, 0])):
+            mode.x.array[:] = 0.0
+            mode.x.array[dofs] = np.column_stack(motion).ravel()
+            yield mode

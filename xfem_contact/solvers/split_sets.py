@@ -6,6 +6,8 @@ unknowns ``y`` (``x = R D y``)."""
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 from petsc4py import PETSc
 
@@ -19,7 +21,7 @@ def split_sets(
     w,
     chosen,
     splits: dict,
-    near_nullspace: list,
+    near_nullspace: Iterable,
     interpolation=None,
 ) -> list:
     """Give a fieldsplit preconditioner its index sets ``"u"`` and ``"lambda"`` (and
@@ -37,7 +39,7 @@ def split_sets(
             (:func:`~xfem_contact.solvers.assembly.selection`), or ``None``.
         splits: Split name to the local dofs of ``W`` it holds, as for
             :class:`~xfem_contact.solvers.newton.RestrictedNewton`.
-        near_nullspace: Functions on ``W`` for the near null space of split ``"u"``.
+        near_nullspace: Functions on ``W`` (any iterable) for the near null space of split ``"u"``.
         interpolation: ``(rows, cols, weights)`` on local dofs of ``W``, or ``None``.
 
     Returns:
@@ -77,12 +79,13 @@ def split_sets(
         squared = D.copy()
         squared.pointwiseMult(D, D)
         vectors = []
+        local = index.getIndices() - first  # owned: a local slice (no scatter, no copy of R)
         for mode in near_nullspace:  # z = D^-1 R^T x, x = R D z on the active dofs
             R.multTranspose(mode.x.petsc_vec, reduced)
             reduced.pointwiseDivide(reduced, squared)
-            part = reduced.getSubVector(index)
-            vectors.append(part.copy())
-            reduced.restoreSubVector(index, part)
+            part = PETSc.Vec().createMPI((local.size, PETSc.DECIDE), comm=comm)
+            part.setArray(reduced.getArray(readonly=True)[local])
+            vectors.append(part)
         vectors = _orthonormalise(vectors)
         space = PETSc.NullSpace().create(vectors=vectors, comm=comm)
         index.compose("nearnullspace", space)
