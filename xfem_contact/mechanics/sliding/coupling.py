@@ -95,6 +95,10 @@ class SlidingCoupling:
         #: The rule's points (where the state is reported)
         self.points = self._points(cells, rules.points, rules.weights * np.abs(np.linalg.det(J)))
         self.pieces = SlavePieces(cut, V_s, self.rows, cut.quadrature_degree)
+        _, X, _ = self.pieces.rule(self.pieces.whole())
+        # the rule's points are the pieces' Gauss points in order: their feet help split
+        self._ordered = X.shape == rules.points.shape and np.allclose(X, rules.points, atol=1e-12)
+        self._paired: tuple | None = None
         self._materials = ctx.materials
         h = self.points.h
         self.radius = radius or self.comm.allreduce(float(h.max(initial=0.0)), op=MPI.MAX)
@@ -156,7 +160,7 @@ class SlidingCoupling:
             self._old_master = np.zeros(self.lip.dofs.shape)
         self._columns = columns
         self._blocks.reset()
-        self._integrated = None
+        self._integrated = self._paired = None
 
     # -- evaluation ------------------------------------------------------------------
     def evaluate(self, w, jacobian: bool = True) -> tuple[Pairing, PairTerms]:
@@ -168,9 +172,7 @@ class SlidingCoupling:
             if cached[2].jacobian is not None or not jacobian:
                 return cached[1], cached[2]
         lip = self.lip
-        lip.refresh(w)
-        x_s = positions(w, self.points)
-        pairing = closest_points(lip, x_s, self.radius, only=self._frozen)
+        x_s, pairing = self._pair(w)
         terms, self.tangential = self._terms(w, self.points, x_s, pairing, jacobian)
         self._evaluated = (w.x.array.copy(), pairing, terms)
         paired = int(pairing.paired.sum())
@@ -184,6 +186,18 @@ class SlidingCoupling:
         self.counts = dict(zip(("paired", "unpaired", "changed"), map(int, counts), strict=True))
         return pairing, terms
 
+    def _pair(self, w) -> tuple[np.ndarray, Pairing]:
+        """The rule's points at ``w`` and their pairing (cached for the same values;
+        the lip refreshed). Collective."""
+        self.lip.refresh(w)
+        cached = self._paired
+        if cached is not None and np.array_equal(cached[0], w.x.array):
+            return cached[1:]
+        x_s = positions(w, self.points)
+        pairing = closest_points(self.lip, x_s, self.radius, only=self._frozen)
+        self._paired = (w.x.array.copy(), x_s, pairing)
+        return x_s, pairing
+
     def integrate(self, w) -> tuple[SlavePoints, Pairing, PairTerms]:
         """The points, pairing and terms the Newton system gets at ``w``: the
         segment-to-segment ones, or the rule's (:meth:`evaluate`). Collective."""
@@ -192,10 +206,14 @@ class SlidingCoupling:
         cached = self._integrated
         if cached is not None and np.array_equal(cached[0], w.x.array):
             return cached[1:4]
-        self.lip.refresh(w)
         segments = self._frozen_segments
         if segments is None:
-            segments = split(self.pieces, w.x.array, self.lip, self.radius)
+            feet = None
+            if self._ordered:
+                feet = self._pair(w)[1].piece.reshape(self.pieces.size, -1)
+            self.lip.refresh(w)
+            segments = split(self.pieces, w.x.array, self.lip, self.radius, feet)
+        self.lip.refresh(w)
         segment, X, weights = self.pieces.rule(segments)
         points = self._points(self.pieces.cells[segments.piece[segment]], X, weights)
         x_s = positions(w, points)
@@ -291,9 +309,10 @@ class SlidingCoupling:
         keep the master pieces (and split points) over the solve. Collective."""
         if self.update_mode == "step":
             self._frozen = self._frozen_segments = None
+            self._paired = None
             pairing, _ = self.evaluate(w, jacobian=False)
             self._frozen = pairing.piece.copy()
-            self._evaluated = self._integrated = None
+            self._evaluated = self._integrated = self._paired = None
             if self.segments:
                 self.lip.refresh(w)
                 self._frozen_segments = split(self.pieces, w.x.array, self.lip, self.radius)
@@ -306,7 +325,7 @@ class SlidingCoupling:
         self._accepted_cells = np.where(pairing.paired, self.lip.cells[pieces], -1)
         self._old_w = w.x.array.copy()  # slips are measured from here
         self._old_master = self.lip.gather(w)
-        self._integrated = None
+        self._integrated = self._paired = None
 
     def unpaired_points(self, w) -> np.ndarray:
         """Reference coordinates (m) of the unpaired slave points of all processes,

@@ -139,6 +139,8 @@ class MasterLip:
         self.orientation = gather(orientation)
         self.owners = gather(np.full(cells.size, comm.rank, dtype=np.int32))
         self.values = np.zeros(self.dofs.shape)
+        #: What is derived from the values, until the next :meth:`refresh`
+        self.cache: dict = {}
         self._comm = comm
 
     @property
@@ -172,7 +174,9 @@ class MasterLip:
     def refresh(self, w) -> None:
         """Gather the master field's dof values of ``w`` (a Function on ``W``) for
         :meth:`curve`. Collective."""
-        self.values = self.gather(w)
+        values = self.gather(w)
+        if not np.array_equal(values, self.values):
+            self.values, self.cache = values, {}
 
     def third_derivatives(self, pieces: np.ndarray, s: np.ndarray):
         """``(X''', phi''')`` along the pieces: the undeformed curve's, ``(m, 2)``, and

@@ -86,8 +86,27 @@ def _candidates(x, samples, radius, k, chunk: int = 512):
     return np.concatenate(orders), np.concatenate(tried), np.concatenate(nearest)
 
 
+def lip_samples(lip) -> np.ndarray:
+    """The deformed pieces at :data:`_SAMPLES`, ``(P, 5, 2)`` (m), cached on the lip
+    until its next ``refresh`` when it offers it (``lip.cache``)."""
+    cache = getattr(lip, "cache", None)
+    if cache is not None and "samples" in cache:
+        return cache["samples"]
+    P = lip.size
+    samples = lip.curve(np.repeat(np.arange(P), _SAMPLES.size), np.tile(_SAMPLES, P)).x
+    samples = samples.reshape(P, _SAMPLES.size, 2)
+    if cache is not None:
+        cache["samples"] = samples
+    return samples
+
+
 def closest_points(
-    lip, x: npt.NDArray[np.float64], radius: float, candidates: int = 4, only=None
+    lip,
+    x: npt.NDArray[np.float64],
+    radius: float,
+    candidates: int = 4,
+    only=None,
+    given=None,
 ) -> Pairing:
     """Pair slave points with the deformed master lip (for its last ``refresh``).
 
@@ -97,7 +116,8 @@ def closest_points(
         radius: Search radius (m): no master within it leaves a point unpaired.
         candidates: Pieces tried per point (nearest boxes first).
         only: A piece per point (``(m,)``, -1: unpaired) to project on instead of
-            searching (the pairing frozen over a load step).
+            searching (the pairing frozen over a load step; no radius).
+        given: Pieces per point (``(m, k)``, -1: none) to try instead of searching.
 
     Returns:
         The :class:`Pairing`. Local.
@@ -106,16 +126,15 @@ def closest_points(
     if m == 0 or lip.size == 0:
         return Pairing(np.full(m, -1), np.zeros(m), np.full(m, np.inf))
     P = lip.size
-    samples = lip.curve(np.repeat(np.arange(P), _SAMPLES.size), np.tile(_SAMPLES, P)).x
-    samples = samples.reshape(P, _SAMPLES.size, 2)
-    if only is None:
+    samples = lip_samples(lip)
+    if only is not None:
+        given = np.asarray(only)[:, None]
+    if given is None:
         order, tried, nearest = _candidates(x, samples, radius, min(candidates, P))
-        k = order.shape[1]
     else:
-        order = np.where(only >= 0, only, 0)[:, None]
-        tried = (only >= 0)[:, None]
+        order, tried = np.where(given >= 0, given, 0), given >= 0
         nearest = np.full(m, np.inf)
-        k = 1
+    k = order.shape[1]
     rows = np.repeat(np.arange(m), k)
     pieces = order.ravel()
     start = _SAMPLES[np.argmin(np.sum((x[rows, None, :] - samples[pieces]) ** 2, axis=2), axis=1)]

@@ -185,7 +185,7 @@ def _roots(pieces: SlavePieces, values, lip, slave, master, x0, x1, iterations=3
     return slave, t, master, ends, entering
 
 
-def split(pieces: SlavePieces, values: np.ndarray, lip, radius: float) -> Segments:
+def split(pieces: SlavePieces, values: np.ndarray, lip, radius: float, feet=None) -> Segments:
     """Split the slave pieces at the crossings of master-piece ends (see the module).
 
     Args:
@@ -194,18 +194,25 @@ def split(pieces: SlavePieces, values: np.ndarray, lip, radius: float) -> Segmen
         lip: The :class:`~xfem_contact.mechanics.sliding.lips.MasterLip`, refreshed at
             the same state.
         radius: Search radius (m) of the pairing.
+        feet: Master pieces (-1: none) already found for points of each slave piece,
+            ``(P, k)`` (the interface rule's): they replace the inner samples.
 
     Returns:
         The :class:`Segments`, piece by piece, ``t`` increasing. Local.
     """
-    P, S = pieces.size, SAMPLES.size
+    P = pieces.size
     if P == 0:
         return pieces.whole()
+    samples = SAMPLES if feet is None else SAMPLES[[0, -1]]
+    S = samples.size
     rows = np.repeat(np.arange(P), S)
-    x, _ = pieces.curve(values, rows, np.tile(SAMPLES, P))
-    feet = closest_points(lip, x, radius).piece
+    x, _ = pieces.curve(values, rows, np.tile(samples, P))
+    found = closest_points(lip, x, radius).piece.reshape(P, S)
+    if feet is not None:
+        found = np.concatenate([found, feet], axis=1)
     x = x.reshape(P, S, 2)
-    pairs = np.unique(np.column_stack([rows, feet])[feet >= 0], axis=0)
+    rows = np.repeat(np.arange(P), found.shape[1])
+    pairs = np.unique(np.column_stack([rows, found.ravel()])[found.ravel() >= 0], axis=0)
     ends = x[pairs[:, 0], 0], x[pairs[:, 0], -1]
     roots = _roots(pieces, values, lip, pairs[:, 0], pairs[:, 1], *ends)
     fixed = np.full(P, -1)
@@ -223,7 +230,11 @@ def split(pieces: SlavePieces, values: np.ndarray, lip, radius: float) -> Segmen
     after = np.r_[False, piece[1:] == piece[:-1]] & np.r_[False, t0[1:] == t1[:-1]]
     source = np.where(after, source, -1)
     mid, _ = pieces.curve(values, piece, 0.5 * (t0 + t1))
-    feet = closest_points(lip, mid, radius)
+    # the midpoints' candidates: the master pieces of their slave piece's pairs
+    rank = np.arange(pairs.shape[0]) - np.searchsorted(pairs[:, 0], pairs[:, 0])
+    given = np.full((P, rank.max(initial=0) + 1), -1)
+    given[pairs[:, 0], rank] = pairs[:, 1]
+    feet = closest_points(lip, mid, radius, given=given[piece])
     master = feet.piece
     # a foot at a piece end (the sub-segment between the two crossings of a convex
     # corner) is a tie between the two pieces: take a neighbour's master instead
