@@ -6,14 +6,15 @@ foot of ``x_s(t)`` on the master lip passes from one master piece to the next wh
 reaches a piece end ``x_e`` (tangent ``t_e``): ``h(t) = (x_s(t) - x_e) . t_e = 0``.
 There the master field's derivative jumps (C0 between cells), so a Gauss rule across
 such a point integrates a kink. :func:`split` finds these points (Newton on ``t``) for
-both ends of every master piece that the feet of samples of the slave piece reach
-(the ends of an unreached piece lying between two reached ones are theirs too) and
-cuts each slave piece there into sub-segments; each sub-segment gets its own Gauss
-rule (:meth:`SlavePieces.rule`, weights scaled by its length) and one master piece,
-that of its midpoint's foot (a neighbour's where that foot is a corner of the lip),
-on which all its points are projected. Geometry only,
-no physics; local (each process splits its own slave pieces against the whole lip).
-SI units (m).
+both ends of every master piece that the feet of the slave piece's ends and of its
+rule points (or of :data:`SAMPLES`) reach (the ends of an unreached piece lying
+between two reached ones are theirs too; two unreached pieces in a row would be
+missed) and cuts each slave piece there into sub-segments. Each sub-segment gets its
+own Gauss rule (:meth:`SlavePieces.rule`, weights scaled by its length) and one master
+piece, that of its midpoint's foot (past a crossing into a piece, that piece; between
+the two crossings of one corner of the lip, the previous sub-segment's), on which all
+its points are projected. Geometry only, no physics; local (each process splits its
+own slave pieces against the whole lip). SI units (m).
 """
 
 from __future__ import annotations
