@@ -44,6 +44,7 @@ U_OPTIONS: dict[str, OptionValue] = {
     "mg_levels_ksp_type": "chebyshev",
     "mg_levels_pc_type": "jacobi",
     "mg_levels_ksp_max_it": 2,
+    "mg_levels_esteig_ksp_type": "cg",  # GMRES's basis would stay allocated
     "mg_coarse_ksp_type": "richardson",
     "mg_coarse_ksp_max_it": 3,
     "mg_coarse_pc_type": "gamg",
