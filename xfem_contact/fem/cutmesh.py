@@ -65,7 +65,7 @@ class CutMesh:
             with the same names (``psi = None``: a closed interface), cut as one pair
             (:mod:`xfem_contact.geometry.crack_union`, :attr:`cracks`), each with its
             own measure.
-        tip_points: Gauss points per direction of a crack tip cell's Duffy rules.
+        tip_points: Gauss points per direction of a tip cell's Duffy rules (K: 12 too few).
 
     Example:
         >>> cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 0.5)
@@ -79,7 +79,7 @@ class CutMesh:
         degree: int = 2,
         quadrature_degree: int | None = None,
         tangent: LevelSetCallable | dolfinx.fem.Function | None = None,
-        tip_points: int = 12,
+        tip_points: int = 24,
     ):
         cell = mesh.topology.cell_name()
         if cell not in ("triangle", "quadrilateral"):
