@@ -100,7 +100,10 @@ def test_williams_field_p1_converges():
         case.problem.solve()
         errors.append(williams_energy_error(case))
     rate = math.log(errors[0] / errors[1]) / math.log(2)
-    assert rate > 0.85, errors  # 0.90 here, 0.98 from 32 to 64 (bench)
+    # with the ramp (corrected X-FEM): 0.086, 0.049 (rate 0.81), 0.027 at n = 64 (0.88);
+    # without: 0.103, 0.056 (0.89), 0.029 (0.97): lower everywhere, most on coarse meshes
+    assert rate > 0.78, errors
+    assert errors[1] < 0.052, errors
 
 
 def test_griffith_crack_both_tips():
@@ -118,7 +121,7 @@ def test_griffith_crack_both_tips():
 @pytest.fixture(scope="module")
 def frictional():
     """The closed crack with friction 0.3, solved, and its Newton report."""
-    case = frictional_crack_case(4, 2, friction=0.3, tip_radius=0.5)
+    case = frictional_crack_case(8, 2, friction=0.3, tip_radius=0.3)
     return case, case.problem.solve()
 
 
@@ -132,16 +135,16 @@ def test_closed_crack_with_coulomb_friction(frictional):
     ]
     slip, sigma_n = frictional_slip(s, friction=0.3)
     # the lips stick together in the normal direction, slide under friction
-    # to 4 % (3.7 % at a tip, 0.5 % elsewhere)
-    assert np.asarray(samples["lambda_n"]) == pytest.approx(sigma_n, abs=4e-2 * abs(sigma_n))
+    # to 2 % (0.85 % at worst, near a tip; 9.7 % without the branch functions' ramp)
+    assert np.asarray(samples["lambda_n"]) == pytest.approx(sigma_n, abs=2e-2 * abs(sigma_n))
     assert np.abs(samples["gap"]).max() < 1e-3 * np.abs(slip).max()
     # the law's tangent is -d: its slip is minus the slip along the crack
     assert -np.asarray(samples["slip"]) == pytest.approx(slip, abs=5e-3 * np.abs(slip).max())
     K_I, K_II = case.K[0]
     results = TipIntegrals(case.problem, [(0.4, 0.8)]).evaluate()
     for (ring,) in results:
-        assert ring.K_II == pytest.approx(K_II, rel=5e-3)  # 2.2e-3 at worst
-        assert abs(ring.K_I) < 1e-2 * abs(K_II)  # 7.5e-3 at worst
+        assert ring.K_II == pytest.approx(K_II, rel=1e-3)
+        assert abs(ring.K_I) < 3e-3 * abs(K_II)
 
 
 def test_lip_term_carries_the_friction(frictional):

@@ -29,7 +29,7 @@ import ufl
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.evaluation import FieldSampler, rule_cells
-from xfem_contact.geometry.levelset import CellMaps
+from xfem_contact.geometry.levelset import CellMaps, LevelSet
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.quadrature.rules import RuleSet
 
@@ -131,8 +131,17 @@ class InterfaceContext:
                 psi = CellMaps(self.cut.mesh, crack.tangent).values(cells, self.rules.points)
                 self._cache["sqrt_r"] = np.sqrt(np.abs(psi))[:, None]
             b = self.values_at(w, w.function_space.num_sub_spaces - 1)  # the branch field
-            jump += 2 * self._cache["sqrt_r"] * b[:, : jump.shape[1]]
+            ramp = self._ramp_at()[:, None]  # the space's R of R F_k
+            jump += 2 * self._cache["sqrt_r"] * ramp * b[:, : jump.shape[1]]
         return jump
+
+    def _ramp_at(self) -> npt.NDArray[np.float64]:
+        """The space's ramp of the branch functions at the rule points (1 without)."""
+        ramp = getattr(getattr(self.split, "__self__", None), "ramp", None)
+        if ramp is None:
+            return np.ones(len(self.rules.point_rows))
+        cells = self.cut.cut_cells[self.rules.point_rows]
+        return CellMaps(self.cut.mesh, LevelSet(ramp, None)).values(cells, self.rules.points)
 
     def cell_size_at(self) -> npt.NDArray[np.float64]:
         """``h`` (m) of the cell of every rule point, ``(npoints,)``."""
