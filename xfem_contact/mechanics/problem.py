@@ -30,9 +30,9 @@ from xfem_contact.mechanics.loads import Loads, SideFields
 from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
-from xfem_contact.solvers.linear import solve_restricted
+from xfem_contact.solvers.linear import crack_options, solve_restricted, tip_transform
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton, weak_method
-from xfem_contact.solvers.options import CRACK_OPTIONS, merged_options
+from xfem_contact.solvers.options import merged_options
 from xfem_contact.solvers.report import SolveReport
 from xfem_contact.solvers.symmetry import symmetric_options
 
@@ -202,7 +202,7 @@ class Problem:
     def _options(self, petsc_options: dict | None) -> dict:
         """``petsc_options`` over the LDL^T of a symmetric problem and a crack's options."""
         options = symmetric_options(petsc_options, self.symmetric)
-        return options if self.cut.crack is None else {**CRACK_OPTIONS, **options}
+        return {**crack_options(self.space, options, bool(self.couplings)), **options}
 
     def law(self, name: str | None = None) -> InterfaceLaw:
         """The law of interface ``name`` (of the only interface for ``None``)."""
@@ -321,6 +321,7 @@ class Problem:
                 interpolation=vertex_interpolation(self.space) if split else None,
                 couplings=list(self.couplings.values()),
                 field_space=self.space.field_space,
+                transform=tip_transform(self.space, off=split or bool(self.couplings)),
             )
             self._newton_key = key
         self._newton.log = log

@@ -5,7 +5,9 @@ The same restriction as :class:`~xfem_contact.solvers.newton.RestrictedNewton`:
 ``R`` of :mod:`xfem_contact.fem.restriction`, ``A_r = R^T A R`` (straight into the
 reduced numbering, :mod:`xfem_contact.solvers.assembly`) and ``b_r = R^T b``; the
 solution is ``x = R y``.
-The solver factors the symmetrically scaled ``D A_r D`` (:mod:`xfem_contact.solvers.scaling`).
+The solver factors the symmetrically scaled ``D A_r D`` (:mod:`xfem_contact.solvers.scaling`),
+or, with a crack's tip enrichment, ``Z^T A_r Z`` with ``x = R Z y`` for the change of
+unknowns ``Z`` of :mod:`xfem_contact.solvers.block_scaling`.
 """
 
 from __future__ import annotations
@@ -17,6 +19,12 @@ from petsc4py import PETSc
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.restriction import restriction_matrix
 from xfem_contact.solvers.assembly import ReducedMatrix
+from xfem_contact.solvers.block_scaling import (  # noqa: F401  (crack_options: for problem)
+    crack_options,
+    refined,
+    scaled,
+    tip_transform,
+)
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.symmetry import mark_symmetric
@@ -68,6 +76,7 @@ def solve_restricted(
     petsc_options_prefix: str = "xfem_linear_",
     R: PETSc.Mat | None = None,
     residuals: list[float] | None = None,
+    tip_scaling: bool = True,
 ) -> tuple[dolfinx.fem.Function, int]:
     """Solve ``a(u, v) = L(v)`` on the reduced space of ``R`` (one KSP solve).
 
@@ -87,6 +96,8 @@ def solve_restricted(
             here. A given ``R`` is not destroyed.
         residuals: If given, the norms of the scaled reduced residual before and
             after the solve are appended to it (``|D b|``, ``|D b - D A D y_s|``).
+        tip_scaling: With a crack's tip enrichment, factor ``Z^T A_r Z`` with ``x = R Z y``
+            (:func:`~xfem_contact.solvers.block_scaling.tip_scaling`) instead of ``D A_r D``.
 
     Returns:
         The solution ``x = R y`` on ``space.W`` (zero on inactive dofs, ghosts
@@ -105,9 +116,16 @@ def solve_restricted(
     if own_R:
         R = restriction_matrix(space)
     A, b = assemble_restricted(a, L, bcs, R)
-    D = saddle_point_scaling(A)  # solve D A D y_s = D b, y = D y_s
-    A.diagonalScale(D, D)
-    b.pointwiseMult(b, D)
+    transform = tip_transform(space, off=not tip_scaling)
+    if transform is None:
+        D = saddle_point_scaling(A)  # solve D A D y_s = D b, y = D y_s
+        A.diagonalScale(D, D)
+        b.pointwiseMult(b, D)
+    else:  # solve Z^T A Z y_s = Z^T b, y = Z y_s (refined against A_r y = b_r)
+        D = transform(R, A)
+        (A_r, b_r), A = (A, b), scaled(A, D)
+        b = A.createVecRight()
+        D.multTranspose(b_r, b)
     ksp = PETSc.KSP().create(A.getComm())
     ksp.setOperators(A)
     prefix = unique_prefix(petsc_options_prefix)
@@ -126,7 +144,10 @@ def solve_restricted(
         r.axpy(-1.0, b)
         residuals += [b.norm(), r.norm()]
         r.destroy()
-    y.pointwiseMult(y, D)
+    if transform is None:
+        y.pointwiseMult(y, D)
+    else:
+        y = refined(ksp, D, A_r, b_r, y)
     w = dolfinx.fem.Function(space.W)
     R.mult(y, w.x.petsc_vec)
     w.x.scatter_forward()

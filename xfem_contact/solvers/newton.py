@@ -24,6 +24,7 @@ from petsc4py import PETSc
 
 from xfem_contact.fem.forms import form_parts
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
+from xfem_contact.solvers.block_scaling import TipFactor
 from xfem_contact.solvers.jacobian import JacobianForms
 from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.report import NewtonFailure, NewtonReport
@@ -83,6 +84,12 @@ class RestrictedNewton:
             <xfem_contact.fem.enrichment.EnrichedSpace.field_space>`). With a selecting
             ``R`` the Jacobian's uncut cells and ghost penalty are then assembled field
             by field on those spaces (:func:`xfem_contact.fem.field_blocks.split_uncut`).
+        transform: ``transform(R, J_r)``: a change of unknowns ``Z`` made from the first
+            unscaled reduced Jacobian (a crack's tip enrichment,
+            :func:`~xfem_contact.solvers.block_scaling.tip_scaling`): each Newton step
+            then factors ``Z^T J_r Z`` (:class:`~xfem_contact.solvers.block_scaling.TipFactor`);
+            SNES's unknowns and residual norms stay ``D``-scaled. Not with couplings or a
+            split preconditioner.
     """
 
     def __init__(
@@ -100,6 +107,7 @@ class RestrictedNewton:
         couplings: list | None = None,
         interpolation=None,
         field_space: Callable | None = None,
+        transform: Callable[[PETSc.Mat, PETSc.Mat], PETSc.Mat] | None = None,
     ):
         self.w, self.bcs, self.R = w, bcs, R
         self.couplings = list(couplings or [])
@@ -142,6 +150,7 @@ class RestrictedNewton:
         self.timings["jacobian"] = time.perf_counter() - start
         start = time.perf_counter()
         self.D = saddle_point_scaling(self.J_r)
+        Z = None if transform is None else transform(R, self.J_r)
         self.J_r.diagonalScale(self.D, self.D)
         self.timings["scaling"] = time.perf_counter() - start
         #: The PETSc options (without prefix) of this solver's SNES, KSP and PC
@@ -160,6 +169,8 @@ class RestrictedNewton:
         self.snes.setOptionsPrefix(self._prefix)
         with applied_options(self._prefix, self.options):
             self.snes.setFromOptions()
+            #: The factorisation through the tip enrichment's change of unknowns, or None
+            self.tip = None if Z is None else TipFactor(self.snes, Z, self.D, self._symmetric)
         self._split_objects = split_sets(
             self.snes.getKSP().getPC(),
             self.R,
@@ -315,6 +326,8 @@ class RestrictedNewton:
             coupling.destroy()
         for obj in (self.snes, self.b, self.y, self.F_r, self.R, self.D, *self._split_objects):
             obj.destroy()
+        if self.tip is not None:
+            self.tip.destroy()
         self.jacobian_forms.destroy()
         if self._projection is not None:
             self._projection.destroy()

@@ -92,10 +92,13 @@ SOLVER_OPTIONS: dict[str, Option] = {
 }
 
 
-#: Options added under a problem's own for a cut with a crack: the geometric tip
-#: enrichment's branch functions are nearly dependent on the polynomials far from the
-#: tip, and MUMPS's delayed pivots then outgrow its default workspace (INFO(1) = -9,
-#: KSP reason -11): 100 % more workspace
+#: Options added under a problem's own for a cut with a crack whose solver does without
+#: the tip enrichment's change of unknowns (:mod:`xfem_contact.solvers.block_scaling`:
+#: a split preconditioner, or large-sliding couplings): the geometric tip enrichment's
+#: branch functions are then nearly dependent on the polynomials far from the tip, and
+#: MUMPS's delayed pivots outgrow its default workspace (INFO(1) = -9, KSP reason -11,
+#: P1 and P2 at n = 128 in the Williams case): 100 % more workspace. With the change
+#: of unknowns (the direct solves) the default workspace suffices.
 CRACK_OPTIONS: dict[str, OptionValue] = {"mat_mumps_icntl_14": 100}
 
 
