@@ -22,7 +22,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from xfem_contact.fem.evaluation import rule_cells
-from xfem_contact.mechanics.sliding.blocks import BlockMatrix
+from xfem_contact.mechanics.sliding.blocks import BlockMatrix, cell_pairs, role
 from xfem_contact.mechanics.sliding.element import PairTerms, frictionless_terms
 from xfem_contact.mechanics.sliding.friction import PointData
 from xfem_contact.mechanics.sliding.friction import residual as friction_residual
@@ -109,6 +109,7 @@ class SlidingCoupling:
         self._frozen_segments: Segments | None = None
         self._accepted_cells: np.ndarray | None = None
         self._blocks = BlockMatrix()
+        self._cells = cut.mesh.topology.index_map(cut.mesh.topology.dim).size_global
         #: Linearise the motion of the split points (iterate pairing): the jump of
         #: the integrand at each split point times the point's derivative
         self.split_linearisation = True
@@ -229,7 +230,9 @@ class SlidingCoupling:
         """The Jacobian block of the split points' motion: at each split point, the
         integrand's jump (left sub-segment's minus right's, per unit ``t``) times the
         point's derivative. ``(rows (b, 2 nz), cols (b, nc), values (b, 2 nz, nc),
-        pairs of global cells)``, None without splits."""
+        the (row, column) pairs of cells it couples
+        (:func:`~xfem_contact.mechanics.sliding.blocks.cell_pairs`)``, None without
+        splits."""
         lip = self.lip
         k, grad = split_gradient(self.pieces, w.x.array, lip, segments)
         if k.size == 0:
@@ -253,12 +256,10 @@ class SlidingCoupling:
         masters = np.where(sides >= 0, lip.cells[np.maximum(sides, 0)], -1)
         tdim = self.cut.mesh.topology.dim
         slave = self.cut.mesh.topology.index_map(tdim).local_to_global(cells)
-        pairs = {
-            ("split", a, c)
-            for r in (slave, masters[:b], masters[b:])
-            for c_cells in (slave, lip.cells[source])
-            for a, c in zip(r.tolist(), c_cells.tolist(), strict=True)
-        }
+        slave, masters = role(slave, False), role(masters, True)
+        row_cells = np.tile(np.concatenate([slave, masters[:b], masters[b:]]), 2)
+        col_cells = np.repeat([slave, role(lip.cells[source], True)], 3, axis=0).ravel()
+        pairs = cell_pairs(self._cells, row_cells, col_cells)
         return rows, cols, jump[:, :, None] * grad[:, None, :], pairs
 
     def _terms(self, w, points: SlavePoints, x_s, pairing: Pairing, jacobian: bool = True):
@@ -365,22 +366,21 @@ class SlidingCoupling:
             [self._columns[self._local(points)], self._indices(pairing, self.lip.columns)], axis=1
         )
         blocks = [(cols, cols, terms.jacobian)]
-        master = np.where(pairing.paired, pairing.piece, -1)
-        key = [points.cells, master]
         tdim = self.cut.mesh.topology.dim
         to_global = self.cut.mesh.topology.index_map(tdim).local_to_global
         slave_cells = to_global(points.cells)
         pieces = np.where(pairing.paired, pairing.piece, 0)
         paired = pairing.paired
-        masters = self.lip.cells[pieces][paired].tolist()
-        pairs = set(zip(slave_cells[paired].tolist(), masters, strict=True))
+        a, b = role(slave_cells[paired], False), role(self.lip.cells[pieces][paired], True)
+        # each point couples {slave, master} x {slave, master}
+        pairs = [cell_pairs(self._cells, np.r_[a, a, b, b], np.r_[a, b, a, b])]
         motion = self._integrated[-1] if self.segments else None
         if motion is not None:
             blocks.append(motion[:3])
-            key += [np.asarray(motion[0].shape), motion[0].ravel(), motion[1].ravel()]
-            pairs |= motion[3]
-        self._blocks.add_to(J, np.concatenate(key).tobytes(), blocks, pairs)
+            pairs.append(motion[3])
+        pairs = np.unique(np.concatenate(pairs))
+        self._blocks.add_to(J, blocks, pairs)
 
     def destroy(self) -> None:
-        """Destroy the COO matrix. Collective."""
+        """Release the point blocks' storage. Collective."""
         self._blocks.destroy()

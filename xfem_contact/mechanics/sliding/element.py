@@ -53,9 +53,36 @@ def node_slots(basis: np.ndarray, v: np.ndarray) -> np.ndarray:
     return (basis[:, :, None] * v[:, None, :]).reshape(basis.shape[0], 2 * basis.shape[1])
 
 
+class GapHessian(typing.NamedTuple):
+    """The gap's Hessian in the displacement unknowns as a sum of outer products,
+    ``H = ds (x) e + e (x) ds + gamma c (x) c`` (``ds``, ``e``, ``c`` each
+    ``(m, nz_u)``, ``gamma`` ``(m,)``): rank 3 per point, so the element's matrix is
+    one batched product (:func:`frictionless_terms`)."""
+
+    ds: npt.NDArray[np.float64]
+    e: npt.NDArray[np.float64]
+    c: npt.NDArray[np.float64]
+    gamma: npt.NDArray[np.float64]
+
+    def dense(self) -> npt.NDArray[np.float64]:
+        """``H``, ``(m, nz_u, nz_u)``."""
+        X = self.ds[:, :, None] * self.e[:, None, :]
+        return (
+            X
+            + np.transpose(X, (0, 2, 1))
+            + self.gamma[:, None, None] * (self.c[:, :, None] * self.c[:, None, :])
+        )
+
+    def scaled(self, k) -> GapHessian:
+        """``k H`` (``k`` a scalar or ``(m,)``)."""
+        k = np.broadcast_to(np.asarray(k, dtype=float), self.gamma.shape)
+        return GapHessian(self.ds, k[:, None] * self.e, self.c, k * self.gamma)
+
+
 def gap_derivatives(x_s, phi_s, curve, orientation):
-    """Gap, its gradient ``(m, nz_u)`` and Hessian ``(m, nz_u, nz_u)`` in the
-    displacement unknowns ``(a, b)`` of the pairs (the multiplier slots excluded).
+    """Gap, its gradient ``(m, nz_u)`` and Hessian (a :class:`GapHessian`; ``.dense()``
+    ``(m, nz_u, nz_u)``) in the displacement unknowns ``(a, b)`` of the pairs (the
+    multiplier slots excluded).
 
     Args:
         x_s: Deformed slave points (m), ``(m, 2)``.
@@ -79,14 +106,9 @@ def gap_derivatives(x_s, phi_s, curve, orientation):
     F_s = -tt + g * kappa
     F_z = slots(phi_s, -curve.phi, t) + g[:, None] * c
     ds = -F_z / F_s[:, None]
-    sym = ds[:, :, None] * c[:, None, :]
-    sym = sym + np.transpose(sym, (0, 2, 1))
-    H = (
-        -(1.0 - g * kappa / tt)[:, None, None] * sym
-        + (F_s * kappa / tt)[:, None, None] * ds[:, :, None] * ds[:, None, :]
-        + (g / tt)[:, None, None] * c[:, :, None] * c[:, None, :]
-    )
-    return g, grad, H
+    # H = -(1 - g kappa / tt) (ds c + c ds) + (F_s kappa / tt) ds ds + (g / tt) c c
+    e = -(1.0 - g * kappa / tt)[:, None] * c + (0.5 * F_s * kappa / tt)[:, None] * ds
+    return g, grad, GapHessian(ds, e, c, g / tt)
 
 
 def frictionless_terms(
@@ -115,22 +137,38 @@ def frictionless_terms(
     contact = paired & (trial < 0.0)
     P = np.where(contact, trial, 0.0)
     nz = 4 * nn + nl
-    grad = np.zeros((m, nz))
-    grad[:, : 2 * nn] = grad_u[:, : 2 * nn]
-    grad[:, 2 * nn + nl :] = grad_u[:, 2 * nn :]
+
+    def slots(v):  # displacement slots (a, b) -> all unknowns (a, l, b)
+        out = np.zeros((v.shape[0], nz))
+        out[:, : 2 * nn] = v[:, : 2 * nn]
+        out[:, 2 * nn + nl :] = v[:, 2 * nn :]
+        return out
+
+    grad = slots(grad_u)
     L = np.zeros((m, nz))
     L[:, 2 * nn : 2 * nn + nl] = lam_basis
     residual = weights[:, None] * (P[:, None] * grad - ((lam - P) / r)[:, None] * L)
     if not jacobian:
         return PairTerms(residual, None, np.where(paired, g, np.nan), lam, P)
-    K = np.where(
-        contact[:, None, None],
-        np.einsum("mi,mj->mij", grad, L)
-        + np.einsum("mi,mj->mij", L, grad)
-        + r[:, None, None] * np.einsum("mi,mj->mij", grad, grad),
-        -np.einsum("mi,mj->mij", L, L) / r[:, None, None],
+    # contact: grad L + L grad + r grad grad + P H = X + X^T, X = U^T V (rank 3)
+    K = np.zeros((m, nz, nz))
+    on = np.flatnonzero(contact)
+    H, Pc, gc = H_u, P[on], grad[on]
+    U = np.stack([gc, slots(H.ds[on]), slots(H.c[on])], axis=1)
+    V = np.stack(
+        [
+            L[on] + 0.5 * r[on, None] * gc,
+            Pc[:, None] * slots(H.e[on]),
+            (0.5 * Pc * H.gamma[on])[:, None] * slots(H.c[on]),
+        ],
+        axis=1,
     )
-    u = np.r_[0 : 2 * nn, 2 * nn + nl : nz]
-    K[:, u[:, None], u[None, :]] += np.where(contact[:, None, None], P[:, None, None] * H_u, 0.0)
+    X = np.matmul(np.transpose(U, (0, 2, 1)), V)
+    K[on] = X + np.transpose(X, (0, 2, 1))
+    off = np.flatnonzero(~contact)  # -L L / r
+    lam_slots = slice(2 * nn, 2 * nn + nl)
+    K[off, lam_slots, lam_slots] = (
+        -(lam_basis[off, :, None] * lam_basis[off, None, :]) / r[off, None, None]
+    )
     K *= weights[:, None, None]
     return PairTerms(residual, K, np.where(paired, g, np.nan), lam, P)

@@ -67,23 +67,77 @@ def _newton(lip, x: np.ndarray, pieces: np.ndarray, s: np.ndarray, iterations: i
     return s
 
 
-def _candidates(x, samples, radius, k, chunk: int = 512):
-    """The ``k`` pieces whose grown box holds each point, nearest sample first:
-    ``(order (m, k), tried (m, k) bool, nearest sample distance (m,))``."""
+def _boxes(samples, radius):
+    """The pieces' deformed boxes, grown by a quarter of their diagonal (the bulge
+    of a curved piece between its samples) and the search radius: ``(low, high)``,
+    each ``(P, 2)``."""
     low, high = samples.min(axis=1), samples.max(axis=1)
-    grow = 0.25 * np.linalg.norm(high - low, axis=1)[:, None] + radius  # bulge + radius
-    low, high = low - grow, high + grow
-    orders, tried, nearest = [], [], []
-    for start in range(0, x.shape[0], chunk):
-        p = x[start : start + chunk]
-        inside = np.all((p[:, None, :] >= low) & (p[:, None, :] <= high), axis=2)
-        d2 = np.min(np.sum((p[:, None, None, :] - samples[None]) ** 2, axis=3), axis=2)
-        nearest.append(np.sqrt(d2.min(axis=1)))
-        d2 = np.where(inside, d2, np.inf)
-        order = np.argsort(d2, axis=1, kind="stable")[:, :k]
-        orders.append(order)
-        tried.append(np.isfinite(np.take_along_axis(d2, order, axis=1)))
-    return np.concatenate(orders), np.concatenate(tried), np.concatenate(nearest)
+    grow = 0.25 * np.linalg.norm(high - low, axis=1)[:, None] + radius
+    return low - grow, high + grow
+
+
+def _grid(low, high):
+    """A uniform grid over the boxes (cell size their mean extent) and, per grid
+    cell, the boxes that overlap it: ``(origin (2,), size, shape (2,), offsets,
+    boxes)`` (CSR: grid cell ``c`` holds ``boxes[offsets[c]:offsets[c + 1]]``)."""
+    origin = low.min(axis=0)
+    spread = high.max(axis=0) - origin
+    size = float(np.mean(np.max(high - low, axis=1)))  # at most ~4 cells per box
+    size = max(size, float(np.sqrt(np.prod(spread) / (4 * low.shape[0]))), 1e-300)
+    first = np.floor((low - origin) / size).astype(np.int64)
+    last = np.floor((high - origin) / size).astype(np.int64)
+    shape = last.max(axis=0) + 1
+    span = last - first + 1  # grid cells per box and direction
+    count = span[:, 0] * span[:, 1]
+    box = np.repeat(np.arange(low.shape[0]), count)
+    k = np.arange(box.size) - np.repeat(np.cumsum(count) - count, count)  # within a box
+    i = first[box, 0] + k % span[box, 0]
+    j = first[box, 1] + k // span[box, 0]
+    cell = i * shape[1] + j
+    order = np.argsort(cell, kind="stable")
+    offsets = np.zeros(shape[0] * shape[1] + 1, dtype=np.int64)
+    np.cumsum(np.bincount(cell, minlength=shape[0] * shape[1]), out=offsets[1:])
+    return origin, size, shape, offsets, box[order]
+
+
+def _candidates(x, samples, radius, k):
+    """The ``k`` pieces whose grown box holds each point, nearest sample first:
+    ``(order (m, k), tried (m, k) bool, nearest sample distance (m,))``. The boxes
+    are binned on a uniform grid (:func:`_grid`): each point is tested against the
+    boxes of its grid cell only; the nearest sample is exact within the radius
+    (every sample that near lies in a box holding the point), beyond it computed
+    over the whole lip for those points only."""
+    m = x.shape[0]
+    low, high = _boxes(samples, radius)
+    origin, size, shape, offsets, boxes = _grid(low, high)
+    ij = np.floor((x - origin) / size).astype(np.int64)
+    inside_grid = np.all((ij >= 0) & (ij < shape), axis=1)
+    cell = np.where(inside_grid, ij[:, 0] * shape[1] + ij[:, 1], 0)
+    count = np.where(inside_grid, offsets[cell + 1] - offsets[cell], 0)
+    point = np.repeat(np.arange(m), count)
+    piece = boxes[
+        np.repeat(offsets[cell] - np.cumsum(count) + count, count) + np.arange(point.size)
+    ]
+    p = x[point]
+    inside = np.all((p >= low[piece]) & (p <= high[piece]), axis=1)
+    point, piece = point[inside], piece[inside]
+    d2 = np.min(np.sum((x[point, None, :] - samples[piece]) ** 2, axis=2), axis=1)
+    by = np.lexsort((piece, d2, point))  # per point: nearest first, ties by piece
+    point, piece, d2 = point[by], piece[by], d2[by]
+    starts = np.searchsorted(point, np.arange(m))
+    rank = np.arange(point.size) - starts[point]
+    keep = rank < k
+    order = np.zeros((m, k), dtype=np.int64)
+    tried = np.zeros((m, k), dtype=bool)
+    order[point[keep], rank[keep]] = piece[keep]
+    tried[point[keep], rank[keep]] = True
+    nearest = np.full(m, np.inf)
+    nearest[point[rank == 0]] = np.sqrt(d2[rank == 0])
+    far = np.flatnonzero(~(nearest <= radius))
+    for chunk in np.array_split(far, max(1, far.size // 256)) if far.size else ():
+        d2 = np.sum((x[chunk, None, None, :] - samples[None]) ** 2, axis=3)
+        nearest[chunk] = np.sqrt(d2.min(axis=(1, 2)))
+    return order, tried, nearest
 
 
 def lip_samples(lip) -> np.ndarray:
