@@ -97,8 +97,8 @@ def restriction_matrix(
     rows = np.concatenate(entries_rows)
     cols = np.concatenate(entries_cols)
     vals = np.concatenate(entries_vals)
+    n_cols = comm.allreduce(n_red, op=MPI.SUM)  # on every process (ties may be on some)
     if len(entries_rows) > 1:  # sum repeated (row, column) pairs; sort by row, column
-        n_cols = comm.allreduce(n_red, op=MPI.SUM)
         keys, inverse = np.unique(rows * n_cols + cols, return_inverse=True)
         rows, cols = np.divmod(keys, n_cols)
         vals = np.bincount(inverse, weights=vals, minlength=keys.size)
