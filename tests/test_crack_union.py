@@ -47,6 +47,7 @@ def mesh():
     return square(24)
 
 
+@pytest.mark.mpi
 def test_each_crack_is_cut_as_if_alone(mesh):
     """A straight and a curved crack: each crack's lips as long as in a cut by it alone
     (the straight one exactly), the areas exact, the four tips where the paths end,
@@ -207,6 +208,7 @@ def two():
     return plate([-XC, XC])
 
 
+@pytest.mark.mpi
 def test_two_mirrored_cracks(single, two):
     """Two equal cracks mirrored about the plate's centre line: K_I equal at mirrored
     tips (1e-5 measured), and each tip's K_I over that of the crack alone in the plate
@@ -242,6 +244,7 @@ def test_tip_zones_rings_and_growth_refused_for_several(two):
         grow(problem, polyline([(0.6, Y0), (1.4, Y0)]), 0.1, RINGS)
 
 
+@pytest.mark.mpi
 def test_a_closed_interface_among_cracks(single):
     """A circular inclusion (``psi = None``) bonded next to crack c0: of the body's own
     material it is no inclusion (K as the crack alone, 5e-10 measured), ten times stiffer
