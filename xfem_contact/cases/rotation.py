@@ -58,27 +58,27 @@ def _shoot(slope, mu, lmbda, radii, steps):
                 break
         return e_r
 
-    def rhs(R, y):
-        u, T = y
+    def rhs(R, u, T):  # (u', T') in Python floats (numpy scalars cost more here)
         e_t = u / R
         e_r = radial_strain(R, e_t, T)
         _, S_tt = _radial_stress(e_r, e_t, mu, lmbda)
-        return np.array([e_r, (1.0 + e_t) * S_tt])
+        return e_r, (1.0 + e_t) * S_tt
 
     S_rr, _ = _radial_stress(slope, 0.0, mu, lmbda)
-    y = np.array([0.0, r_in * (1.0 + slope) * S_rr])
+    u, T = 0.0, float(r_in * (1.0 + slope) * S_rr)
     values = {}
     for start, end in ((r_in, r_gamma), (r_gamma, r_out)):
         h = (end - start) / steps
         R = start
         for _ in range(steps):
-            k1 = rhs(R, y)
-            k2 = rhs(R + h / 2, y + h / 2 * k1)
-            k3 = rhs(R + h / 2, y + h / 2 * k2)
-            k4 = rhs(R + h, y + h * k3)
-            y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            a1, b1 = rhs(R, u, T)
+            a2, b2 = rhs(R + h / 2, u + h / 2 * a1, T + h / 2 * b1)
+            a3, b3 = rhs(R + h / 2, u + h / 2 * a2, T + h / 2 * b2)
+            a4, b4 = rhs(R + h, u + h * a3, T + h * b3)
+            u += h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+            T += h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
             R += h
-        values[end] = y[1] / end
+        values[end] = T / end
     return values[r_gamma], values[r_out]
 
 

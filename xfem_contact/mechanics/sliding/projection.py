@@ -42,8 +42,60 @@ class Pairing(typing.NamedTuple):
         return self.piece >= 0
 
 
+def _polynomials(lip) -> np.ndarray | None:
+    """Each deformed piece as a polynomial in ``tau = 2 s - 1``: monomial coefficients
+    ``(P, d + 1, 2)``, interpolated at ``d + 1`` Chebyshev points (exact: the cell
+    map and the displacement are polynomials of degree ``<= tdim k`` in the
+    reference coordinates, ``k`` their Lagrange degree, and those are quadratic in
+    ``s``: ``d = 4 k``). Cached on the lip until its next ``refresh``; None for a lip
+    without elements."""
+    cache = getattr(lip, "cache", None)
+    if cache is not None and "polynomials" in cache:
+        return cache["polynomials"]
+    elements = [getattr(lip, name, None) for name in ("element", "coordinate_element")]
+    if any(e is None for e in elements):
+        return None
+    d = 4 * max(e.embedded_superdegree for e in elements)
+    tau = np.cos(np.pi * (np.arange(d + 1) + 0.5) / (d + 1))
+    P = lip.size
+    x = lip.curve(np.repeat(np.arange(P), d + 1), np.tile(0.5 * (tau + 1.0), P)).x
+    V = tau[:, None] ** np.arange(d + 1)[None, :]
+    values = x.reshape(P, d + 1, 2).transpose(1, 0, 2).reshape(d + 1, 2 * P)
+    coefficients = np.linalg.solve(V, values).reshape(d + 1, P, 2).transpose(1, 0, 2)
+    if cache is not None:
+        cache["polynomials"] = coefficients
+    return coefficients
+
+
+def _horner(coefficients: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, ...]:
+    """``(x, dx/ds, d^2x/ds^2)`` of polynomials ``(m, d + 1, 2)`` (in ``tau = 2 s - 1``)
+    at ``s`` ``(m,)``, each ``(m, 2)``."""
+    tau = (2.0 * s - 1.0)[:, None]
+    p = coefficients[:, -1].copy()
+    dp = np.zeros_like(p)
+    ddp = np.zeros_like(p)
+    for k in range(coefficients.shape[1] - 2, -1, -1):
+        ddp = ddp * tau + 2.0 * dp
+        dp = dp * tau + p
+        p = p * tau + coefficients[:, k]
+    return p, 2.0 * dp, 4.0 * ddp
+
+
 def _newton(lip, x: np.ndarray, pieces: np.ndarray, s: np.ndarray, iterations: int = 30):
-    """Newton on ``f(s) = 0`` for each (point, piece), started from ``s``; the
+    """:func:`_exact_newton` started from the feet on the pieces' polynomials
+    (:func:`_polynomials`, no element tabulated), which the exact curve then
+    polishes in one or two iterations."""
+    coefficients = _polynomials(lip)
+    if coefficients is not None and pieces.size:
+        s = _exact_newton(None, x, pieces, s, iterations, coefficients[pieces])
+    return _exact_newton(lip, x, pieces, s, iterations)
+
+
+def _exact_newton(
+    lip, x: np.ndarray, pieces: np.ndarray, s: np.ndarray, iterations: int = 30, polynomials=None
+):
+    """Newton on ``f(s) = 0`` for each (point, piece), started from ``s``, on the
+    exact curve or on the pieces' ``polynomials`` (``(m, d + 1, 2)``); the
     parameter is kept in ``[-0.5, 1.5]`` (the polynomial piece extended a little).
     Only the pairs not yet converged are iterated on; a pair held at a bound twice
     in a row stays there (its foot is off the piece)."""
@@ -53,10 +105,14 @@ def _newton(lip, x: np.ndarray, pieces: np.ndarray, s: np.ndarray, iterations: i
     for _ in range(iterations):
         if active.size == 0:
             break
-        c = lip.curve(pieces[active], s[active])
-        r = x[active] - c.x
-        f = -np.sum(r * c.t, axis=1)
-        df = np.sum(c.t * c.t, axis=1) - np.sum(r * c.t2, axis=1)
+        if polynomials is None:
+            c = lip.curve(pieces[active], s[active])
+            c_x, c_t, c_t2 = c.x, c.t, c.t2
+        else:
+            c_x, c_t, c_t2 = _horner(polynomials[active], s[active])
+        r = x[active] - c_x
+        f = -np.sum(r * c_t, axis=1)
+        df = np.sum(c_t * c_t, axis=1) - np.sum(r * c_t2, axis=1)
         step = np.where(df > 0.0, f / np.where(df > 0.0, df, 1.0), 0.0)
         new = s[active] - step
         held = (new < -0.5) | (new > 1.5)
