@@ -235,12 +235,15 @@ def condition_number(problem, iterations: int = 60, tip_scaling: bool = True) ->
     x.setRandom()
     for _ in range(iterations // 2):
         ksp.solve(x, y)
+        if ksp.getConvergedReason() < 0:  # MUMPS failed (its workspace): no estimate
+            low = 0.0
+            break
         low = 1 / y.norm()
         y.copy(x)
         x.scale(low)
     for obj in (ksp, A, b, D, R, x, y):
         obj.destroy()
-    return top / low
+    return top / low if low > 0 else math.inf
 
 
 def conditioning(say, quick: bool) -> list[dict]:
