@@ -36,6 +36,8 @@ from xfem_contact.mechanics.fracture import (
     TipIntegrals,
 )
 from xfem_contact.mechanics.fracture.tips import lip_tractions
+from xfem_contact.solvers.linear import assemble_restricted
+from xfem_contact.solvers.scaling import saddle_point_scaling
 
 
 def total(expr) -> float:
@@ -91,6 +93,22 @@ def test_williams_field_p2(enrichment):
     assert ring.K_I == pytest.approx(1.0, abs=1.5e-4)
     assert ring.K_II == pytest.approx(0.5, abs=1.5e-4)
     assert ring.J == pytest.approx(ring.G, rel=2e-4)
+
+
+@pytest.mark.serial
+def test_ramp_leaves_no_null_vector():
+    """The ramp makes the P1 partition complete around the tip, where the branch functions
+    times linear functions are dependent (4 null vectors of the stiffness); dropping F_1
+    and F_2 at one node removes them: smallest eigenvalue of the Jacobi-scaled reduced
+    stiffness 2.4e-7 (5.5e-16 with all dofs)."""
+    problem = williams_case(8, 1, tip_radius=0.4).problem
+    R = problem.restriction()
+    a, L = form(problem.bilinear_form()), form(problem.loads.linear_form())
+    A, b = assemble_restricted(a, L, problem.loads.bcs, R)
+    D = saddle_point_scaling(A)
+    A.diagonalScale(D, D)
+    eigenvalues = np.abs(np.linalg.eigvalsh(A.convert("dense").getDenseArray()))
+    assert eigenvalues.min() > 1e-9 * eigenvalues.max()
 
 
 def test_williams_field_p1_converges():

@@ -22,7 +22,7 @@ import numpy.typing as npt
 import ufl
 from mpi4py import MPI
 
-from xfem_contact.fem.branch import UFL, branch_values
+from xfem_contact.fem.branch import UFL, branch_values, null_pins
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.subspaces import collapse
 from xfem_contact.geometry.crack import CROSSED, TIP
@@ -262,7 +262,12 @@ class EnrichedSpace:
         distance = np.linalg.norm(x[:, None, :] - crack.tips[None], axis=2).min(axis=1)
         R.x.array[:] = distance <= self.tip_radius
         ramp_cells = R.function_space.dofmap.list[: self.cut.cell_sides.size]
-        return self._mark(field, np.flatnonzero(R.x.array[ramp_cells].max(axis=1) > 0)) > 0
+        flags = self._mark(field, np.flatnonzero(R.x.array[ramp_cells].max(axis=1) > 0)) > 0
+        V, parent = self.field_space(field)  # F_1, F_2 dropped at one node: no null vectors
+        gdim, bs, xb = crack.tips.shape[1], V.dofmap.index_map_bs, V.tabulate_dof_coordinates()
+        pins = null_pins(xb[:, :gdim], crack.tips, crack.directions, self.tip_radius, mesh.comm)
+        flags[parent[(np.flatnonzero(pins)[:, None] * bs + np.arange(2 * gdim)).ravel()]] = False
+        return flags
 
     def _tied(self, active: npt.NDArray[np.bool_]) -> npt.NDArray[np.int64]:
         """``(kept, follower)`` owned dofs of fields 0 and 1 at the same node and
