@@ -265,7 +265,7 @@ class EnrichedSpace:
         flags = self._mark(field, np.flatnonzero(R.x.array[ramp_cells].max(axis=1) > 0)) > 0
         V, parent = self.field_space(field)  # F_1, F_2 dropped at one node: no null vectors
         gdim, bs, xb = crack.tips.shape[1], V.dofmap.index_map_bs, V.tabulate_dof_coordinates()
-        pins = null_pins(xb[:, :gdim], crack.tips, crack.directions, self.tip_radius, mesh.comm)
+        pins = null_pins(xb[:, :gdim], crack.tips, crack.directions, 0.5 * h, mesh.comm)
         flags[parent[(np.flatnonzero(pins)[:, None] * bs + np.arange(2 * gdim)).ravel()]] = False
         return flags
 
