@@ -414,7 +414,10 @@ def main() -> None:
     args = parser.parse_args()
     rank0 = MPI.COMM_WORLD.rank == 0
     say = print if rank0 and not args.no_progress else (lambda *a: None)
-    rows = []
+    saved = RESULTS / "crack_convergence.json"
+    # the rows of the parts not rerun are kept (a run of some parts updates only theirs)
+    kept = json.loads(saved.read_text()) if saved.exists() else []
+    rows = [r for r in kept if r["case"] not in args.parts]
     for part in args.parts:  # results saved after each part
         rows += PARTS[part](say, args.quick)
         if rank0:
