@@ -211,7 +211,8 @@ class SlidingCoupling:
         if segments is None:
             feet = None
             if self._ordered:
-                feet = self._pair(w)[1].piece.reshape(self.pieces.size, -1)
+                piece, count = self._pair(w)[1].piece, self.pieces.size  # none on a process
+                feet = piece.reshape(count, piece.size // max(count, 1))
             self.lip.refresh(w)
             segments = split(self.pieces, w.x.array, self.lip, self.radius, feet)
         self.lip.refresh(w)
