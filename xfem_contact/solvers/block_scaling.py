@@ -41,7 +41,7 @@ from xfem_contact.fem.branch import branch_values
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.solvers.options import CRACK_OPTIONS
 from xfem_contact.solvers.scaling import saddle_point_scaling
-from xfem_contact.solvers.symmetry import TOLERANCE, mark_symmetric
+from xfem_contact.solvers.symmetry import TOLERANCE, mark_symmetric, symmetry_gap
 
 REFINEMENTS = 1
 #: The preconditioners that read the diagonal scaling (no change of unknowns then)
@@ -105,18 +105,8 @@ def scaled(J: PETSc.Mat, Z: PETSc.Mat, out: PETSc.Mat | None = None) -> PETSc.Ma
 
 
 def _symmetric(A: PETSc.Mat) -> bool:
-    """Whether ``y.Ax = x.Ay`` for two random vectors, to ``TOLERANCE``. Collective."""
-    x, y = A.createVecs()
-    rank = A.getComm().getRank()
-    for k, v in enumerate((x, y)):
-        v.setArray(np.random.default_rng([k, rank]).standard_normal(v.getLocalSize()))
-    Ax, Ay = x.duplicate(), y.duplicate()
-    A.mult(x, Ax)
-    A.mult(y, Ay)
-    gap = abs(y.dot(Ax) - x.dot(Ay))
-    scale = y.norm() * Ax.norm() + x.norm() * Ay.norm()
-    for v in (x, y, Ax, Ay):
-        v.destroy()
+    """Whether ``A`` is symmetric to ``TOLERANCE`` (:func:`symmetry_gap`). Collective."""
+    gap, scale = symmetry_gap(A)
     return gap <= TOLERANCE * scale
 
 

@@ -41,14 +41,10 @@ def symmetric_options(petsc_options: dict | None, symmetric: bool) -> dict:
     return options
 
 
-def mark_symmetric(A: PETSc.Mat) -> None:
-    """Check that ``A`` is symmetric (``y.Ax = x.Ay`` for two random vectors, to
-    :data:`TOLERANCE`) and flag it so for PETSc's symmetric factorisations. Two
-    matrix-vector products. Collective.
-
-    Raises:
-        ValueError: ``A`` is not symmetric.
-    """
+def symmetry_gap(A: PETSc.Mat) -> tuple[float, float]:
+    """``(|y.Ax - x.Ay|, |y| |Ax| + |x| |Ay|)`` for two random vectors ``x``, ``y`` (the
+    same on every run): ``A`` is symmetric to ``tol`` when the first is at most ``tol``
+    times the second. Two matrix-vector products. Collective."""
     x, y = A.createVecs()
     rank = A.getComm().getRank()
     for k, v in enumerate((x, y)):
@@ -60,6 +56,17 @@ def mark_symmetric(A: PETSc.Mat) -> None:
     scale = y.norm() * Ax.norm() + x.norm() * Ay.norm()
     for v in (x, y, Ax, Ay):
         v.destroy()
+    return gap, scale
+
+
+def mark_symmetric(A: PETSc.Mat) -> None:
+    """Check that ``A`` is symmetric (:func:`symmetry_gap`, to :data:`TOLERANCE`) and
+    flag it so for PETSc's symmetric factorisations. Collective.
+
+    Raises:
+        ValueError: ``A`` is not symmetric.
+    """
+    gap, scale = symmetry_gap(A)
     if not gap <= TOLERANCE * scale:
         raise ValueError(
             f"The matrix for the symmetric factorisation (pc_type = 'cholesky') is not "
