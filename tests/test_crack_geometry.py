@@ -9,9 +9,15 @@ import pytest
 
 from xfem_contact.geometry.crack import CROSSED, NONE, TIP, classify_crack, polar
 from xfem_contact.geometry.crack_tip_cell import cut_tip_cells
+from xfem_contact.geometry.cut import CutGeometry
 from xfem_contact.geometry.cut_topology import cell_data
 from xfem_contact.quadrature.rules import triangle_rules
-from xfem_contact.quadrature.tip_rules import duffy_rule, tip_lip_rule, tip_side_rules
+from xfem_contact.quadrature.tip_rules import (
+    duffy_rule,
+    near_tip_side_rules,
+    tip_lip_rule,
+    tip_side_rules,
+)
 
 CELLS = ("triangle", "quadrilateral")
 A = np.array([[1.3, 0.4], [-0.2, 0.9]])  # an affine parent map x = A X + b
@@ -173,11 +179,12 @@ def _crack_theta(x):
     return np.angle(np.exp(1j * (np.arctan2(x[:, 1], x[:, 0]) - CRACK_ANGLE + np.pi)))
 
 
-def _reference_integrals(n=400):
-    """int r^a h(theta) over FAN in polar coordinates: the radial part exactly
-    (R(theta)^(a+2) / (a+2), R the distance to the far edge), the angle by n-point Gauss."""
-    p1, p2 = FAN[1], FAN[2]
-    a1, a2 = np.arctan2(p1[1], p1[0]), np.arctan2(p2[1], p2[0])
+def _reference_integrals(n=400, p1=FAN[1], p2=FAN[2]):
+    """int r^a h(theta) over the fan (0, p1, p2) in polar coordinates (negative if
+    clockwise): the radial part exactly (R(theta)^(a+2) / (a+2), R the distance to the
+    far edge), the angle by n-point Gauss."""
+    a1 = np.arctan2(p1[1], p1[0])
+    a2 = a1 + np.angle(np.exp(1j * (np.arctan2(p2[1], p2[0]) - a1)))
     x, w = np.polynomial.legendre.leggauss(n)
     phi = a1 + (a2 - a1) * (x + 1) / 2
     w = w * (a2 - a1) / 2
@@ -217,6 +224,39 @@ def test_duffy_rule_integrates_tip_singularities_plain_gauss_does_not():
     assert gauss["r^-1/2"] > 1e-6 and gauss["|grad sqrt(r) sin(theta/2)|^2"] > 1e-4
     assert errors["plain Duffy"]["r^-1/2"] > 1e-7  # the grading is what makes r^-1/2 smooth
     assert errors["plain Duffy"]["|grad sqrt(r) sin(theta/2)|^2"] < 1e-12  # 1/r is smooth
+
+
+def test_near_tip_rule_integrates_a_tip_just_outside_the_cell():
+    """A sub-triangle of a cell next to the tip cell, its vertex A 0.022 from the tip:
+    exact integrals as the signed sum of the three fans from the tip. The Duffy rule
+    collapsed onto A (found by distance, A is the sub-triangle's vertex 2) is exact to
+    1e-9; the degree-16 Gauss rule of uncut cells and one collapsed onto B are not."""
+    A, B, C = np.array([0.02, 0.01]), np.array([1.0, 0.3]), np.array([0.2, 0.9])
+    fans = [_reference_integrals(400, p, q) for p, q in ((A, B), (B, C), (C, A))]
+    exact = {k: sum(f[k] for f in fans) for k in fans[0]}
+    tri = _fan_p2(np.array([B, C, A]))
+    empty = np.zeros(0, dtype=np.int64)
+    geom = CutGeometry(
+        np.zeros((0, 6, 2)), empty, tri, np.array([0]), np.zeros((0, 3, 2)), empty, 1, empty
+    )
+
+    def errors(points, weights):
+        got = _integrate(points, weights)
+        return max(abs(got[k] - exact[k]) / abs(exact[k]) for k in exact)
+
+    near = near_tip_side_rules(geom, 1, np.array([0]), lambda r, X: np.hypot(*X.T), 24)
+    assert abs(near.weights.sum() - 0.41) < 1e-14  # the triangle's area
+    assert errors(near.points, near.weights) < 1e-9
+    assert near_tip_side_rules(geom, -1, np.array([0]), lambda r, X: 1 / 0, 24).points.shape == (
+        0,
+        2,
+    )
+    gauss = triangle_rules(
+        tri, np.array([0]), 1, *basix.make_quadrature(basix.CellType.triangle, 16)
+    )
+    assert errors(gauss.points, gauss.weights) > 1e-3
+    at_B = triangle_rules(tri, np.array([0]), 1, *duffy_rule(24))
+    assert errors(at_B.points, at_B.weights) > 1e-6
 
 
 def test_duffy_rule_weights_and_polynomials():

@@ -18,11 +18,12 @@ import numpy as np
 import numpy.typing as npt
 from mpi4py import MPI
 
-from xfem_contact.geometry.crack import CROSSED, NONE, classify_crack
+from xfem_contact.geometry.crack import CROSSED, NONE, TIP, classify_crack
 from xfem_contact.geometry.crack_tip_cell import cut_tip_cells
+from xfem_contact.geometry.cut import CutGeometry
 from xfem_contact.geometry.levelset import CellMaps, LevelSet
 from xfem_contact.quadrature.rules import RuleSet
-from xfem_contact.quadrature.tip_rules import tip_lip_rule, tip_side_rules
+from xfem_contact.quadrature.tip_rules import near_tip_side_rules, tip_lip_rule, tip_side_rules
 
 __all__ = ["Crack", "crack_rules"]
 
@@ -62,7 +63,7 @@ def crack_rules(
     rules: dict[str, RuleSet],
     maps: CellMaps,
     tangent: LevelSet,
-    degree: int,
+    geometry: CutGeometry,
     tip_points: int,
 ) -> tuple[dict[str, RuleSet], Crack]:
     """The side and interface rules of a crack from those of the cut by ``phi``.
@@ -73,9 +74,11 @@ def crack_rules(
             ``phi`` (one rule per cut cell).
         maps: The cell maps and ``phi`` of the cut.
         tangent: ``psi``, interpolated in the degree of ``phi``.
-        degree: The level sets' degree (1 or 2).
+        geometry: The sub-triangulation of the cut cells by ``phi``.
         tip_points: Gauss points per direction of the Duffy rules of a tip cell's fan
-            triangles (and along its lip piece).
+            triangles (and along its lip piece), and of the other cut cells with a
+            node within one cell diameter of a tip (see
+            :func:`~xfem_contact.quadrature.tip_rules.near_tip_side_rules`).
 
     Returns:
         The new rules (same keys and rows) and the :class:`Crack`. Collective.
@@ -85,7 +88,7 @@ def crack_rules(
             :func:`~xfem_contact.geometry.crack.classify_crack` (tip on a node or an
             edge, a crack along a mesh edge, ...), naming the case.
     """
-    mesh = maps.mesh
+    mesh, degree = maps.mesh, tangent.degree
     cell_name = mesh.topology.cell_name()
     phi = maps.nodal_values(cut_cells)
     psi_maps = CellMaps(mesh, tangent)
@@ -128,5 +131,30 @@ def crack_rules(
             "The crack never enters the mesh: psi >= 0 all along the zero line of phi "
             "(the crack is phi = 0 where psi < 0)"
         )
+    near = _near_tip_rows(maps, cut_cells, cells.kind, tips[:, :gdim])
+    if near.size:
+
+        def distance(r, X):
+            x = maps.push_forward(cut_cells[r], X)
+            return np.linalg.norm(x[:, None, :] - tips[None, :, :gdim], axis=2).min(axis=1)
+
+        for key, side in (("minus", -1), ("plus", 1)):
+            near_rules = near_tip_side_rules(geometry, side, near, distance, tip_points)
+            new[key] = new[key].replace(near, near_rules)
     upper = tips[:, -1].astype(np.int64)
     return new, Crack(tangent, cells.kind, tips[:, :gdim], tips[:, gdim : 2 * gdim], upper)
+
+
+def _near_tip_rows(
+    maps: CellMaps, cut_cells: npt.NDArray[np.int32], kind: npt.NDArray[np.int8], tips: np.ndarray
+) -> npt.NDArray[np.int64]:
+    """Rows of the cut cells, tip cells excepted, with a geometry node within their own
+    diameter of a tip (``tips`` (m), ``(ntips, gdim)``). Not collective."""
+    if not len(tips) or not cut_cells.size:
+        return np.zeros(0, dtype=np.int64)
+    mesh = maps.mesh
+    gdim = mesh.geometry.dim
+    nodes = mesh.geometry.x[mesh.geometry.dofmap[cut_cells]][..., :gdim]  # (ncut, k, gdim)
+    diameter = np.linalg.norm(nodes[:, :, None] - nodes[:, None, :], axis=-1).max(axis=(1, 2))
+    to_tip = np.linalg.norm(nodes[:, :, None] - tips[None, None], axis=-1).min(axis=(1, 2))
+    return np.flatnonzero((to_tip <= diameter) & (kind != TIP)).astype(np.int64)

@@ -195,7 +195,7 @@ class CutMesh:
         psi = interpolate_tangent(self.mesh, tangent, self.degree, into=previous)
         keys = {"minus": _SIDE_MINUS, "plus": _SIDE_PLUS, "interface": _INTERFACE}
         named = {key: rules[sid] for key, sid in keys.items()}
-        named, crack = crack_rules(self.cut_cells, named, maps, psi, self.degree, self.tip_points)
+        named, crack = crack_rules(self.cut_cells, named, maps, psi, self.geometry, self.tip_points)
         names = self.interface_names
         at = np.zeros(len(crack.tips), dtype=int)
         if self.cracks is not None and len(names) > 1:  # the crack of each tip

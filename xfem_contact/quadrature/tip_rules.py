@@ -19,6 +19,11 @@ piece, from the tip: ``t = sigma^g`` is the SEG3 parameter measured from the tip
 Points are in the parent cell's reference coordinates and weights in its reference
 measure, as in :mod:`xfem_contact.quadrature.rules`: sides sum to reference areas, the
 lip rule stores ``ds / |det J|``.
+
+Cells next to a tip cell see the singularity from just outside:
+:func:`near_tip_side_rules` collapses the same Duffy rule onto the vertex of each of
+their sub-triangles nearest the tip (for a cell the crack or its extension enters, the
+point where it enters, on the crack line).
 """
 
 from __future__ import annotations
@@ -29,10 +34,17 @@ import numpy as np
 import numpy.typing as npt
 
 from xfem_contact.geometry.crack_tip_cell import TipCut
+from xfem_contact.geometry.cut import CutGeometry
 from xfem_contact.geometry.cut_topology import seg3_basis
 from xfem_contact.quadrature.rules import RuleSet, curve_rules, triangle_rules
 
-__all__ = ["duffy_rule", "gauss_interval", "tip_lip_rule", "tip_side_rules"]
+__all__ = ["duffy_rule", "gauss_interval", "near_tip_side_rules", "tip_lip_rule", "tip_side_rules"]
+
+#: Node permutations of a P2 triangle (Basix order) making vertex ``k`` vertex 0,
+#: orientation kept: row ``k``
+_ROTATIONS = np.array(
+    [[k, (k + 1) % 3, (k + 2) % 3, 3 + k, 3 + (k + 1) % 3, 3 + (k + 2) % 3] for k in range(3)]
+)
 
 
 def gauss_interval(n: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
@@ -92,6 +104,46 @@ def tip_side_rules(cut: TipCut, side: int, n_radial: int, grading: int = 2) -> R
         (cut.tri_minus, cut.tri_minus_cell) if side == -1 else (cut.tri_plus, cut.tri_plus_cell)
     )
     return triangle_rules(tri, cell, cut.num_cells, *duffy_rule(n_radial, grading=grading))
+
+
+def near_tip_side_rules(
+    geom: CutGeometry,
+    side: int,
+    rows: npt.NDArray[np.int64],
+    distance: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    n_radial: int,
+    grading: int = 2,
+) -> RuleSet:
+    """Rules of one side of cut cells near a tip: each curved sub-triangle by
+    :func:`duffy_rule` collapsed onto its vertex nearest the tip.
+
+    Args:
+        geom: Sub-triangulation of all cut cells.
+        side: -1 (``phi < 0``) or +1.
+        rows: Distinct cut-cell rows, shape ``(m,)``.
+        distance: ``(rows (k,), X (k, 2)) -> (k,)``: distance (m) from the reference
+            points ``X`` of cut cells ``rows`` to the nearest tip.
+        n_radial: Gauss points per direction.
+        grading: See :func:`duffy_rule`.
+
+    Returns:
+        A :class:`~xfem_contact.quadrature.rules.RuleSet`, rule ``k`` for cell ``rows[k]``.
+    """
+    if side not in (-1, 1):
+        raise ValueError(f"side must be -1 or +1, got {side!r}")
+    tri, cell = (
+        (geom.tri_minus, geom.tri_minus_cell) if side == -1 else (geom.tri_plus, geom.tri_plus_cell)
+    )
+    position = np.full(geom.num_cells, -1, dtype=np.int64)
+    position[rows] = np.arange(len(rows))
+    keep = position[cell] >= 0
+    order = np.argsort(position[cell[keep]], kind="stable")
+    tri, cell = tri[keep][order], position[cell[keep]][order]
+    nearest = np.zeros(len(tri), dtype=np.int64)
+    if len(tri):
+        nearest = np.argmin([distance(rows[cell], tri[:, k]) for k in range(3)], axis=0)
+    tri = np.take_along_axis(tri, _ROTATIONS[nearest][:, :, None], axis=1)
+    return triangle_rules(tri, cell, len(rows), *duffy_rule(n_radial, grading=grading))
 
 
 def tip_lip_rule(

@@ -111,21 +111,46 @@ def _symmetric(A: PETSc.Mat) -> bool:
 
 
 def refined(ksp: PETSc.KSP, Z: PETSc.Mat, A: PETSc.Mat, b: PETSc.Vec, y_s: PETSc.Vec):
-    """``y = Z y_s`` for ``ksp`` solving ``Z^T A Z y_s = Z^T b``, refined
-    :data:`REFINEMENTS` times against ``A y = b`` itself. Destroys ``A``, ``b`` and
-    ``y_s``; returns ``y``. Collective."""
-    y, r, t = A.createVecRight(), A.createVecRight(), y_s.duplicate()
+    """``y = Z y_s`` for ``ksp`` solving ``Z^T A Z y_s = Z^T b``, refined against
+    ``A y = b`` itself (:func:`refine`). Destroys ``A``, ``b`` and ``y_s``; returns ``y``.
+    Collective."""
+    y, t = A.createVecRight(), y_s.duplicate()
     Z.mult(y_s, y)
-    for _ in range(REFINEMENTS):
-        A.mult(y, r)
-        r.aypx(-1.0, b)  # b - A y
+
+    def solve(r: PETSc.Vec, c: PETSc.Vec) -> None:
         Z.multTranspose(r, t)
         ksp.solve(t, y_s)
-        Z.mult(y_s, r)
-        y.axpy(1.0, r)
-    for obj in (A, b, y_s, r, t):
+        Z.mult(y_s, c)
+
+    refine(solve, A, b, y)
+    for obj in (A, b, y_s, t):
         obj.destroy()
     return y
+
+
+def refine(
+    solve: Callable[[PETSc.Vec, PETSc.Vec], None], A: PETSc.Mat, b: PETSc.Vec, y: PETSc.Vec
+) -> None:
+    """Iterative refinement of ``y`` against ``A y = b``, in place: up to
+    :data:`REFINEMENTS` steps ``y += solve(b - A y)``, each kept only if it lowers
+    ``|b - A y|``: a factorisation too inexact for the system's conditioning (a small
+    cut) makes the steps diverge, and the first solution is then the best. Collective."""
+    r, c, trial = y.duplicate(), y.duplicate(), y.duplicate()
+    A.mult(y, r)
+    r.aypx(-1.0, b)
+    norm = r.norm()
+    for _ in range(REFINEMENTS):
+        solve(r, c)
+        y.copy(trial)
+        trial.axpy(1.0, c)
+        A.mult(trial, r)
+        r.aypx(-1.0, b)
+        if not r.norm() < norm:
+            break
+        norm = r.norm()
+        trial.copy(y)
+    for v in (r, c, trial):
+        v.destroy()
 
 
 def reduced_columns(space: EnrichedSpace, R: PETSc.Mat) -> np.ndarray:
@@ -327,14 +352,7 @@ class TipFactor:
 
     def apply(self, pc: PETSc.PC, x: PETSc.Vec, y: PETSc.Vec) -> None:
         self._solve(pc, x, y)
-        for _ in range(REFINEMENTS):  # against J_D itself: y += solve(x - J_D y)
-            residual, correction = x.duplicate(), x.duplicate()
-            pc.getOperators()[1].mult(y, residual)
-            residual.aypx(-1.0, x)
-            self._solve(pc, residual, correction)
-            y.axpy(1.0, correction)
-            residual.destroy()
-            correction.destroy()
+        refine(functools.partial(self._solve, pc), pc.getOperators()[1], x, y)  # against J_D
 
     def _solve(self, pc: PETSc.PC, x: PETSc.Vec, y: PETSc.Vec) -> None:
         self.Z.multTranspose(x, self.r)
