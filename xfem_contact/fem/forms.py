@@ -63,9 +63,13 @@ def _source_key(data, integral) -> tuple[str, int, int]:
     return (type(data).__name__, data.id, integral.subdomain_id())
 
 
-def _integral(itg: ufl.Integral, integrand, integral_type: str, sid: int) -> ufl.Integral:
-    """``itg`` with a new integrand, type and id, and no subdomain data."""
-    return ufl.Integral(integrand, integral_type, itg.ufl_domain(), sid, itg.metadata(), None)
+def _integral(
+    itg: ufl.Integral, integrand, integral_type: str, sid: int, metadata: dict | None = None
+) -> ufl.Integral:
+    """``itg`` with a new integrand, type and id, ``metadata`` over its own, and no
+    subdomain data."""
+    metadata = {**itg.metadata(), **(metadata or {})}
+    return ufl.Integral(integrand, integral_type, itg.ufl_domain(), sid, metadata, None)
 
 
 class _Rewrite(typing.NamedTuple):
@@ -114,7 +118,8 @@ def _rewrite(ufl_form: ufl.Form) -> _Rewrite:
             sid = ids[key, j]
             if part.rules is None:
                 domains.setdefault(part.integral_type, {})[sid] = part.entities
-                integrals.append(_integral(itg, itg.integrand(), part.integral_type, sid))
+                integrand, kind = itg.integrand(), part.integral_type
+                integrals.append(_integral(itg, integrand, kind, sid, part.metadata))
             else:
                 integrand = itg.integrand()
                 if part.replace:

@@ -1,4 +1,4 @@
-"""Bulk models of the two sides of a cut mesh, with the ghost penalty.
+"""Bulk models of the two sides of an enriched space, with the ghost penalty.
 
 :class:`SmallStrain`: linear elasticity per side, ``sum_s int_s sigma_s(u_s) :
 eps(v_s)``, plus the ghost penalty that keeps the operator well conditioned under
@@ -16,6 +16,8 @@ import ufl
 from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.enrichment import EnrichedSpace
+from xfem_contact.fem.tip_zone import TipZone, branch_cells
 from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws.base import Fields
 from xfem_contact.mechanics.materials import MaterialField, Moduli
@@ -42,7 +44,7 @@ class SmallStrain:
     """Small-strain elasticity of both sides plus the ghost penalty.
 
     Args:
-        cut: The cut mesh.
+        space: The enriched space (its cut mesh, and a crack's tip zone).
         materials: ``{-1: m, 1: m}``, each a :class:`Material` or a
             :class:`MaterialField` (a side whose material varies by region).
         degree: Displacement degree (the ghost penalty jumps derivatives 1..degree).
@@ -56,16 +58,26 @@ class SmallStrain:
 
     name = "bulk"
     ghost_penalty = Parameter(minimum=0.0)
+    #: Polynomial degree of the integrand per degree of the displacement (uncut cells
+    #: outside a crack's tip zone)
+    integrand_degree = 2
 
     def __init__(
         self,
-        cut: CutMesh,
+        space: EnrichedSpace,
         materials: dict[int, Moduli | MaterialField],
         degree: int,
         h: dolfinx.fem.Function,
         ghost_penalty: float = DEFAULT.ghost_penalty,
     ):
+        cut = space.cut
         self.cut, self.materials, self.degree, self.h = cut, materials, degree, h
+        #: With a crack's tip enrichment: the side measures' tip zone (the branch
+        #: functions' cells) at the cut's quadrature degree
+        self.zone = None
+        if space.branch_field is not None:
+            degree_of_cut = {"quadrature_degree": cut.quadrature_degree}
+            self.zone = TipZone(cut, lambda: branch_cells(space), degree_of_cut)
         self.ghost_penalty = ghost_penalty
         #: Whether the forms hold the ghost penalty (its weight > 0 at construction)
         self.penalised = self.ghost_penalty > 0
@@ -91,13 +103,16 @@ class SmallStrain:
         return a
 
     def dx(self, side: int) -> ufl.Measure:
-        """The measure of ``side``; with a crack, its uncut cells take the cut cells'
-        degree (the branch functions' integrands are far from polynomials, and UFL's
-        estimate of their degree, 40 to 60, would cost 1000 points a cell; 112 on the
-        ghost penalty's facets, which take that degree too)."""
+        """The measure of ``side``. With a crack, the uncut cells of the tip zone take
+        the cut cells' degree (the branch functions' integrands are far from
+        polynomials, and UFL's estimate of their degree, 40 to 60, would cost 1000
+        points a cell; 112 on the ghost penalty's facets, which take that degree too),
+        the others the integrand's polynomial degree."""
         if self.cut.crack is None:
             return self.cut.dx(side)
-        return self.cut.dx(side, {"quadrature_degree": self.cut.quadrature_degree})
+        if self.zone is None:
+            return self.cut.dx(side, {"quadrature_degree": self.cut.quadrature_degree})
+        return self.zone.dx(side, {"quadrature_degree": self.integrand_degree * self.degree})
 
     def _ghost_penalty(self, trial, test) -> ufl.Form:
         metadata = (
@@ -132,6 +147,8 @@ class SaintVenantKirchhoff(SmallStrain):
     penalty of :class:`SmallStrain` (it jumps gradients, which a rigid rotation keeps
     continuous). Same arguments as :class:`SmallStrain`; :meth:`form` takes the
     unknown ``u`` as a coefficient (the residual), never a trial function."""
+
+    integrand_degree = 4  # P(u) : grad v, P cubic in grad u
 
     def form(self, u: Fields, v: Fields) -> ufl.Form:
         """The residual's bulk terms (UFL, linear in the test functions ``v``)."""

@@ -104,7 +104,7 @@ class Problem:
         self.loads = Loads(SideFields(self.space))
         self.cell_size = cell_size(self.mesh)
         bulk = BULK_MODELS[kinematics]
-        self.bulk = bulk(cut, side_materials.bulk, degree, self.cell_size, ghost_penalty)
+        self.bulk = bulk(self.space, side_materials.bulk, degree, self.cell_size, ghost_penalty)
         #: The materials as Constants of the forms (``Moduli`` per side, per interface
         #: name on side -1 when given so): set ``E`` or ``nu`` on them (no new compile)
         self.materials = side_materials.user

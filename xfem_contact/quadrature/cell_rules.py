@@ -45,12 +45,15 @@ class IntegrationPart(typing.NamedTuple):
         rules: Runtime rules, or ``None`` for a standard part.
         replace: UFL replacements applied to the runtime integrand (e.g. the
             facet normal of a boundary piece integrated as a cell integral).
+        metadata: Overrides of the integral's metadata for a standard part (e.g. its
+            own ``quadrature_degree``).
     """
 
     integral_type: str
     entities: np.ndarray | None = None
     rules: CellRules | None = None
     replace: dict | None = None
+    metadata: dict | None = None
 
 
 class CellRules:
