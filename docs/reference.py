@@ -169,7 +169,12 @@ def scene_reference() -> str:
 
 
 def solver_options() -> str:
-    from xfem_contact.solvers.options import LINEAR_PRESETS, SOLVER_OPTIONS
+    from xfem_contact.solvers.options import (
+        LINEAR_PRESETS,
+        REFACTOR_AFTER,
+        REUSED_LU_OPTIONS,
+        SOLVER_OPTIONS,
+    )
 
     lines = [
         "# Solver options",
@@ -194,6 +199,14 @@ def solver_options() -> str:
     for name, options in LINEAR_PRESETS.items():
         shown = ", ".join(f"`{k}={v}`" for k, v in options.items()) or "MUMPS LU (the defaults)"
         lines.append(f"- `{name}`: {shown}")
+    reused = ", ".join(f"`{k}={v}`" for k, v in REUSED_LU_OPTIONS.items())
+    lines += [
+        "",
+        "Large sliding with the `direct` preset and no `ksp_type` given adds "
+        f"{reused}: GMRES on the LU of the solve's first iterate, refactored when GMRES "
+        f"needs more than {REFACTOR_AFTER} iterations (`REFACTOR_AFTER`). In Newton, any Krylov "
+        "method over `pc_type = lu` or `cholesky` reuses its factorisation so.",
+    ]
     return "\n".join(lines) + "\n"
 
 

@@ -10,7 +10,7 @@ import pytest
 import ufl
 from mpi4py import MPI
 
-from xfem_contact.cases.paper import ANNULUS_CONTACT_PRESSURE, ANNULUS_RADII
+from xfem_contact.cases.paper import ANNULUS_CONTACT_PRESSURE, ANNULUS_RADII, annulus_problem
 from xfem_contact.cases.rotation import (
     pressure_errors,
     rotating_annulus_problem,
@@ -28,6 +28,7 @@ from xfem_contact.mechanics.sliding.lips import CurvePoint
 from xfem_contact.mechanics.sliding.projection import closest_points
 from xfem_contact.mechanics.sliding.segments import split
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton
+from xfem_contact.solvers.options import preset
 
 
 class ArcLip:
@@ -431,3 +432,38 @@ def test_a_turn_by_one_radian_gives_the_unturned_pressures(segments):
         assert pressure_errors(turned)["oscillation"] < 1e-8
     else:
         assert difference > 1e-5, difference
+
+
+def test_newton_reuses_a_factorisation_and_takes_the_exact_steps(monkeypatch):
+    """Large sliding's default Newton steps: GMRES on the LU of the solve's first
+    iterate. The same residual history and solution as an LU at every iterate (preonly),
+    more than one Krylov iteration after the first iterate of a step (the factorisation
+    reused), and one everywhere when GMRES may take none before refactoring."""
+    runs = {}
+    for name, options in (("exact", {"ksp_type": "preonly"}), ("reused", None)):
+        problem = rotating_annulus_problem(6, 2, 1.0)
+        assert (problem.solver_options(options)["ksp_type"] == "gmres") == (options is None)
+        reports = []
+        for k in (1, 2):
+            problem.loads.set_time(k / 2)
+            reports.append(problem.solve(options))
+            problem.accept_step()
+        runs[name] = (reports, problem.w.x.array.copy())
+    (exact, w_exact), (reused, w_reused) = runs["exact"], runs["reused"]
+    assert np.abs(w_reused - w_exact).max() < 1e-9 * np.abs(w_exact).max()
+    for a, b in zip(exact, reused, strict=True):
+        assert a.iterations == b.iterations
+        assert np.allclose(a.residuals[:-1], b.residuals[:-1], rtol=1e-6)
+        assert b.linear_iterations[0] == 1 and max(b.linear_iterations[1:]) > 1
+    monkeypatch.setattr("xfem_contact.solvers.newton.REFACTOR_AFTER", 0)
+    problem = rotating_annulus_problem(6, 2, 1.0)
+    problem.loads.set_time(0.5)
+    assert set(problem.solve().linear_iterations) == {1}
+
+
+def test_the_reused_lu_only_where_no_linear_solver_is_chosen():
+    """Options given are kept as given; small sliding factors at every iterate."""
+    problem = rotating_annulus_problem(4, 2, 0.0)
+    assert problem.solver_options({"ksp_type": "preonly"})["ksp_type"] == "preonly"
+    assert problem.solver_options(preset("iterative"))["pc_type"] == "python"
+    assert annulus_problem(4, 16, 2, 2).solver_options()["ksp_type"] == "preonly"

@@ -109,10 +109,15 @@ class SmallStrain:
         points a cell; 112 on the ghost penalty's facets, which take that degree too),
         the others the integrand's polynomial degree."""
         if self.cut.crack is None:
-            return self.cut.dx(side)
+            return self.cut.dx(side, self.uncut_metadata())
         if self.zone is None:
             return self.cut.dx(side, {"quadrature_degree": self.cut.quadrature_degree})
         return self.zone.dx(side, {"quadrature_degree": self.integrand_degree * self.degree})
+
+    def uncut_metadata(self) -> dict:
+        """Quadrature metadata of the uncut cells without a crack: none (UFL's
+        estimate; the linear bulk is assembled once a solve)."""
+        return {}
 
     def _ghost_penalty(self, trial, test) -> ufl.Form:
         metadata = (
@@ -149,6 +154,12 @@ class SaintVenantKirchhoff(SmallStrain):
     unknown ``u`` as a coefficient (the residual), never a trial function."""
 
     integrand_degree = 4  # P(u) : grad v, P cubic in grad u
+
+    def uncut_metadata(self) -> dict:
+        """The integrand's polynomial degree on the uncut cells: its tangent is
+        assembled at every Newton iterate, and UFL's estimate (12 for P2 on curved Q2
+        cells, where no degree is exact) doubles its points."""
+        return {"quadrature_degree": self.integrand_degree * self.degree}
 
     def form(self, u: Fields, v: Fields) -> ufl.Form:
         """The residual's bulk terms (UFL, linear in the test functions ``v``)."""

@@ -30,7 +30,7 @@ from xfem_contact.mechanics.loads import Loads, SideFields
 from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
-from xfem_contact.solvers.linear import crack_options, solve_restricted, tip_transform
+from xfem_contact.solvers.linear import added_options, solve_restricted, tip_transform
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton, weak_method
 from xfem_contact.solvers.options import merged_options
 from xfem_contact.solvers.report import SolveReport
@@ -200,9 +200,9 @@ class Problem:
         return merged_options(solver, self._options(petsc_options))
 
     def _options(self, petsc_options: dict | None) -> dict:
-        """``petsc_options`` over the LDL^T of a symmetric problem and a crack's options."""
+        """``petsc_options`` over LDL^T when symmetric and a crack's or large sliding's."""
         options = symmetric_options(petsc_options, self.symmetric)
-        return {**crack_options(self.space, options, bool(self.couplings)), **options}
+        return {**added_options(self.space, options, bool(self.couplings)), **options}
 
     def law(self, name: str | None = None) -> InterfaceLaw:
         """The law of interface ``name`` (of the only interface for ``None``)."""

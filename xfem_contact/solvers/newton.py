@@ -26,7 +26,12 @@ from xfem_contact.fem.forms import form_parts
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
 from xfem_contact.solvers.block_scaling import TipFactor
 from xfem_contact.solvers.jacobian import JacobianForms
-from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
+from xfem_contact.solvers.options import (
+    REFACTOR_AFTER,
+    applied_options,
+    merged_options,
+    unique_prefix,
+)
 from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.split_sets import split_sets
@@ -45,7 +50,12 @@ class RestrictedNewton:
     residual norms it reports are those of ``D R^T F``. Each :meth:`solve` starts from
     the current ``w`` (projected on the range of ``R D``) and checks the final residual
     against the tolerances. With ``pc_type = "cholesky"`` every Jacobian is checked to
-    be symmetric first (:func:`~xfem_contact.solvers.symmetry.mark_symmetric`).
+    be symmetric first (:func:`~xfem_contact.solvers.symmetry.mark_symmetric`). A
+    Krylov method over a factorisation (``pc_type`` lu or cholesky, e.g.
+    :data:`~xfem_contact.solvers.options.REUSED_LU_OPTIONS`) keeps the factorisation of
+    an earlier iterate of the same solve: it refactors at the first iterate, when the
+    pattern grows, and after a linear solve that failed or took more than
+    :data:`~xfem_contact.solvers.options.REFACTOR_AFTER` iterations.
 
     Args:
         residual: UFL residual form, linear in the test function, on the full
@@ -156,6 +166,9 @@ class RestrictedNewton:
         #: The PETSc options (without prefix) of this solver's SNES, KSP and PC
         self.options = merged_options("newton", petsc_options)
         self._symmetric = self.options.get("pc_type") == "cholesky"
+        #: Whether factorisations are reused across iterates (see the class docstring)
+        self.reuses_factor = transform is None and self.options.get("ksp_type") != "preonly"
+        self.reuses_factor &= self.options.get("pc_type") in ("lu", "cholesky")
         if self._symmetric:
             mark_symmetric(self.J_r)
         self.R = R.copy()
@@ -185,7 +198,14 @@ class RestrictedNewton:
         # PETSc objects: callbacks hold this object weakly, or it would never be freed.
         this = weakref.ref(self)
         self.snes.setFunction(lambda snes, y, F: this()._residual(snes, y, F), self.F_r)
-        self.snes.setJacobian(lambda snes, y, J, P: this()._jacobian(snes, y, J, P), self.J_r)
+        #: The preconditioner's matrix: a copy of an earlier iterate's Jacobian when
+        #: factorisations are reused, else the Jacobian itself
+        self.P = self.J_r.duplicate(copy=True) if self.reuses_factor else self.J_r
+        if self.reuses_factor:
+            self.P.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+        self.snes.setJacobian(
+            lambda snes, y, J, P: this()._jacobian(snes, y, J, P), self.J_r, self.P
+        )
         self.snes.setMonitor(lambda snes, it, norm: this()._monitor(snes, it, norm))
         self.report = NewtonReport()
         self._projection: PETSc.KSP | None = None
@@ -222,7 +242,24 @@ class RestrictedNewton:
             J_r.diagonalScale(self.D, self.D)
             if self._symmetric:
                 mark_symmetric(J_r)
+        if P_r is not J_r:  # the preconditioner's copy, taken anew only when needed
+            grown = J_r.getInfo(_GLOBAL)["nz_allocated"] != P_r.getInfo(_GLOBAL)["nz_allocated"]
+            if grown or self._refactor(snes):
+                J_r.copy(P_r, _DIFFERENT if grown else _SAME)
+                if self._symmetric:
+                    mark_symmetric(P_r)
         self.report.assembly_time += time.perf_counter() - start
+
+    def _refactor(self, snes) -> bool:
+        """Whether the preconditioner takes the Jacobian of this iterate: at the first
+        iterate of a solve, or after a linear solve that failed or took more than
+        ``REFACTOR_AFTER`` Krylov iterations. Otherwise its matrix, hence its
+        factorisation, stays that of an earlier iterate (PETSc refactors only a
+        preconditioning matrix that changed)."""
+        ksp = snes.getKSP()
+        if snes.getIterationNumber() == 0 or ksp.getConvergedReason() <= 0:
+            return True
+        return ksp.getIterationNumber() > REFACTOR_AFTER
 
     def _add_couplings(self, J_r) -> None:
         """Add the couplings' Jacobians. A coupling that grows the pattern replaces
@@ -322,6 +359,8 @@ class RestrictedNewton:
         """Destroy the PETSc objects made here (the scaled copy of ``R`` included, not
         the ``R`` given). Collective."""
         self.jacobian.destroy()  # J_r included
+        if self.P is not self.J_r:
+            self.P.destroy()
         for coupling in self.couplings:
             coupling.destroy()
         for obj in (self.snes, self.b, self.y, self.F_r, self.R, self.D, *self._split_objects):
@@ -332,6 +371,10 @@ class RestrictedNewton:
         if self._projection is not None:
             self._projection.destroy()
 
+
+_GLOBAL = PETSc.Mat.InfoType.GLOBAL_SUM
+_SAME = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
+_DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
 
 #: SNES types that evaluate the residual at the iterate they stop at (and monitor it)
 _EVALUATES_LAST = ("newtonls", "newtontr")

@@ -102,6 +102,34 @@ SOLVER_OPTIONS: dict[str, Option] = {
 CRACK_OPTIONS: dict[str, OptionValue] = {"mat_mumps_icntl_14": 100}
 
 
+#: Options added under a problem's own when its Jacobian is factored by LU and changes
+#: little from one Newton iterate to the next (large sliding): GMRES preconditioned by
+#: the LU of an earlier iterate of the same solve, refactored only when GMRES needs more
+#: than :data:`REFACTOR_AFTER` iterations
+#: (:class:`~xfem_contact.solvers.newton.RestrictedNewton`). A tolerance far below
+#: Newton's keeps the steps those of the exact Jacobian.
+REUSED_LU_OPTIONS: dict[str, OptionValue] = {
+    "ksp_type": "gmres",
+    "ksp_gmres_restart": 100,
+    "ksp_rtol": 1e-12,
+    "ksp_atol": 1e-30,
+    "ksp_max_it": 100,
+}
+
+#: A Krylov method over a factorisation (``pc_type`` lu or cholesky) keeps the
+#: factorisation across the iterates of a Newton solve while it converges within this
+#: many iterations
+REFACTOR_AFTER = 20
+
+
+def reused_lu(options: dict, couplings: bool) -> dict:
+    """:data:`REUSED_LU_OPTIONS` for a problem with ``couplings`` (large sliding) whose
+    ``options`` choose neither a Krylov method nor a preconditioner; else none. Not
+    collective."""
+    chosen = "ksp_type" in options or options.get("pc_type", "lu") != "lu"
+    return {} if chosen or not couplings else dict(REUSED_LU_OPTIONS)
+
+
 #: Linear-solver presets of the Newton steps (``--solver`` of the demo, ``[solver] linear``
 #: of a scene): option name (without prefix) to value, merged over the defaults. The
 #: iterative one is GMRES(100) preconditioned by
