@@ -17,6 +17,7 @@ from mpi4py import MPI
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.forms import form
 from xfem_contact.io import pictures, vtk_grids
+from xfem_contact.io.outlines import region_outline
 from xfem_contact.io.output import write_cut_geometry, write_lips
 from xfem_contact.io.plots import interface_abscissa, plot_pressure
 from xfem_contact.scenes import cli
@@ -84,6 +85,32 @@ def test_subcell_grid_covers_the_domain(cell):
     one = dolfinx.fem.Constant(mesh, 1.0)
     assert abs(area_minus - assemble(one * cut.dx(-1))) < 1e-12
     assert abs(area_minus - np.pi * RADIUS**2) < 1e-4
+
+
+def polyline_length(poly) -> float:
+    """Total length (m) of a PolyData's polylines."""
+    lines, points, length, i = poly.lines, poly.points, 0.0, 0
+    while i < len(lines):
+        nodes = lines[i + 1 : i + 1 + lines[i]]
+        length += np.linalg.norm(np.diff(points[nodes], axis=0), axis=1).sum()
+        i += lines[i] + 1
+    return length
+
+
+@pytest.mark.parametrize("cell", ["triangle", "quadrilateral"])
+def test_region_outline_is_the_interface_and_the_boundary(cell):
+    """Each side's outline of the sub-cell grid: the interface (side -1) and the
+    interface plus the square's boundary (side +1), against the cut's own interface
+    length. The triangles' fans split edges that their neighbours keep whole (hanging
+    nodes): without dropping the overlapping edges side +1 measures 1.25 m more."""
+    mesh = unit_square(8, cell, comm=MPI.COMM_SELF)
+    cut = CutMesh(mesh, disc, degree=2)
+    interface = dolfinx.fem.assemble_scalar(form(dolfinx.fem.Constant(mesh, 1.0) * cut.dGamma))
+    grid = pictures.subcell_grid(cut)
+    side = np.asarray(grid.cell_data["side"])
+    for s, expected in ((-1, interface), (1, 4.0 + interface)):
+        outline = region_outline(grid.extract_cells(np.flatnonzero(side == s)))
+        assert abs(polyline_length(outline) - expected) < 5e-4 * expected
 
 
 @pytest.mark.mpi

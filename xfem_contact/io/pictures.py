@@ -47,6 +47,19 @@ __all__ = [
 SIDE_COLOURS = {-1: ("#c9d9ef", "#3b6fb6", "#1f3f73"), 1: ("#f7dcc6", "#e0823d", "#8a4a17")}
 
 
+#: The smallest mean cell width (pixels) at which the pictures draw cell edges
+EDGE_PIXELS = 4.0
+
+
+def _cell_pixels(grid: pyvista.DataSet, window_size: tuple[int, int], bounds=None) -> float:
+    """The mean cell width of ``grid`` in pixels of a picture of ``window_size`` that
+    shows ``bounds`` (default: the grid's)."""
+    xmin, xmax, ymin, ymax = grid.bounds[:4]
+    width = np.sqrt((xmax - xmin) * (ymax - ymin) / max(grid.n_cells, 1))
+    xmin, xmax, ymin, ymax = grid.bounds[:4] if bounds is None else bounds[:4]
+    return width * 0.8 * min(window_size) / max(xmax - xmin, ymax - ymin, 1e-300)
+
+
 def render_cut(
     subcells: pyvista.DataSet,
     interface: pyvista.DataSet | None,
@@ -55,7 +68,8 @@ def render_cut(
     title: str = "cut cells: sub-triangles and interface",
     window_size: tuple[int, int] = (800, 600),
 ) -> pathlib.Path:
-    """PNG of the mesh edges, the curved sub-triangles coloured by side and the interface.
+    """PNG of the mesh edges, the curved sub-triangles coloured by side and the interface
+    (uncut cells narrower than :data:`EDGE_PIXELS` pixels: their region's outline only).
 
     Args:
         subcells: A :func:`subcell_grid` (or several merged, or read from ``.vtu``).
@@ -82,8 +96,9 @@ def render_cut(
         part = subcells.extract_cells(np.flatnonzero(mask))
         fill, strong, edge = SIDE_COLOURS[s]
         plotter.add_mesh(_clip(_surface(part), bounds), color=strong if c else fill, lighting=False)
+        fine = not c and _cell_pixels(part, window_size, bounds) < EDGE_PIXELS
         plotter.add_mesh(
-            _lift(_clip(_outlines(part), bounds), dz),
+            _lift(_clip(_outlines(part, merge=fine), bounds), dz),
             color=edge if c else "#8c8c8c",
             line_width=1.0 if c else 0.8,
         )
@@ -147,7 +162,8 @@ def plot_deformed(
             displacement 10% of the size). The title states the factor.
         title: Text at the top; `` (displacement x F)`` is appended.
         window_size: Pixels ``(width, height)``.
-        edges: Draw the cell outlines (thin).
+        edges: Draw the cell outlines (thin) where cells are at least
+            :data:`EDGE_PIXELS` pixels wide (finer meshes would turn white).
         bounds: ``(xmin, xmax, ymin, ymax)`` in m (deformed coordinates) to zoom
             on; default: the whole grid, deformed and undeformed.
         field: A scalar point field to colour by (e.g. ``von_mises``, Pa); default
@@ -190,7 +206,7 @@ def plot_deformed(
         },
     )
     plotter.add_text(label, position=(0.74, 0.81), viewport=True, font_size=10, color="black")
-    if edges:
+    if edges and _cell_pixels(grid, window_size, bounds) >= EDGE_PIXELS:
         lines = _lift(_clip(_outlines(warped), bounds), dz)
         plotter.add_mesh(lines, color="white", line_width=0.5, opacity=0.35)
     sides = np.asarray(warped.cell_data["side"]) if "side" in warped.cell_data else None

@@ -15,6 +15,8 @@ from collections.abc import Sequence
 import numpy as np
 import pyvista
 
+from xfem_contact.io.outlines import cell_outlines, region_outline
+
 
 def _surface(grid: pyvista.DataSet, subdivision: int = 3) -> pyvista.PolyData:
     """Linear triangles of (possibly quadratic) 2D cells, curved edges subdivided."""
@@ -22,31 +24,10 @@ def _surface(grid: pyvista.DataSet, subdivision: int = 3) -> pyvista.PolyData:
 
 
 def _outlines(grid: pyvista.DataSet, merge: bool = False) -> pyvista.PolyData:
-    """Curved outlines of the cells (``merge=False``; nodes are not shared) or of
-    the region they cover (``merge=True``).
-
-    For a region, coincident nodes are merged first; edges that still look like
-    boundary edges but have the region on both sides (hanging nodes where a
-    refined fan of sub-triangles meets a whole cell edge) are dropped.
-    """
-    surface = _surface(grid)
-    if merge:
-        surface = surface.clean(
-            tolerance=1e-9 * max(grid.length, 1e-300), lines_to_points=False, polys_to_lines=False
-        )
-    edges = surface.extract_feature_edges(
-        boundary_edges=True, feature_edges=False, manifold_edges=False, non_manifold_edges=False
-    )
-    if not merge or edges.n_cells == 0:
-        return edges
-    lines = edges.lines.reshape(-1, 3)[:, 1:]
-    a, b = edges.points[lines[:, 0]], edges.points[lines[:, 1]]
-    mid, normal = 0.5 * (a + b), np.c_[a[:, 1] - b[:, 1], b[:, 0] - a[:, 0], np.zeros(len(a))]
-    offset = 1e-3 * normal  # 1e-3 of the segment's length, either side
-    inside = (surface.find_containing_cell(mid + offset) >= 0) & (
-        surface.find_containing_cell(mid - offset) >= 0
-    )
-    return edges.extract_cells(np.flatnonzero(~inside)).extract_surface(algorithm=None)
+    """Curved outlines of the cells (``merge=False``) or of the region they cover
+    (``merge=True``, hanging nodes of cut cells handled:
+    :func:`~xfem_contact.io.outlines.region_outline`)."""
+    return region_outline(grid) if merge else cell_outlines(grid)
 
 
 def _clip(poly: pyvista.PolyData, bounds: Sequence[float] | None) -> pyvista.PolyData:
