@@ -1,6 +1,8 @@
 """The floor of this stack: plain DOLFINx elasticity on the mesh of paper case 2.
 
-No cut, no enrichment, no xfem_contact import: unit square, ``--n`` x ``--n`` cells,
+No cut, no enrichment, no xfem_contact import (but for the mesh of ``--mesh annulus``,
+paper case 3's ``--n`` x ``4 n`` curved cells, inner circle clamped, 1 MPa outside):
+unit square, ``--n`` x ``--n`` cells,
 Lagrange ``--degree`` displacement, E = 100 MPa, nu = 0, the case-2 tractions (-1 Pa
 lateral, -2 Pa top and bottom) and the same three point constraints, one direct solve
 (MUMPS LU, or with ``--factor cholesky`` its Cholesky, the matrix flagged symmetric
@@ -13,6 +15,7 @@ also under ``mpiexec``.
 """
 
 import argparse
+import functools
 import json
 import pathlib
 import time
@@ -49,14 +52,8 @@ def rigid_modes(V: dolfinx.fem.FunctionSpace) -> PETSc.NullSpace:
     return PETSc.NullSpace().create(vectors=[v.petsc_vec for v in vectors], comm=V.mesh.comm)
 
 
-def solve(
-    n: int, degree: int, cell: str, out: pathlib.Path, mumps: dict[str, int], factor: str = "lu"
-) -> dict:
-    """Solve and write; returns the dofs and the wall time of each phase (s). Collective."""
-    comm = MPI.COMM_WORLD
-    times = {}
-    start = time.perf_counter()
-    mesh = dolfinx.mesh.create_unit_square(comm, n, n, dolfinx.mesh.CellType[cell])
+def _elasticity(mesh, degree: int):
+    """The space and the bilinear form of linear elasticity (E, NU) on ``mesh``."""
     V = dolfinx.fem.functionspace(
         mesh, basix.ufl.element("Lagrange", mesh.basix_cell(), degree, shape=(2,))
     )
@@ -66,6 +63,13 @@ def solve(
     def sigma(w):
         return 2 * mu * ufl.sym(ufl.grad(w)) + lmbda * ufl.tr(ufl.grad(w)) * ufl.Identity(2)
 
+    return V, ufl.inner(sigma(u), ufl.sym(ufl.grad(v))) * ufl.dx, v
+
+
+def square(comm, n: int, degree: int, cell: str):
+    """Paper case 2's square: ``(V, a, L, bcs)``. Collective."""
+    mesh = dolfinx.mesh.create_unit_square(comm, n, n, dolfinx.mesh.CellType[cell])
+    V, a, v = _elasticity(mesh, degree)
     fdim = mesh.topology.dim - 1
     sides = [
         (1, lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0)),
@@ -79,7 +83,6 @@ def solve(
     tags = dolfinx.mesh.meshtags(mesh, fdim, np.concatenate(facets)[order], values[order])
     ds = ufl.Measure("ds", domain=mesh, subdomain_data=tags)
     normal = ufl.FacetNormal(mesh)
-    a = ufl.inner(sigma(u), ufl.sym(ufl.grad(v))) * ufl.dx
     L = -1.0 * ufl.dot(normal, v) * ds(1) - 2.0 * ufl.dot(normal, v) * ds(2)
     bcs = []
     for point, component in (((0.5, 0.0), 0), ((0.5, 1.0), 0), ((0.0, 0.5), 1)):
@@ -89,6 +92,34 @@ def solve(
             (sub, Vc), lambda x, p=point: np.isclose(x[0], p[0]) & np.isclose(x[1], p[1])
         )
         bcs.append(dolfinx.fem.dirichletbc(dolfinx.fem.Function(Vc), dofs, sub))
+    return V, a, L, bcs
+
+
+def annulus(comm, n: int, degree: int):
+    """Paper case 3's annulus (radii 3 and 20 m, ``n`` x ``4 n`` curved Q2 cells, the
+    mesh of ``xfem_contact.io.meshes.annulus``): the inner circle clamped, 1 MPa on
+    the outer one. ``(V, a, L, bcs)``. Collective."""
+    from xfem_contact.io.meshes import annulus as annulus_mesh  # the mesh only
+
+    mesh = annulus_mesh(comm, 3.0, 20.0, n, 4 * n, 2)
+    V, a, v = _elasticity(mesh, degree)
+    fdim = mesh.topology.dim - 1
+    inner = dolfinx.mesh.locate_entities_boundary(
+        mesh, fdim, lambda x: np.hypot(x[0], x[1]) < 3.0 + 1e-6
+    )
+    zero = dolfinx.fem.Function(V)
+    bcs = [dolfinx.fem.dirichletbc(zero, dolfinx.fem.locate_dofs_topological(V, fdim, inner))]
+    L = -1e6 * ufl.dot(ufl.FacetNormal(mesh), v) * ufl.ds
+    return V, a, L, bcs
+
+
+def solve(setup, out: pathlib.Path, mumps: dict[str, int], factor: str = "lu") -> dict:
+    """Solve the problem ``setup()`` gives and write; returns the dofs and the wall
+    time of each phase (s). Collective."""
+    comm = MPI.COMM_WORLD
+    times = {}
+    start = time.perf_counter()
+    V, a, L, bcs = setup()
     times["mesh_and_spaces"] = time.perf_counter() - start
     t = time.perf_counter()
     a_form, L_form = dolfinx.fem.form(a), dolfinx.fem.form(L)
@@ -146,9 +177,17 @@ def main():
         help="MUMPS controls, e.g. icntl_7=4 (default: MUMPS's own choices)",
     )
     parser.add_argument("--factor", default="lu", choices=["lu", "cholesky", "gamg"])
+    parser.add_argument(
+        "--mesh", default="square", choices=["square", "annulus"], help="case 2 or case 3"
+    )
     args = parser.parse_args()
     mumps = dict(item.split("=", 1) for item in args.mumps)
-    result = solve(args.n, args.degree, args.cell, pathlib.Path(args.out), mumps, args.factor)
+    comm = MPI.COMM_WORLD
+    if args.mesh == "square":
+        setup = functools.partial(square, comm, args.n, args.degree, args.cell)
+    else:
+        setup = functools.partial(annulus, comm, args.n, args.degree)
+    result = solve(setup, pathlib.Path(args.out), mumps, args.factor)
     if MPI.COMM_WORLD.rank == 0:
         print(json.dumps(result))
 

@@ -114,10 +114,10 @@ def max_difference(a: dict, b: dict) -> float:
     return float(np.abs(la - lb).max() / np.abs(la).max())
 
 
-def plain(n, degree, work, mumps, env=None, ranks=1, factor="lu") -> dict:
+def plain(n, degree, work, mumps, env=None, ranks=1, factor="lu", mesh="square") -> dict:
     command = [sys.executable, str(ROOT / "bench" / "plain_elasticity.py")]
     command += ["--n", str(n), "--degree", str(degree), "--out", str(work / "plain")]
-    command += ["--mumps", *mumps, "--factor", factor]
+    command += ["--mumps", *mumps, "--factor", factor, "--mesh", mesh]
     if ranks > 1:
         command = [str(pathlib.Path(sys.executable).parent / "mpiexec"), "-n", str(ranks)] + command
     wall, rss, text = run(command, env)
