@@ -88,9 +88,7 @@ def main():
                     lambda r=ranks, s=solver: sliding(args.n, s, r, work), args.repeat
                 )
                 runs[ranks, "plain"] = fastest(
-                    lambda r=ranks, f=factor, m=mumps if factor == "lu" else []: plain(
-                        args.n, 2, work, m, None, r, f, "annulus"
-                    ),
+                    lambda r=ranks, f=factor: plain(args.n, 2, work, mumps, None, r, f, "annulus"),
                     args.repeat,
                 )
             one, many = runs[1], runs[args.ranks]

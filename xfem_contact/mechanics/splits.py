@@ -102,7 +102,7 @@ def rigid_modes(space: EnrichedSpace) -> Iterator[dolfinx.fem.Function]:
     W = space.W
     mode = dolfinx.fem.Function(W)
     for field in SIDE_FIELDS:
-        V, dofs = W.sub(field).collapse()  # dofs: the W dof of each (unrolled) V dof
+        V, dofs = space.field_space(field)  # dofs: the W dof of each (unrolled) V dof
         x = V.tabulate_dof_coordinates()[:, :2]  # (nodes, 2), a node's components together
         one, zero = np.ones(x.shape[0]), np.zeros(x.shape[0])
         for motion in ((one, zero), (zero, one), (-x[:, 1], x[:, 0])):
