@@ -28,7 +28,7 @@ from xfem_contact.mechanics.sliding.lips import CurvePoint
 from xfem_contact.mechanics.sliding.projection import closest_points
 from xfem_contact.mechanics.sliding.segments import split
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton
-from xfem_contact.solvers.options import preset
+from xfem_contact.solvers.options import REUSED_LU_OPTIONS, preset
 
 
 class ArcLip:
@@ -467,3 +467,17 @@ def test_the_reused_lu_only_where_no_linear_solver_is_chosen():
     assert problem.solver_options({"ksp_type": "preonly"})["ksp_type"] == "preonly"
     assert problem.solver_options(preset("iterative"))["pc_type"] == "python"
     assert annulus_problem(4, 16, 2, 2).solver_options()["ksp_type"] == "preonly"
+
+
+def test_a_reused_factorisation_that_fails_is_refactored_not_fatal():
+    """GMRES allowed 3 iterations where a reused LU needs about 5: the linear solve
+    fails at the second iterate, Newton goes on, the next iterate refactors and the
+    step converges to the solution of LU at every iterate."""
+    solutions = []
+    for options in ({"ksp_type": "preonly"}, {**REUSED_LU_OPTIONS, "ksp_max_it": 3}):
+        problem = rotating_annulus_problem(6, 2, 1.0)
+        problem.loads.set_time(0.5)
+        report = problem.solve(options)
+        solutions.append(problem.w.x.array.copy())
+    assert max(report.linear_iterations) == 3 and report.linear_iterations.count(1) >= 2
+    assert np.abs(solutions[1] - solutions[0]).max() < 1e-9 * np.abs(solutions[0]).max()

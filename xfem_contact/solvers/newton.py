@@ -55,7 +55,9 @@ class RestrictedNewton:
     :data:`~xfem_contact.solvers.options.REUSED_LU_OPTIONS`) keeps the factorisation of
     an earlier iterate of the same solve: it refactors at the first iterate, when the
     pattern grows, and after a linear solve that failed or took more than
-    :data:`~xfem_contact.solvers.options.REFACTOR_AFTER` iterations.
+    :data:`~xfem_contact.solvers.options.REFACTOR_AFTER` iterations; such a failed
+    linear solve does not end the Newton solve (its step is taken as it is, the final
+    residual check stands).
 
     Args:
         residual: UFL residual form, linear in the test function, on the full
@@ -182,6 +184,8 @@ class RestrictedNewton:
         self.snes.setOptionsPrefix(self._prefix)
         with applied_options(self._prefix, self.options):
             self.snes.setFromOptions()
+            if self.reuses_factor:  # a reused factor's GMRES may fail: the next refactors
+                self.snes.setMaxLinearSolveFailures(self.snes.getTolerances()[3])
             #: The factorisation through the tip enrichment's change of unknowns, or None
             self.tip = None if Z is None else TipFactor(self.snes, Z, self.D, self._symmetric)
         self._split_objects = split_sets(
