@@ -261,18 +261,17 @@ class RestrictedNewton:
         factorisation, stays that of an earlier iterate (PETSc refactors only a
         preconditioning matrix that changed)."""
         ksp = snes.getKSP()
-        if snes.getIterationNumber() == 0 or ksp.getConvergedReason() <= 0:
-            return True
-        return ksp.getIterationNumber() > REFACTOR_AFTER
+        stale = ksp.getConvergedReason() <= 0 or ksp.getIterationNumber() > REFACTOR_AFTER
+        return snes.getIterationNumber() == 0 or stale
 
     def _add_couplings(self, J_r) -> None:
         """Add the couplings' Jacobians. A coupling that grows the pattern replaces
         the matrix's storage (PETSc's merge), which the preconditioner does not see as
         a new pattern: its factorisation is then reset. Collective."""
-        size = J_r.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_allocated"]
+        size = J_r.getInfo(_GLOBAL)["nz_allocated"]
         for coupling in self.couplings:
             coupling.add_jacobian(self.w, J_r)
-        if J_r.getInfo(PETSc.Mat.InfoType.GLOBAL_SUM)["nz_allocated"] != size:
+        if J_r.getInfo(_GLOBAL)["nz_allocated"] != size:
             self.snes.getKSP().getPC().reset()
 
     def _monitor(self, snes, it, norm):
@@ -376,8 +375,7 @@ class RestrictedNewton:
             self._projection.destroy()
 
 
-_GLOBAL = PETSc.Mat.InfoType.GLOBAL_SUM
-_SAME = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
+_GLOBAL, _SAME = PETSc.Mat.InfoType.GLOBAL_SUM, PETSc.Mat.Structure.SAME_NONZERO_PATTERN
 _DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
 
 #: SNES types that evaluate the residual at the iterate they stop at (and monitor it)
