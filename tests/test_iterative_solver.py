@@ -39,7 +39,8 @@ def _context(problem):
 def test_band_and_interpolation():
     """The band holds every multiplier and lies in the cut region; the interpolation
     from the vertex unknowns reproduces a bilinear displacement exactly, in the
-    scaled reduced unknowns the solver works with."""
+    scaled reduced unknowns the solver works with; the set-up keeps no copies it
+    does not need."""
     problem = inclusion_problem(10, 2, "sticking")
     problem.solve(preset("iterative"))
     context, newton = _context(problem), problem.newton
@@ -62,6 +63,10 @@ def test_band_and_interpolation():
     interpolated = context.P.createVecLeft()
     context.P.mult(coarse, interpolated)
     assert np.allclose(interpolated.getArray(), fine, rtol=1e-12, atol=1e-12 * np.abs(fine).max())
+    # what the set-up keeps (memory): one restriction, the scaled one; P a view of
+    # P_full; no interpolation arrays once the prolongations are built
+    assert newton.jacobian.R is None
+    assert context.P.getType() == "submatrix" and context._interpolation is None
 
 
 @pytest.mark.parametrize("degree, bound", [(2, 20), (1, 18)])

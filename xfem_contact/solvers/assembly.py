@@ -296,11 +296,12 @@ class ReducedMatrix:
         field_blocks: list[tuple[dolfinx.fem.Form, np.ndarray, bool]] = (),
         chosen: Selection | None = None,
     ):
-        self.a, self.bcs, self.R = a, bcs, R
+        self.a, self.bcs = a, bcs
         W = a.function_spaces[0]
         chosen = chosen or selection(R, W)
         #: Whether the form is assembled straight into the reduced numbering
         self.direct = chosen is not None
+        self.R = None if self.direct else R  # only PtAP reads it again
         if field_blocks and not self.direct:
             raise ValueError("field blocks need a restriction that selects dofs")
         #: The reduced column of every dof (:class:`Selection`; None for ``PtAP``)

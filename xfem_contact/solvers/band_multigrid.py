@@ -76,7 +76,7 @@ class BandMultigrid:
 
     def __init__(self):
         self.u = self.band = None
-        self._interpolation = None
+        self._interpolation, self._degree2 = None, False
         self._prolongations: tuple | None = None  # (P, P in J's rows, coarse positions)
         self._modes: list[PETSc.Vec] = []
         self._objects: list = []
@@ -94,7 +94,8 @@ class BandMultigrid:
                 the vertex unknowns it interpolates from (the coarse unknowns).
         """
         self.u, self.band, self._modes = u, band, list(modes)
-        self._interpolation = interpolation
+        self._degree2 = interpolation is not None
+        self._interpolation = interpolation  # released once the prolongations are built
         self._forget_prolongations()
 
     def _forget_prolongations(self) -> None:
@@ -159,7 +160,9 @@ class BandMultigrid:
         self.all_columns = PETSc.IS().createStride(last - first, first, 1, comm=comm)
         others = np.setdiff1d(np.arange(first, last), self.u.getIndices())
         multipliers = PETSc.IS().createGeneral(others.astype(PETSc.IntType), comm=comm)
-        self.B = J.createSubMatrix(multipliers, self.u)
+        # the multipliers' rows: on u for degree 1, on all columns for degree 2 (``B P``
+        # as ``B_all P_full``: P_full's rows outside u are zero)
+        self.B = J.createSubMatrix(multipliers, self.all_columns if self._degree2 else self.u)
         self.J_bb = J.createSubMatrix(self.band, self.band)
         self.J_b = J.createSubMatrix(self.band, self.all_columns)
         self.r_b, self.x_b = self.J_bb.createVecLeft(), self.J_bb.createVecRight()
@@ -172,7 +175,7 @@ class BandMultigrid:
         self.P = self.A_c = None
         self._objects = [self.all_columns, multipliers, self.B, self.J_bb, self.J_b]
         self._objects += [self.r_b, self.x_b, self.ksp_band, self.ksp_u, space]
-        if self._interpolation is None:  # degree 1: GAMG on the augmented block
+        if not self._degree2:  # degree 1: GAMG on the augmented block
             self.u_options = U_OPTIONS_DEGREE1
             self.A = J.createSubMatrix(self.u, self.u)
             self.A.axpy(1.0, _gram(self.B), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
@@ -184,12 +187,13 @@ class BandMultigrid:
             self.u_options = U_OPTIONS
             if self._prolongations is None:  # the pattern of J does not change them
                 self._prolongations = _prolongation(J, self.u, *self._interpolation)
-            self.P, self.P_full, coarse = self._prolongations
+                self._interpolation = None
+            self.P, self.P_full, coarse = self._prolongations  # P: P_full's rows u (a view)
             #: Local positions in ``u`` of the owned coarse (vertex) unknowns
             self.coarse_positions = coarse
             self.A = PETSc.Mat().createSubMatrixVirtual(J, self.u, self.u)
             self.A_c = J.PtAP(self.P_full)
-            BP = self.B.matMult(self.P)
+            BP = self.B.matMult(self.P_full)
             self.A_c.axpy(1.0, _gram(BP), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             self.A_c.setBlockSize(2)
             coarse_modes = _orthonormal([_restricted(m, coarse) for m in self._modes])
@@ -217,11 +221,11 @@ def _gram(B: PETSc.Mat) -> PETSc.Mat:
 def _prolongation(
     J: PETSc.Mat, u: PETSc.IS, rows, cols, weights
 ) -> tuple[PETSc.Mat, PETSc.Mat, np.ndarray]:
-    """``P`` from the coarse unknowns (the distinct ``cols``, numbered process by
-    process in the order of their global index) to the unknowns of ``u``; the same
-    into all of ``J``'s unknowns (zero rows outside ``u``: ``P_full^T J P_full`` is the
-    coarse ``P^T J_uu P`` without extracting ``J_uu``); and the positions in ``u``'s
-    local part of the owned coarse unknowns. Collective."""
+    """``P_full`` from the coarse unknowns (the distinct ``cols``, numbered process by
+    process in the order of their global index) into all of ``J``'s unknowns (zero rows
+    outside ``u``: ``P_full^T J P_full`` is the coarse ``P^T J_uu P`` without extracting
+    ``J_uu``); ``P``, its rows ``u`` (a virtual sub-matrix: no copy); and the positions
+    in ``u``'s local part of the owned coarse unknowns. Collective."""
     comm = u.getComm()
     owned_u = u.getIndices()
     first, last = J.getOwnershipRange()
@@ -232,35 +236,24 @@ def _prolongation(
     values = np.full(last - first, -1.0)
     values[coarse - first] = offset + np.arange(coarse.size)  # exact below 2^53
     number.setArray(values)
-    coarse_cols = np.rint(gather(number, cols)).astype(np.int64)
+    coarse_cols = np.rint(gather(number, cols)).astype(PETSc.IntType)
     number.destroy()
     if np.any(coarse_cols < 0) or not np.all(np.isin(rows, owned_u)):
         raise RuntimeError("BandMultigrid: the interpolation does not fit the splits")
-    by_index = np.argsort(owned_u)  # u need not be sorted (side -1's nodes, then +1's)
-
-    def position(indices):  # local position in u of owned unknowns
-        return by_index[np.searchsorted(owned_u, indices, sorter=by_index)]
-
-    local_rows = position(rows)
-    order = np.lexsort((coarse_cols, local_rows))
-    local_rows, coarse_cols, weights = local_rows[order], coarse_cols[order], weights[order]
-    indptr = np.searchsorted(local_rows, np.arange(owned_u.size + 1)).astype(PETSc.IntType)
-    P = PETSc.Mat().createAIJ(
-        ((owned_u.size, PETSc.DETERMINE), (coarse.size, PETSc.DETERMINE)), comm=comm
-    )
-    columns = coarse_cols.astype(PETSc.IntType)
-    P.setPreallocationCSR((indptr, columns, weights))
-    P.assemble()
-    counts = np.zeros(last - first, dtype=PETSc.IntType)  # the same rows, in J's numbering
-    counts[owned_u - first] = np.diff(indptr)
-    full_indptr = np.concatenate([[0], np.cumsum(counts)]).astype(PETSc.IntType)
-    by_row = np.argsort(owned_u[local_rows], kind="stable")
+    order = np.lexsort((coarse_cols, rows))
+    rows, coarse_cols, weights = rows[order], coarse_cols[order], weights[order]
+    indptr = np.searchsorted(rows, np.arange(first, last + 1)).astype(PETSc.IntType)
     P_full = PETSc.Mat().createAIJ(
         ((last - first, PETSc.DETERMINE), (coarse.size, PETSc.DETERMINE)), comm=comm
     )
-    P_full.setPreallocationCSR((full_indptr, columns[by_row], weights[by_row]))
+    P_full.setPreallocationCSR((indptr, coarse_cols, weights))
     P_full.assemble()
-    return P, P_full, position(coarse)
+    columns = PETSc.IS().createStride(coarse.size, offset, 1, comm=comm)
+    P = PETSc.Mat().createSubMatrixVirtual(P_full, u, columns)
+    columns.destroy()
+    by_index = np.argsort(owned_u)  # u need not be sorted (side -1's nodes, then +1's)
+    positions = by_index[np.searchsorted(owned_u, coarse, sorter=by_index)]
+    return P, P_full, positions
 
 
 def _restricted(mode: PETSc.Vec, positions: np.ndarray) -> PETSc.Vec:
