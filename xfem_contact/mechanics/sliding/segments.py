@@ -35,6 +35,12 @@ from xfem_contact.mechanics.sliding.projection import closest_points
 SAMPLES = np.linspace(0.0, 1.0, 5)
 #: Sub-segments shorter than this (in ``t``) are dropped (two roots at one point)
 MIN_LENGTH = 1e-12
+#: Crossings this close (in ``t``) to an end of the slave piece are not split points:
+#: aligned pieces (a slave node over a master node) would otherwise get slivers of
+#: round-off length paired with either neighbour in turn, a new Jacobian pattern at
+#: every iterate; the kink left inside the piece's rule costs ``TOUCH^2`` of its
+#: integrand's derivative jump
+TOUCH = 1e-8
 #: Sub-segments shorter than this (in ``t``; between the two crossings of one master
 #: corner) get one point: the midpoint rule's error, ``SHORT^3 / 24`` of the piece's
 #: integrand scale, is below round-off of the Newton residual
@@ -181,6 +187,8 @@ def _roots(pieces: SlavePieces, values, lip, slave, master, x0, x1, iterations=3
         t = np.clip(t - step, 0.0, 1.0)
         if np.all(np.abs(step) < 1e-14):
             break
+    inner = (t > TOUCH) & (t < 1.0 - TOUCH)
+    slave, t, master, ends, x_e, t_e = (a[inner] for a in (slave, t, master, ends, x_e, t_e))
     _, dx = pieces.curve(values, slave, t)
     entering = (ends == 0.0) == (np.sum(dx * t_e, axis=1) > 0.0)
     return slave, t, master, ends, entering
