@@ -10,15 +10,19 @@ The baseline, measured in the same run: plain DOLFINx P2 elasticity on the same 
 solved by CG + GAMG (``bench/plain_elasticity.py --factor gamg``, no cut); the table
 gives the iterative preset's peak memory over the baseline's and its time over MUMPS's.
 A size that fails (memory) is reported as such.
-Writes ``bench/results/iterative.{json,md}``.
+Writes ``bench/results/iterative.{json,md}`` (``--name``: another stem).
 
-Run: ``python bench/iterative.py [--sizes 40 80 160 320 640] [--tiny]`` (``make bench``).
+Run: ``python bench/iterative.py [--sizes 40 80 160 320 640] [--tiny]`` (``make bench``);
+the largest sizes: ``--sizes 1024 1280 --solvers plain iterative --memory-gb 21 --name
+iterative_large`` (``--memory-gb``: each case's address-space limit, so that a size
+that does not fit fails on its allocation, not by the kernel's out-of-memory killer).
 """
 
 import argparse
 import json
 import os
 import pathlib
+import resource
 import subprocess
 import sys
 import tempfile
@@ -28,6 +32,7 @@ from xfem_contact.io.progress import note, progress
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "results"
+SOLVERS = ["plain", "direct", "iterative"]
 
 
 def case(n: int, solver: str, tiny: bool) -> dict:
@@ -52,16 +57,19 @@ def case(n: int, solver: str, tiny: bool) -> dict:
     }
 
 
-def run(n: int, solver: str, tiny: bool) -> dict:
+def run(n: int, solver: str, tiny: bool, memory_gb: float | None = None) -> dict:
     """:func:`case` in a process of its own (``solver == "plain"``: the baseline), with
-    that process's peak RSS (MB); ``{"failed": ...}`` if it failed."""
+    that process's peak RSS (MB); ``{"failed": ...}`` if it failed. ``memory_gb``: the
+    process's address-space limit (GB; None: none)."""
     command = [sys.executable, __file__, "--case", str(n), solver, str(int(tiny))]
     if solver == "plain":
         plain = ROOT / "bench" / "plain_elasticity.py"
         out = tempfile.mkdtemp()
         command = [sys.executable, str(plain), "--n", str(n), "--factor", "gamg", "--out", out]
     with tempfile.TemporaryFile("w+") as out:
-        proc = subprocess.Popen(command, stdout=out, stderr=subprocess.STDOUT)
+        proc = subprocess.Popen(
+            command, stdout=out, stderr=subprocess.STDOUT, preexec_fn=_limit(memory_gb)
+        )
         _, status, usage = os.wait4(proc.pid, 0)
         out.seek(0)
         text = out.read()
@@ -78,10 +86,21 @@ def run(n: int, solver: str, tiny: bool) -> dict:
     return result
 
 
+def _limit(memory_gb: float | None):
+    """A ``preexec_fn`` limiting the child's address space to ``memory_gb`` GB (or None)."""
+    if memory_gb is None:
+        return None
+    size = int(memory_gb * 2**30)
+    return lambda: resource.setrlimit(resource.RLIMIT_AS, (size, size))
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[40, 80, 160, 320])
     parser.add_argument("--tiny", action="store_true", help="also the tiny-cut radius")
+    parser.add_argument("--solvers", nargs="+", default=SOLVERS, choices=SOLVERS)
+    parser.add_argument("--memory-gb", type=float, help="each case's address-space limit")
+    parser.add_argument("--name", default="iterative", help="stem of the results' files")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--case", nargs=3, help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -92,8 +111,8 @@ def main():
     rows = []
     for tiny in (False, True) if args.tiny else (False,):
         for n in progress(args.sizes, "sizes", not args.no_progress):
-            for solver in ("plain", "direct", "iterative"):
-                r = run(n, solver, tiny)
+            for solver in args.solvers:
+                r = run(n, solver, tiny, args.memory_gb)
                 rows.append(r)
                 if "failed" in r:
                     note(
@@ -107,8 +126,8 @@ def main():
                     + ("" if r["error"] is None else f", error {r['error']:.4e}")
                 )
     RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / "iterative.json").write_text(json.dumps(rows, indent=1))
-    (RESULTS / "iterative.md").write_text(table(rows))
+    (RESULTS / f"{args.name}.json").write_text(json.dumps(rows, indent=1))
+    (RESULTS / f"{args.name}.md").write_text(table(rows))
     print(table(rows))
 
 

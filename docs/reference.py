@@ -301,10 +301,23 @@ def expression_functions() -> list[str]:
     return [*lines, ""]
 
 
+def _bench_script(result: pathlib.Path) -> pathlib.Path:
+    """The script that wrote ``result``: ``bench/NAME.py`` or ``bench/PREFIX.py`` for the
+    longest ``PREFIX_`` that ``NAME`` starts with (``NAME.py`` if there is none)."""
+    words = result.stem.split("_")
+    for k in range(len(words), 0, -1):
+        script = result.parents[1] / ("_".join(words[:k]) + ".py")
+        if script.exists():
+            return script
+    return result.parents[1] / f"{result.stem}.py"
+
+
 def bench_page(result: pathlib.Path) -> str:
     """The page of one benchmark result ``bench/results/NAME.md``: the bench script's
-    docstring (its first paragraph), the command, the table and the pictures."""
-    script = result.parents[1] / f"{result.stem}.py"
+    docstring (its first paragraph), the command, the table and the pictures. The
+    script is ``bench/NAME.py`` or, for a second result of one script (``--name``),
+    the one whose name ``NAME`` starts with (``iterative_large``: ``iterative.py``)."""
+    script = _bench_script(result)
     docstring = ast.get_docstring(ast.parse(script.read_text())) if script.exists() else None
     text = re.sub(r":\w+:`~?([^`]+)`", r"`\1`", (docstring or "").replace("``", "`"))
     paragraphs = [" ".join(p.split()) for p in text.split("\n\n")]
@@ -314,7 +327,7 @@ def bench_page(result: pathlib.Path) -> str:
     if about:
         lines += [about, ""]
     lines += [
-        f"Made by `python bench/{result.stem}.py` (`make bench` runs every bench); the",
+        f"Made by `python bench/{script.name}` (`make bench` runs every bench); the",
         f"numbers are in `bench/results/{result.stem}.json`. Generated from",
         f"`bench/results/{result.name}` at every documentation build.",
         "",

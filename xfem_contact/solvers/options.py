@@ -132,7 +132,7 @@ def reused_lu(options: dict, couplings: bool) -> dict:
 
 #: Linear-solver presets of the Newton steps (``--solver`` of the demo, ``[solver] linear``
 #: of a scene): option name (without prefix) to value, merged over the defaults. The
-#: iterative one is GMRES(100) preconditioned by
+#: iterative one is GMRES(10) preconditioned by
 #: :class:`~xfem_contact.solvers.band_multigrid.BandMultigrid`: an exact solve on the
 #: band of the interface (cut cells, their neighbours, the multipliers) after a
 #: two-level p-multigrid V-cycle on the displacements (iteration counts:
@@ -141,7 +141,7 @@ LINEAR_PRESETS: dict[str, dict[str, OptionValue]] = {
     "direct": {},
     "iterative": {
         "ksp_type": "gmres",
-        "ksp_gmres_restart": 100,
+        "ksp_gmres_restart": 10,  # a short basis: its W-sized vectors are memory
         "ksp_rtol": 1e-12,
         "ksp_atol": 1e-30,
         "ksp_max_it": 500,
