@@ -138,7 +138,7 @@ def _jacobian_error(problem, eps, seed=0):
     rng = np.random.default_rng(seed)
     _perturbed_state(problem, 0.3, rng)
     newton = RestrictedNewton(
-        problem.residual(),
+        problem.residual(problem.w),
         problem.w,
         problem.loads.bcs,
         problem.restriction(),

@@ -46,7 +46,10 @@ def solved(data: dict, comm=MPI.COMM_WORLD):
 )
 def test_reactions_balance_the_loads(law, options):
     forces = [
-        balance(solved(plate(law, **options), comm)) for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)
+        balance(problem, problem.w)
+        for problem in (
+            solved(plate(law, **options), comm) for comm in (MPI.COMM_WORLD, MPI.COMM_SELF)
+        )
     ]
     for f in forces:
         assert f["balance_relative"] < BALANCE, f
@@ -69,7 +72,7 @@ def test_plain_scene_reactions_balance_the_loads():
     assert forces["balance_relative"] < BALANCE, forces
     np.testing.assert_allclose(forces["reactions"]["bottom"], [-0.4e6, 1.0e6], rtol=1e-8)
     assert forces["interface_resultants"] == {}
-    assert balance(problem) == forces  # the problem keeps its solution
+    assert balance(problem, problem.w) == forces  # the problem keeps its solution
 
 
 def test_point_supports_and_parts_share_out_the_reactions():
@@ -80,7 +83,8 @@ def test_point_supports_and_parts_share_out_the_reactions():
         {"part": "right", "type": "pressure", "value": 1.0e6},
         {"part": "top", "type": "pressure", "value": 2.0e6},
     ]
-    forces = balance(solved(data))
+    problem = solved(data)
+    forces = balance(problem, problem.w)
     assert forces["balance_relative"] < BALANCE, forces
     np.testing.assert_allclose(forces["reactions"]["left"], [1.0e6, 0.0], atol=1e-6)
     np.testing.assert_allclose(forces["reactions"]["bottom"], [0.0, 2.0e6], atol=1e-6)
@@ -89,16 +93,41 @@ def test_point_supports_and_parts_share_out_the_reactions():
 def test_interface_resultant_balances_the_load_on_the_inclusion():
     problem = inclusion_problem(10, 2, "sticking")  # body-force free, pressure outside
     problem.solve()
-    forces = balance(problem)
+    forces = balance(problem, problem.w)
     assert forces["balance_relative"] < BALANCE, forces
     (resultant,) = forces["interface_resultants"].values()
     assert np.abs(resultant).max() < 1e-10  # the inclusion carries no load (N/m)
 
 
+@pytest.mark.parametrize("law, options", [("coulomb", {"friction": 0.3}), ("bonded", {})])
+def test_forces_at_a_state_are_those_of_the_problem_solved_to_it(law, options):
+    """The balance at a state ``w`` other than the problem's solution is that of the
+    problem solved to ``w``: every term (bulk, laws, springs) is evaluated at ``w``."""
+    data = plate(law, **options)
+    data["loads"].append({"part": "left", "type": "tangential_support", "value": 1e9})
+    problem = solved(data)
+    half = problem.w.copy()
+    at_half = balance(problem, problem.w)
+    problem.loads.set_time(2.0)
+    problem.solve()
+    at_full = balance(problem, problem.w)
+    problem.loads.set_time(1.0)  # the loads of the first state, the solution of the second
+    again = balance(problem, half)
+    for key in ("reactions", "interface_resultants"):
+        for name, force in at_half[key].items():
+            np.testing.assert_allclose(again[key][name], force, rtol=1e-10, atol=1e-6)
+    for name, force in at_half["reactions"].items():  # the second state's differ
+        assert (
+            np.abs(np.subtract(at_full["reactions"][name], force)).max() > 0.1 * np.abs(force).max()
+        )
+    assert again["balance_relative"] < BALANCE, again
+
+
 def test_spring_supports_are_reactions():
     data = plate("sticking")
     data["loads"].append({"part": "left", "type": "tangential_support", "value": 1e9})
-    forces = balance(solved(data))
+    problem = solved(data)
+    forces = balance(problem, problem.w)
     assert set(forces["reactions"]) == {"bottom", "tangential_supports"}
     assert np.abs(forces["reactions"]["tangential_supports"]).max() > 1e3  # it carries load
     assert forces["balance_relative"] < BALANCE, forces

@@ -39,7 +39,7 @@ def problem(request):
 
 
 def _jacobian(problem):
-    F = problem.residual()
+    F = problem.residual(problem.w)
     return form(ufl.derivative(F, problem.w, ufl.TrialFunction(problem.space.W)))
 
 
@@ -48,7 +48,7 @@ def test_form_parts_sum_to_the_form(problem):
     packs fewer values per cell: no marker of a runtime rule."""
     w = problem.w
     w.x.array[:] = np.random.default_rng(3).standard_normal(w.x.array.size)
-    F = problem.residual()
+    F = problem.residual(problem.w)
     whole, parts = form(F), form_parts(F)
     assert len(parts) == 2
     expected = dolfinx.fem.assemble_vector(whole).array
@@ -138,12 +138,12 @@ def test_a_facet_term_coupling_two_fields_is_kept():
     u_minus = ufl.split(ufl.TrialFunction(W))[0]
     v_plus = ufl.split(ufl.TestFunction(W))[1]
     extra = 1e6 * ufl.inner(ufl.avg(u_minus), ufl.avg(v_plus)) * ufl.dS
-    J = form(ufl.derivative(problem.residual(), problem.w, ufl.TrialFunction(W)) + extra)
+    J = form(ufl.derivative(problem.residual(problem.w), problem.w, ufl.TrialFunction(W)) + extra)
     R = problem.restriction()
     reduced = ReducedMatrix(J, problem.loads.bcs, R)
     A = reduced.assemble()
     without = ReducedMatrix(
-        form(ufl.derivative(problem.residual(), problem.w)), problem.loads.bcs, R
+        form(ufl.derivative(problem.residual(problem.w), problem.w)), problem.loads.bcs, R
     )
     assert A.getInfo()["nz_used"] > without.assemble().getInfo()["nz_used"]  # inserted
     without.destroy()
@@ -172,7 +172,7 @@ def test_uncut_cells_on_the_fields_own_spaces(law, cell, blocked, coupled):
     options = {"friction": 0.3} if law == "coulomb" else {}
     problem = inclusion_problem(8, 2, law, cell, **options)
     W = problem.space.W
-    J = ufl.derivative(problem.residual(), problem.w, ufl.TrialFunction(W))
+    J = ufl.derivative(problem.residual(problem.w), problem.w, ufl.TrialFunction(W))
     if coupled:  # u_- tested with v_+ on the uncut cells of side -1 (inactive dofs aside)
         u_minus, v_plus = ufl.split(ufl.TrialFunction(W))[0], ufl.split(ufl.TestFunction(W))[1]
         J = J + 1e6 * ufl.inner(u_minus, v_plus) * problem.cut.dx(-1)
@@ -200,7 +200,7 @@ def test_constant_blocks_are_added_from_their_copy(problem):
     """Kept for a solve, the uncut cells' linear bulk is added from a copy: at a new
     state the matrix equals one assembled afresh there."""
     W = problem.space.W
-    J = ufl.derivative(problem.residual(), problem.w, ufl.TrialFunction(W))
+    J = ufl.derivative(problem.residual(problem.w), problem.w, ufl.TrialFunction(W))
     split = split_uncut(J, problem.space.field_space)
     blocks = [(form(b.form), b.parent, True) for b in split.blocks]
     R, rest = problem.restriction(), form(split.rest)
@@ -230,11 +230,12 @@ def test_split_newton_lifts_unmet_dirichlet_data():
     solutions = []
     for field_space in (problem.space.field_space, None):
         problem.w.x.array[:] = 0.0
-        newton = RestrictedNewton(problem.residual(), problem.w, bcs, R, field_space=field_space)
+        F = problem.residual(problem.w)
+        newton = RestrictedNewton(F, problem.w, bcs, R, field_space=field_space)
         assert (newton.jacobian_forms._whole is None) == (field_space is not None)
         newton._residual(None, newton.y, newton.F_r)  # at w = R y = 0
         x = problem.w.x.petsc_vec
-        b = dolfinx.fem.petsc.assemble_vector(form(problem.residual()))
+        b = dolfinx.fem.petsc.assemble_vector(form(problem.residual(problem.w)))
         dolfinx.fem.petsc.apply_lifting(b, [_jacobian(problem)], bcs=[bcs], x0=[x], alpha=-1.0)
         b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         dolfinx.fem.petsc.set_bc(b, bcs, x, -1.0)
@@ -281,7 +282,7 @@ def test_prolongation_takes_the_ptap_path():
 
 def test_stored_layouts_equal_computed(problem, tmp_path):
     """The JSON beside a JIT module gives back the layouts FFCx's IR gave."""
-    form(problem.residual())  # compiles (or loads) and fills the in-memory cache
+    form(problem.residual(problem.w))  # compiles (or loads) and fills the in-memory cache
     checked = 0
     for compiled in forms._cache.values():
         if not compiled.kernels:
@@ -290,7 +291,7 @@ def test_stored_layouts_equal_computed(problem, tmp_path):
         kernel_store.save(path, compiled.kernels)
         assert path.is_file()
         # the elements are found again in a form of the same signature
-        loaded = kernel_store.load(path, forms._rewrite(problem.residual()).form)
+        loaded = kernel_store.load(path, forms._rewrite(problem.residual(problem.w)).form)
         if loaded is None:  # a cached form of another problem: its elements differ
             continue
         assert loaded.keys() == compiled.kernels.keys()
@@ -300,7 +301,7 @@ def test_stored_layouts_equal_computed(problem, tmp_path):
         checked += 1
     assert checked > 0
     (tmp_path / "bad.json").write_text("{not json")
-    assert kernel_store.load(tmp_path / "bad.json", problem.residual()) is None
+    assert kernel_store.load(tmp_path / "bad.json", problem.residual(problem.w)) is None
 
 
 def test_first_jacobian_reused_only_at_its_state(monkeypatch):
@@ -325,7 +326,7 @@ def test_first_jacobian_reused_only_at_its_state(monkeypatch):
 
     problem.w.x.array[:] = 0.0
     newton = RestrictedNewton(
-        problem.residual(), problem.w, problem.loads.bcs, problem.restriction()
+        problem.residual(problem.w), problem.w, problem.loads.bcs, problem.restriction()
     )
     problem.w.x.array[:] = 0.5 * solution  # moved after the set-up assembly
     calls.clear()

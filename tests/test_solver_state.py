@@ -5,12 +5,18 @@ tolerances hold, and no PETSc option of ours outlives its solve."""
 import xfem_contact  # noqa: F401
 
 # isort: split
+import dolfinx.mesh
 import numpy as np
 import pytest
+from mpi4py import MPI
 from petsc4py import PETSc
 
-from xfem_contact import NewtonFailure
+from xfem_contact import LinearSolveFailure, Material, NewtonFailure, SolveError
 from xfem_contact.cases.paper import inclusion_problem
+from xfem_contact.mechanics.plain import PlainElasticityProblem
+
+#: A Krylov solve that cannot converge: one unpreconditioned CG iteration
+ONE_CG_STEP = {"ksp_type": "cg", "pc_type": "none", "ksp_max_it": 1, "ksp_rtol": 1e-12}
 
 
 def multipliers(problem) -> np.ndarray:
@@ -60,6 +66,39 @@ def test_failure_keeps_the_state_before_the_solve():
         problem.solve(petsc_options={"snes_max_it": 1})
     assert failure.value.report.iterations == 1
     assert np.array_equal(problem.w.x.array, before)
+    assert problem.last_report is failure.value.report
+    assert isinstance(failure.value, SolveError)
+    assert our_options() == []
+
+
+def plain_problem() -> PlainElasticityProblem:
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    problem = PlainElasticityProblem(mesh, 1, Material(1e3, 0.3))
+    problem.loads.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
+    problem.loads.add_traction(lambda x: np.isclose(x[1], 1.0), (0.0, -10.0))
+    return problem
+
+
+@pytest.mark.parametrize(
+    "make", [lambda: inclusion_problem(8, 1, "bonded"), plain_problem], ids=["cut", "plain"]
+)
+def test_a_linear_solve_fails_as_newton_does(make):
+    """Every problem kind: the same error type, the state before the solve, the failed
+    solve's report in ``last_report``, no option of ours left behind."""
+    problem = make()
+    problem.solve()
+    assert problem.last_report.converged
+    before = problem.w.x.array.copy()
+    problem.loads.set_time(2.0)
+    with pytest.raises(LinearSolveFailure, match="KSP converged reason -3") as failure:
+        problem.solve(petsc_options=ONE_CG_STEP)
+    assert isinstance(failure.value, SolveError)
+    assert failure.value.report.reason < 0
+    assert problem.last_report is failure.value.report
+    assert np.array_equal(problem.w.x.array, before)
+    assert our_options() == []
+    problem.solve()  # and the problem solves again
+    assert problem.last_report.converged
 
 
 def test_newton_starts_from_w():

@@ -49,7 +49,7 @@ def test_coulomb_keeps_lu_and_its_jacobian_fails_the_guard():
     with pytest.raises(ValueError, match="needs a symmetric Jacobian"):
         problem.solve({"pc_type": "cholesky"})
     newton = RestrictedNewton(
-        problem.residual(),
+        problem.residual(problem.w),
         problem.w,
         problem.loads.bcs,
         problem.restriction(),

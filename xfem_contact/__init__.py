@@ -20,16 +20,18 @@ from xfem_contact.mechanics.materials import Material  # noqa: E402
 from xfem_contact.mechanics.presets import ContactProblem, ElasticityProblem  # noqa: E402
 from xfem_contact.mechanics.problem import Problem  # noqa: E402
 from xfem_contact.quadrature.cell_rules import CellRules  # noqa: E402
-from xfem_contact.solvers.newton import NewtonFailure  # noqa: E402
+from xfem_contact.solvers.report import LinearSolveFailure, NewtonFailure, SolveError  # noqa: E402
 
 __all__ = [
     "CellRules",
     "ContactProblem",
     "CutMesh",
     "ElasticityProblem",
+    "LinearSolveFailure",
     "Material",
     "NewtonFailure",
     "Problem",
+    "SolveError",
     "form",
     "versions",
 ]

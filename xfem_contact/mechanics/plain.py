@@ -26,7 +26,7 @@ from xfem_contact.fem.forms import form
 from xfem_contact.mechanics.loads import Loads, PlainFields
 from xfem_contact.mechanics.materials import Material, Moduli
 from xfem_contact.solvers.options import remove_options, unique_prefix
-from xfem_contact.solvers.report import SolveReport
+from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 
 
 class PlainSpace:
@@ -115,8 +115,15 @@ class PlainElasticityProblem:
 
     def solve(self, petsc_options: dict | None = None, log=None) -> SolveReport:
         """One linear solve (PETSc LU unless ``petsc_options`` say otherwise); ``w``
-        holds the result. ``log`` is unused (no iterates). Collective."""
+        holds the result and :attr:`last_report` the report. ``log`` is unused (no
+        iterates). Collective.
+
+        Raises:
+            LinearSolveFailure: the KSP diverged; ``w`` then holds the state from before
+                this solve and :attr:`last_report` the failed solve's report.
+        """
         start = time.perf_counter()
+        accepted = self.w.x.array.copy()
         prefix = unique_prefix("xfem_plain_")
         problem = dolfinx.fem.petsc.LinearProblem(
             form(self.bilinear_form()),
@@ -131,9 +138,17 @@ class PlainElasticityProblem:
             reason = problem.solver.getConvergedReason()
         finally:
             remove_options(prefix)  # nothing of ours outlives the solve
+            del problem  # its KSP, matrix and vectors (LinearProblem.__del__)
         self.last_report = SolveReport(
             reason=reason, total_time=time.perf_counter() - start, w=self.w, space=self.space
         )
+        if reason < 0:
+            self.w.x.array[:] = accepted
+            raise LinearSolveFailure(
+                f"Linear solve failed: KSP converged reason {reason}; w restored to the state"
+                " before this solve",
+                self.last_report,
+            )
         return self.last_report
 
     def accept_step(self) -> None:

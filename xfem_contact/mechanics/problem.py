@@ -33,7 +33,7 @@ from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_inte
 from xfem_contact.solvers.linear import added_options, solve_restricted, tip_transform
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton, weak_method
 from xfem_contact.solvers.options import merged_options
-from xfem_contact.solvers.report import SolveReport
+from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 from xfem_contact.solvers.symmetry import symmetric_options
 
 
@@ -114,6 +114,7 @@ class Problem:
         self._law_materials = side_materials.laws
         self._newton: RestrictedNewton | None = None
         self._newton_key = None
+        self._last_report: SolveReport | None = None
         #: Pseudo-time of the rotations that the bodies of ``w`` have turned by
         self._rotated_at = 0.0
         self._attach_cut()
@@ -235,9 +236,11 @@ class Problem:
         u, v = self.space.trial(), self.space.test()
         return sum(self._law_and_spring_terms(u, v), self.bulk.form(u, v))
 
-    def residual(self) -> ufl.Form:
-        """The residual ``F(w; v)`` (UFL, linear in the test functions)."""
-        u, v = self.space.split(self.w), self.space.test()
+    def residual(self, w: dolfinx.fem.Function) -> ufl.Form:
+        """The residual ``F(w; v)`` at the state ``w`` (a function on ``space.W``, e.g.
+        :attr:`w`): UFL, linear in the test functions. Large sliding's two-cell terms
+        are not in it (``couplings``, assembled at ``w`` by their ``add_residual``)."""
+        u, v = self.space.split(w), self.space.test()
         F = sum(self._law_and_spring_terms(u, v), self.bulk.form(u, v))
         if self.loads.has_terms:
             F -= self.loads.linear_form()
@@ -294,14 +297,22 @@ class Problem:
         if self.linear:
             a, L = form(self.bilinear_form()), form(self.loads.linear_form())
             start, residuals = time.perf_counter(), []
-            w, reason = solve_restricted(
-                a, L, self.loads.bcs, self.space, petsc_options, residuals=residuals
-            )
+            try:
+                w, reason = solve_restricted(
+                    a, L, self.loads.bcs, self.space, petsc_options, residuals=residuals
+                )
+            except LinearSolveFailure as failure:  # self.w is untouched
+                self._last_report = failure.report
+                raise
             self.w.x.array[:] = w.x.array
-            elapsed = time.perf_counter() - start
-            return SolveReport(
-                residuals, reason=reason, total_time=elapsed, w=self.w, space=self.space
+            self._last_report = SolveReport(
+                residuals,
+                reason=reason,
+                total_time=time.perf_counter() - start,
+                w=self.w,
+                space=self.space,
             )
+            return self._last_report
         key = (self.loads.revision, repr(sorted((petsc_options or {}).items())))
         if self._newton is not None and key != self._newton_key:
             self._newton.destroy()  # loads or solver options changed since it was built
@@ -309,7 +320,7 @@ class Problem:
         if self._newton is None:
             split = (petsc_options or {}).get("pc_type") in ("fieldsplit", "python")
             self._newton = RestrictedNewton(
-                self.residual(),
+                self.residual(self.w),
                 self.w,
                 self.loads.bcs,
                 self.restriction(),
@@ -333,9 +344,11 @@ class Problem:
             report = self._newton.solve()
             self._rotated_at = t
             report.w, report.space = self.w, self.space
+            self._last_report = report
             return report
         except NewtonFailure as failure:
             self.w.x.array[:] = accepted  # the state before this solve, not the diverged one
+            self._last_report = failure.report
             raise NewtonFailure(
                 f"{str(failure).splitlines()[0]}; w restored to the state before this solve",
                 failure.report,
@@ -356,8 +369,9 @@ class Problem:
 
     @property
     def last_report(self) -> SolveReport | None:
-        """The report of the last Newton solve (None before the first)."""
-        return None if self._newton is None else self._newton.report
+        """The report of the last solve, linear or Newton, converged or failed (None
+        before the first)."""
+        return self._last_report
 
     def accept_step(self) -> None:
         """Accept the current solution as the end of a load step: incremental laws

@@ -29,30 +29,15 @@ from xfem_contact.fem.forms import form
 
 
 # -- accessors of the problem (one place to follow its API) ---------------------------
-class _AtState:
-    """``problem`` seen at the state ``w`` instead of its solution."""
-
-    def __init__(self, problem, w: dolfinx.fem.Function):
-        self._problem, self.w = problem, w
-
-    def __getattr__(self, name):
-        return getattr(self._problem, name)
-
-
-def _view(problem, w: dolfinx.fem.Function | None):
-    """``problem`` itself, or seen at the state ``w``."""
-    return problem if w is None or w is problem.w else _AtState(problem, w)
-
-
 def _load_form(problem) -> ufl.Form:
     """The loads' terms ``L(v)`` (tractions, pressures, body forces)."""
     return problem.loads.linear_form()
 
 
-def _springs(problem):
-    """The springs' residual terms (UFL, linear in the test of ``W``), or None."""
-    u = problem.space.split(problem.w)
-    return problem.loads.spring_terms(u, problem.space.test())
+def _springs(problem, w: dolfinx.fem.Function):
+    """The springs' residual terms at the state ``w`` (UFL, linear in the test of ``W``),
+    or None."""
+    return problem.loads.spring_terms(problem.space.split(w), problem.space.test())
 
 
 def _functions(load) -> list:
@@ -84,20 +69,21 @@ def _vector(problem, ufl_form) -> PETSc.Vec:
     return b
 
 
-def residual_vector(problem) -> PETSc.Vec:
-    """``F(w; v_i)`` of the problem's current ``w`` for every dof ``i`` of ``W``, without
-    Dirichlet lifting and with no row set (owned entries valid). Collective."""
+def residual_vector(problem, w: dolfinx.fem.Function) -> PETSc.Vec:
+    """``F(w; v_i)`` at the state ``w`` (a function on the problem's space, e.g. its
+    solution ``problem.w``) for every dof ``i`` of ``W``, without Dirichlet lifting and
+    with no row set (owned entries valid). Collective."""
     if problem.linear:  # A w - L with the forms of the solve (no new compile)
         A = dolfinx.fem.petsc.assemble_matrix(form(problem.bilinear_form()))
         A.assemble()
         b = _vector(problem, _load_form(problem))
         b.scale(-1.0)
-        A.multAdd(problem.w.x.petsc_vec, b, b)
+        A.multAdd(w.x.petsc_vec, b, b)
         A.destroy()
         return b
-    b = _vector(problem, problem.residual())
-    for coupling in (getattr(problem, "couplings", None) or {}).values():
-        coupling.add_residual(problem.w, b)
+    b = _vector(problem, problem.residual(w))
+    for coupling in problem.couplings.values():
+        coupling.add_residual(w, b)
     return b
 
 
@@ -129,20 +115,21 @@ def _force(problem, b: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray
 
 # -- public ---------------------------------------------------------------------------
 def reactions(
-    problem, b: np.ndarray | None = None, w: dolfinx.fem.Function | None = None
+    problem, w: dolfinx.fem.Function, b: np.ndarray | None = None
 ) -> dict[str, np.ndarray]:
-    """Force (N/m, ``(2,)``) of each support (:func:`supports`) on the body.
+    """Force (N/m, ``(2,)``) of each support (:func:`supports`) on the body at a state.
 
     Args:
-        problem: A solved problem (its ``w``; a plain problem needs ``w``).
-        b: The residual vector's owned entries (:func:`residual_vector`), if at hand.
+        problem: A problem (its loads at their current time).
+        w: The state, a function on the problem's space (e.g. ``problem.w``).
+        b: The residual vector's owned entries at ``w`` (:func:`residual_vector`), if
+            at hand.
 
     Returns:
         ``{name: array([R_x, R_y])}``. Collective.
     """
-    problem = _view(problem, w)
     if b is None:
-        vec = residual_vector(problem)
+        vec = residual_vector(problem, w)
         b = vec.array_r.copy()
         vec.destroy()
     n = _owned(problem)
@@ -159,33 +146,33 @@ def reactions(
     return out
 
 
-def applied_loads(problem, w: dolfinx.fem.Function | None = None) -> tuple[np.ndarray, float]:
+def applied_loads(problem) -> tuple[np.ndarray, float]:
     """The resultant (N/m, ``(2,)``) of the tractions, pressures and body forces at the
     current time, ``L(e_c)``, and their total size ``max_c sum_i |L_i e_c(i)|`` (N/m: the
-    scale of a balance of self-equilibrated loads). Collective."""
-    problem = _view(problem, w)
+    scale of a balance of self-equilibrated loads); they do not depend on the state.
+    Collective."""
     vec = _vector(problem, _load_form(problem))
     L = vec.array_r.copy()
     vec.destroy()
     return _force(problem, L), float(_force(problem, np.abs(L)).max())
 
 
-def interface_resultants(problem, w: dolfinx.fem.Function | None = None) -> dict[str, np.ndarray]:
-    """Per interface, the resultant (N/m, ``(2,)``) of its traction on side -1 (the force
-    side +1 exerts on side -1 across it; zero for a free interface). Collective."""
-    problem = _view(problem, w)
+def interface_resultants(problem, w: dolfinx.fem.Function) -> dict[str, np.ndarray]:
+    """Per interface, the resultant (N/m, ``(2,)``) of its traction on side -1 at the
+    state ``w`` (the force side +1 exerts on side -1 across it; zero for a free
+    interface). Collective."""
     out = {}
     v = problem.space.test()
     for name, law in problem.laws.items():
         ctx = problem.contexts[name]
-        term = law.residual(ctx, ctx.fields(problem.space.split(problem.w)), ctx.fields(v))
+        term = law.residual(ctx, ctx.fields(problem.space.split(w)), ctx.fields(v))
         b = None if term is None else _vector(problem, term)
-        coupling = (getattr(problem, "couplings", None) or {}).get(name)
+        coupling = problem.couplings.get(name)
         if coupling is not None:
             if b is None:
                 b = dolfinx.fem.petsc.create_vector(problem.space.W)
                 b.zeroEntries()
-            coupling.add_residual(problem.w, b)
+            coupling.add_residual(w, b)
         if b is None:
             out[name] = np.zeros(2)
             continue
@@ -196,11 +183,10 @@ def interface_resultants(problem, w: dolfinx.fem.Function | None = None) -> dict
     return out
 
 
-def spring_reactions(problem, w: dolfinx.fem.Function | None = None) -> np.ndarray | None:
-    """The force (N/m, ``(2,)``) of the tangential spring supports on the body, or None
-    without springs. Collective."""
-    problem = _view(problem, w)
-    terms = _springs(problem)
+def spring_reactions(problem, w: dolfinx.fem.Function) -> np.ndarray | None:
+    """The force (N/m, ``(2,)``) of the tangential spring supports on the body at the
+    state ``w``, or None without springs. Collective."""
+    terms = _springs(problem, w)
     if terms is None:
         return None
     vec = _vector(problem, terms)
@@ -209,15 +195,15 @@ def spring_reactions(problem, w: dolfinx.fem.Function | None = None) -> np.ndarr
     return force
 
 
-def balance(problem, w: dolfinx.fem.Function | None = None) -> dict:
+def balance(problem, w: dolfinx.fem.Function) -> dict:
     """Reactions per support, the applied loads, interface resultants and the global
-    balance ``sum(reactions) + loads`` (N/m), with its size relative to the largest
-    reaction or the total size of the loads (:func:`applied_loads`). Collective."""
-    problem = _view(problem, w)
-    vec = residual_vector(problem)
-    held = reactions(problem, vec.array_r.copy())
+    balance ``sum(reactions) + loads`` (N/m) at the state ``w`` (e.g. ``problem.w``),
+    with its size relative to the largest reaction or the total size of the loads
+    (:func:`applied_loads`). Collective."""
+    vec = residual_vector(problem, w)
+    held = reactions(problem, w, vec.array_r.copy())
     vec.destroy()
-    springs = spring_reactions(problem)
+    springs = spring_reactions(problem, w)
     if springs is not None:
         held["tangential_supports"] = springs
     loads, size = applied_loads(problem)
@@ -226,7 +212,9 @@ def balance(problem, w: dolfinx.fem.Function | None = None) -> dict:
     return {
         "reactions": {k: r.tolist() for k, r in held.items()},
         "applied_loads": loads.tolist(),
-        "interface_resultants": {k: r.tolist() for k, r in interface_resultants(problem).items()},
+        "interface_resultants": {
+            k: r.tolist() for k, r in interface_resultants(problem, w).items()
+        },
         "balance": total.tolist(),
         "balance_relative": float(np.abs(total).max() / scale) if scale > 0 else 0.0,
     }

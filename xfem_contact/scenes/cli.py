@@ -21,7 +21,7 @@ def _run(args) -> int:
     from mpi4py import MPI
 
     from xfem_contact.scenes.scene import bundled_scenes, load_scene
-    from xfem_contact.solvers.newton import NewtonFailure
+    from xfem_contact.solvers.report import SolveError
 
     path = pathlib.Path(args.scene)
     if not path.exists() and args.scene in bundled_scenes():
@@ -48,7 +48,7 @@ def _run(args) -> int:
             log=None if args.quiet else print,
             progress_bar=not (args.quiet or args.no_progress),
         )
-    except NewtonFailure as failure:
+    except SolveError as failure:
         failed(3, str(failure).splitlines()[0])
         say(failure.report.table(), file=sys.stderr)
         return 3

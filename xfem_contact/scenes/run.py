@@ -29,7 +29,7 @@ from xfem_contact.scenes.builder import (  # noqa: F401  (re-exported)
 )
 from xfem_contact.scenes.crack_outputs import CrackOutputs
 from xfem_contact.scenes.scene import Scene
-from xfem_contact.solvers.newton import NewtonFailure
+from xfem_contact.solvers.report import NewtonFailure, SolveError
 
 
 class Result:
@@ -143,10 +143,15 @@ def run(
                 solution, its, status = solve_step(
                     problem, scene.petsc_options or None, say if log else None
                 )
-            except NewtonFailure as failure:
-                raise NewtonFailure(
+            except SolveError as failure:
+                solver = (
+                    "Newton (SNES"
+                    if isinstance(failure, NewtonFailure)
+                    else "the linear solve (KSP"
+                )
+                raise type(failure)(
                     f"Scene {scene.name!r}, load step {k}/{len(steps)} (time {t:.4g}): "
-                    f"Newton failed (SNES reason {failure.report.reason})",
+                    f"{solver} reason {failure.report.reason}) failed",
                     failure.report,
                 ) from None
             iterations.append(its)
@@ -208,7 +213,7 @@ def run(
         for line in cracks.lines(summary["cracks"]):
             say(line)
     forces_start = time.perf_counter()  # reactions, interface resultants, balance (N/m)
-    summary["forces"] = balance(problem)
+    summary["forces"] = balance(problem, problem.w)
     forces_time = time.perf_counter() - forces_start
     reactions = ", ".join(f"{k} {v}" for k, v in summary["forces"]["reactions"].items())
     say(

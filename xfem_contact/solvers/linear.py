@@ -31,6 +31,7 @@ from xfem_contact.solvers.options import (
     reused_lu,
     unique_prefix,
 )
+from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.symmetry import mark_symmetric
 
@@ -109,59 +110,75 @@ def solve_restricted(
         updated) and the KSP's converged reason (> 0).
 
     Raises:
-        RuntimeError: The KSP diverged (converged reason < 0).
+        LinearSolveFailure: The KSP diverged (converged reason < 0); nothing made
+            here outlives the call.
     """
-    own_R = R is None
     if (petsc_options or {}).get("pc_type") == "python":
         raise ValueError(
             "solver.linear = 'iterative' (the band multigrid) preconditions the Newton "
             "steps of contact problems; a linear problem (interfaces 'bonded' or 'free' "
             "only) takes 'direct'"
         )
-    if own_R:
-        R = restriction_matrix(space)
-    A, b = assemble_restricted(a, L, bcs, R)
-    transform = tip_transform(space, off=not tip_scaling)
-    if transform is None:
-        D = saddle_point_scaling(A)  # solve D A D y_s = D b, y = D y_s
-        A.diagonalScale(D, D)
-        b.pointwiseMult(b, D)
-    else:  # solve Z^T A Z y_s = Z^T b, y = Z y_s (refined against A_r y = b_r)
-        D = transform(R, A)
-        (A_r, b_r), A = (A, b), scaled(A, D)
-        b = A.createVecRight()
-        D.multTranspose(b_r, b)
-    ksp = PETSc.KSP().create(A.getComm())
-    ksp.setOperators(A)
-    prefix = unique_prefix(petsc_options_prefix)
-    ksp.setOptionsPrefix(prefix)
-    options = merged_options("linear", petsc_options)
-    if options.get("pc_type") == "cholesky":
-        mark_symmetric(A)  # checked: an LDL^T reads one triangle only
-    with applied_options(prefix, options):
-        ksp.setFromOptions()
-    y = R.createVecRight()
-    with applied_options(prefix, options):  # the factorisation reads options too
-        ksp.solve(b, y)
-    if residuals is not None:
+    owned = []  # every PETSc object made here, destroyed on every path
+    try:
+        if R is None:
+            R = restriction_matrix(space)
+            owned.append(R)
+        A, b = assemble_restricted(a, L, bcs, R)
+        owned += [A, b]
+        transform = tip_transform(space, off=not tip_scaling)
+        if transform is None:
+            D = saddle_point_scaling(A)  # solve D A D y_s = D b, y = D y_s
+            A.diagonalScale(D, D)
+            b.pointwiseMult(b, D)
+        else:  # solve Z^T A Z y_s = Z^T b, y = Z y_s (refined against A_r y = b_r)
+            D = transform(R, A)
+            (A_r, b_r), A = (A, b), scaled(A, D)
+            b = A.createVecRight()
+            owned += [A, b]
+            D.multTranspose(b_r, b)
+        owned.append(D)
+        ksp = PETSc.KSP().create(A.getComm())
+        owned.append(ksp)
+        ksp.setOperators(A)
+        prefix = unique_prefix(petsc_options_prefix)
+        ksp.setOptionsPrefix(prefix)
+        options = merged_options("linear", petsc_options)
+        if options.get("pc_type") == "cholesky":
+            mark_symmetric(A)  # checked: an LDL^T reads one triangle only
+        with applied_options(prefix, options):
+            ksp.setFromOptions()
+        y = R.createVecRight()
+        owned.append(y)
+        with applied_options(prefix, options):  # the factorisation reads options too
+            ksp.solve(b, y)
+        norms = [b.norm()]
         r = b.duplicate()
+        owned.append(r)
         A.mult(y, r)
         r.axpy(-1.0, b)
-        residuals += [b.norm(), r.norm()]
-        r.destroy()
-    if transform is None:
-        y.pointwiseMult(y, D)
-    else:
-        y = refined(ksp, D, A_r, b_r, y)
-    w = dolfinx.fem.Function(space.W)
-    R.mult(y, w.x.petsc_vec)
-    w.x.scatter_forward()
-    reason = ksp.getConvergedReason()
-    if reason < 0:
-        raise RuntimeError(f"Linear solve failed: KSP converged reason {reason}")
-    for obj in (ksp, A, b, y, D, *([R] if own_R else [])):
-        obj.destroy()
-    return w, reason
+        norms.append(r.norm())
+        if residuals is not None:
+            residuals += norms
+        reason = ksp.getConvergedReason()
+        if reason < 0:
+            raise LinearSolveFailure(
+                f"Linear solve failed: KSP converged reason {reason} "
+                f"({ksp.getType()} with pc {ksp.getPC().getType()})",
+                SolveReport(norms, reason=reason),
+            )
+        if transform is None:
+            y.pointwiseMult(y, D)
+        else:
+            y = refined(ksp, D, A_r, b_r, y)
+            owned.append(y)
+        w = dolfinx.fem.Function(space.W)
+        R.mult(y, w.x.petsc_vec)
+        w.x.scatter_forward()
+        return w, reason
+    finally:
+        for obj in {id(o): o for o in owned}.values():
+            obj.destroy()
 
 
 def added_options(space: EnrichedSpace, options: dict, couplings: bool) -> dict:

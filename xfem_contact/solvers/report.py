@@ -1,5 +1,10 @@
 """What a solve reports: the solution, the history of its iterates (one for a linear
-solve), and the failure that carries it (:mod:`xfem_contact.solvers.newton`)."""
+solve), and the failures that carry it.
+
+Every solve of the package fails the same way: it raises a :class:`SolveError`
+(:class:`NewtonFailure` for a Newton solve, :class:`LinearSolveFailure` for a linear
+one) holding the :class:`SolveReport` of the failed solve, after the problem's state
+was put back to the one before the solve and every PETSc object of the solve freed."""
 
 from __future__ import annotations
 
@@ -73,9 +78,18 @@ class SolveReport:
 NewtonReport = SolveReport
 
 
-class NewtonFailure(RuntimeError):
-    """Newton did not converge; ``report`` holds the iteration history."""
+class SolveError(RuntimeError):
+    """A solve did not converge; ``report`` holds its history (reason < 0)."""
 
     def __init__(self, message: str, report: SolveReport):
         super().__init__(f"{message}\n{report.table()}")
         self.report = report
+
+
+class NewtonFailure(SolveError):
+    """Newton (SNES) did not converge; ``report`` holds the iteration history."""
+
+
+class LinearSolveFailure(SolveError):
+    """A linear solve (KSP) did not converge; ``report`` holds its reason and the
+    residual norms before and after (when they were computed)."""
