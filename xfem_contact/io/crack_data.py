@@ -17,7 +17,6 @@ import dolfinx.fem
 import numpy as np
 
 from xfem_contact.fem.evaluation import interface_points
-from xfem_contact.io.interface_data import status_codes
 
 
 class EnrichedDisplacements:
@@ -62,6 +61,6 @@ def lip_samples(problem, name: str) -> dict[str, list]:
     if ctx.field is not None:
         state = law.state(ctx, problem.w)
         local |= {key: state[key] for key in ("lambda_n", "lambda_t") if key in state}
-        local["status"] = status_codes(law, state, points.shape[0])
+        local["status"] = law.point_status(state, points.shape[0])
     comm = problem.mesh.comm
     return {key: np.concatenate(comm.allgather(v)).tolist() for key, v in local.items()}

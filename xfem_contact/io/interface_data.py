@@ -16,28 +16,11 @@ import dataclasses
 
 import numpy as np
 
-from xfem_contact.mechanics.laws.base import NUMPY_OPS
 from xfem_contact.quadrature.rules import RuleSet
 
-#: Point data of ``interface.vtu`` and the codes of ``status``
+#: Point data of ``interface.vtu`` (its ``status`` holds the codes of
+#: :meth:`~xfem_contact.mechanics.laws.base.InterfaceLaw.point_status`)
 KEYS = ("lambda_n", "lambda_t", "gap", "slip")
-OPEN, STICK, SLIP = 0, 1, 2
-
-
-def status_codes(law, state: dict[str, np.ndarray], npoints: int) -> np.ndarray:
-    """Per point 0 (open), 1 (stick) or 2 (slip), int8, ``(npoints,)``: in contact where
-    the applied pressure ``P_n < 0``; sticking where the trial tangential traction lies
-    within the law's friction bound (always for ``sticking``, never for frictionless)."""
-    if "P_n" not in state:  # no contact law: bonded sticks, free is open
-        code = STICK if law.name == "bonded" else OPEN
-        return np.full(npoints, code, dtype=np.int8)
-    contact = state["P_n"] < 0.0
-    if not getattr(law, "tangential", False):
-        stick = np.zeros_like(contact)
-    else:
-        bound = law.friction_bound(state["P_n"], NUMPY_OPS)
-        stick = contact if bound is None else contact & (np.abs(state["trial_t"]) <= bound)
-    return np.where(contact, np.where(stick, STICK, SLIP), OPEN).astype(np.int8)
 
 
 def _node_rules(cut, pieces: np.ndarray) -> RuleSet:
@@ -98,7 +81,7 @@ def interface_point_data(problem) -> dict[str, np.ndarray]:
         for key in KEYS:
             if key in state:
                 data[key][rows] = state[key]
-        data["status"][rows] = status_codes(law, state, rows.size)
+        data["status"][rows] = law.point_status(state, rows.size)
     return data
 
 
@@ -109,5 +92,5 @@ def sample_status(problem, name: str) -> list[int]:
     law = problem.laws[name]
     state = problem.interface_state(name=name)
     npoints = problem.contexts[name].rules.points.shape[0]
-    local = status_codes(law, state, npoints)
+    local = law.point_status(state, npoints)
     return np.concatenate(problem.mesh.comm.allgather(local)).tolist()

@@ -49,7 +49,7 @@ def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
         laws[name] = law
         if not isinstance(laws[name], InterfaceLaw):
             raise ValueError(f"Interface {name!r}: {law!r} is not an interface law")
-        if crack and getattr(law, "lbb", "none") == "stabilized":
+        if crack and law.lbb == "stabilized":
             raise ValueError(
                 f"Crack {name!r}: lbb='stabilized' squares the tip's singular traction on "
                 "the lips (K_I of a closed crack 30 % off); give the law lbb='none'"

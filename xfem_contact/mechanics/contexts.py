@@ -25,6 +25,7 @@ def interface_context(
     cell_size: dolfinx.fem.Function,
     w_old: dolfinx.fem.Function,
     split: Callable = ufl.split,
+    ramp: dolfinx.fem.Function | None = None,
 ) -> InterfaceContext:
     """The context of interface ``name`` on the current cut of ``cut``.
 
@@ -37,6 +38,7 @@ def interface_context(
         cell_size: DG0 cell diameters (m).
         w_old: The last accepted state.
         split: The fields of a Function on ``W`` (the space's ``split``).
+        ramp: The ramp of a crack's branch functions (the space's), None without.
 
     Collective.
     """
@@ -56,6 +58,7 @@ def interface_context(
         field=field,
         w_old=w_old,
         split=split,
+        ramp=ramp,
     )
 
 

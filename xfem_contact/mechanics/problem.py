@@ -138,6 +138,7 @@ class Problem:
                 self.cell_size,
                 self.w_old,
                 self.space.split,
+                self.space.ramp,
             )
             for name in self.laws
         }
@@ -250,10 +251,7 @@ class Problem:
         """``(lambda_n, lambda_t or None)`` (UFL) of a split mixed function, for a
         contact law (the Cartesian multiplier vector for ``bonded``)."""
         name = self._name(name)
-        law, ctx = self.laws[name], self.contexts[name]
-        if hasattr(law, "multipliers"):
-            return law.multipliers(ctx.fields(fields))
-        return fields[ctx.field], None
+        return self.laws[name].multipliers(self.contexts[name].fields(fields))
 
     # -- solve -----------------------------------------------------------------------
     def restriction(self):

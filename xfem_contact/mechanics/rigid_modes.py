@@ -43,7 +43,6 @@ from mpi4py import MPI
 
 from xfem_contact.fem.evaluation import interface_points
 from xfem_contact.fem.subspaces import collapse
-from xfem_contact.mechanics.laws import ContactLaw, Free
 
 #: What a closed interface of each kind transmits (the reason in the messages)
 _KIND_TEXT = {
@@ -111,17 +110,6 @@ def _num(value: float, digits: int) -> str:
     return f"{(0.0 if abs(value) < 1e-9 else float(value)):.{digits}g}"
 
 
-def law_kind(law) -> str:
-    """What a closed interface of ``law`` transmits: ``none``, ``normal`` or ``full``."""
-    if isinstance(law, Free):
-        return "none"
-    if isinstance(law, ContactLaw) and (  # small or large sliding
-        not law.tangential or getattr(law, "friction", None) == 0
-    ):
-        return "normal"
-    return "full"
-
-
 class RigidModeWarning(UserWarning):
     """A body may spin freely (a frictionless circular interface): fine without torque."""
 
@@ -161,7 +149,7 @@ def free_bodies(problem, tol: float = 1e-3) -> list[FreeBody]:
     held = [np.trace(Q[3 * b : 3 * b + 3, 3 * b : 3 * b + 3]) >= tol for b in range(nb)]
     # the two sides of a crack are one body: joined ahead of its tips
     joined = getattr(problem.cut, "crack", None) is not None
-    kinds = {name: "full" if joined else law_kind(law) for name, law in problem.laws.items()}
+    kinds = {name: "full" if joined else law.transmits for name, law in problem.laws.items()}
     for name, kind in kinds.items():
         if kind != "none" and name in inside and plus is not None:
             Q += _interface_gram(problem, bodies, name, inside[name], plus, kind)

@@ -16,7 +16,7 @@ from mpi4py import MPI
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.io.gmsh import GmshMesh, facets, read_gmsh
 from xfem_contact.io.meshes import annulus
-from xfem_contact.mechanics.laws import ContactLaw, make_law
+from xfem_contact.mechanics.laws import make_law
 from xfem_contact.mechanics.loads import annulus_parts, rectangle_parts
 from xfem_contact.mechanics.plain import PlainElasticityProblem
 from xfem_contact.mechanics.problem import Problem
@@ -175,8 +175,7 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             "enrichment": True,
             "multipliers": sum(c for _, c, _ in problem.space.multiplier_fields),
             "tangential_multiplier": any(
-                isinstance(law, ContactLaw) and law.multiplier_components(gdim) > 1
-                for law in laws.values()
+                law.tangential and law.multiplier_components(gdim) > 1 for law in laws.values()
             ),
             "solver": "KSP (one linear solve per load step)"
             if problem.linear

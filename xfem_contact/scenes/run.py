@@ -144,14 +144,11 @@ def run(
                     problem, scene.petsc_options or None, say if log else None
                 )
             except SolveError as failure:
-                solver = (
-                    "Newton (SNES"
-                    if isinstance(failure, NewtonFailure)
-                    else "the linear solve (KSP"
-                )
+                newton = isinstance(failure, NewtonFailure)
+                solver = "Newton failed (SNES" if newton else "the linear solve failed (KSP"
                 raise type(failure)(
                     f"Scene {scene.name!r}, load step {k}/{len(steps)} (time {t:.4g}): "
-                    f"{solver} reason {failure.report.reason}) failed",
+                    f"{solver} reason {failure.report.reason})",
                     failure.report,
                 ) from None
             iterations.append(its)

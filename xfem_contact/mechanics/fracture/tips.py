@@ -31,11 +31,7 @@ def lip_tractions(problem, upper: int = 1, name: str | None = None) -> list[Lip]
     law, ctx = problem.laws[name], problem.contexts[name]
     if ctx.field is None:
         return []
-    fields = ctx.fields(problem.space.split(problem.w))
-    if hasattr(law, "traction_vector"):
-        traction = law.traction_vector(ctx, fields)
-    else:  # a Cartesian multiplier (bonded)
-        traction = fields.multiplier
+    traction = law.traction_vector(ctx, fields := ctx.fields(problem.space.split(problem.w)))
     measure = ctx.measure
     return [
         Lip(traction, fields.minus, measure, -upper),

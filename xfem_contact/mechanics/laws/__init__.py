@@ -11,9 +11,7 @@ A new law subclasses :class:`InterfaceLaw` (or :class:`MultiplierLaw`) and is li
 in :data:`LAWS`.
 """
 
-import inspect
-
-from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw
+from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw, law_options
 from xfem_contact.mechanics.laws.bonding import Bonded, Free
 from xfem_contact.mechanics.laws.contact import ContactLaw, Coulomb, Frictionless, Sticking
 from xfem_contact.mechanics.laws.multiplier import LBB_OPTIONS, MultiplierLaw
@@ -32,19 +30,6 @@ LAWS: dict[str, type[InterfaceLaw]] = {
 #: Names of the linear laws (one KSP solve) and of the contact laws (Newton)
 LINEAR_LAWS = tuple(name for name, law in LAWS.items() if law.linear)
 CONTACT_LAWS = tuple(name for name, law in LAWS.items() if not law.linear)
-
-
-def law_options(law: type[InterfaceLaw]) -> tuple[str, ...]:
-    """The options a law class takes (the named arguments of its constructors)."""
-    names: list[str] = []
-    for cls in law.__mro__:
-        init = vars(cls).get("__init__")
-        if init is None:
-            continue
-        for p in inspect.signature(init).parameters.values():
-            if p.name != "self" and p.kind is p.POSITIONAL_OR_KEYWORD and p.name not in names:
-                names.append(p.name)
-    return tuple(names)
 
 
 #: The options of each law by name

@@ -9,7 +9,12 @@ interface. A law
   sliding), an assembled contribution (:meth:`InterfaceLaw.coupling`);
 - evaluates its state at the interface rule points (:meth:`InterfaceLaw.state`)
   *from the same definitions and the same normal* as the residual it enforces, so
-  the reported status is what was solved.
+  the reported status is what was solved;
+- answers what callers ask of any law, with the base class's defaults:
+  :attr:`~InterfaceLaw.transmits` (what a closed interface carries),
+  :meth:`~InterfaceLaw.multipliers`, :meth:`~InterfaceLaw.traction_vector`,
+  :meth:`~InterfaceLaw.point_status`, :meth:`~InterfaceLaw.options`. Callers never
+  test a law's type or name.
 
 Conventions: the normal ``n`` points from side -1 to side +1, ``t`` is ``n``
 turned by +90 degrees, the jump is ``[u] = u_+ - u_-`` and the multiplier is the
@@ -20,6 +25,7 @@ from __future__ import annotations
 
 import abc
 import dataclasses
+import inspect
 import typing
 
 import dolfinx.fem
@@ -68,6 +74,8 @@ class InterfaceContext:
             no process has one.
         split: The fields of a Function on the mixed space, e.g. ``split(w_old)`` (the
             space's ``split``: the displacements with a crack's branch functions).
+        ramp: The ramp ``R`` of a crack's branch functions (P1; see
+            :class:`~xfem_contact.fem.enrichment.EnrichedSpace`), None without.
     """
 
     cut: CutMesh
@@ -81,8 +89,17 @@ class InterfaceContext:
     w_old: dolfinx.fem.Function
     aligned_cells: dolfinx.fem.Function | None = None
     split: typing.Callable = ufl.split
-    #: Point values cached for the fixed rules (basis tables, dofs, the normal)
+    ramp: dolfinx.fem.Function | None = None
+    #: Point values cached for the fixed rules (basis tables, dofs, the normal) and the
+    #: objects made :meth:`once`
     _cache: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
+
+    def once(self, key: str, make: typing.Callable[[], typing.Any]) -> typing.Any:
+        """``make()`` the first time ``key`` is asked for on this context, the same
+        object afterwards (e.g. a law's coupling of this interface)."""
+        if key not in self._cache:
+            self._cache[key] = make()
+        return self._cache[key]
 
     @property
     def normal(self) -> ufl.core.expr.Expr:
@@ -136,12 +153,11 @@ class InterfaceContext:
         return jump
 
     def _ramp_at(self) -> npt.NDArray[np.float64]:
-        """The space's ramp of the branch functions at the rule points (1 without)."""
-        ramp = getattr(getattr(self.split, "__self__", None), "ramp", None)
-        if ramp is None:
+        """The :attr:`ramp` of the branch functions at the rule points (1 without)."""
+        if self.ramp is None:
             return np.ones(len(self.rules.point_rows))
         cells = self.cut.cut_cells[self.rules.point_rows]
-        return CellMaps(self.cut.mesh, LevelSet(ramp, None)).values(cells, self.rules.points)
+        return CellMaps(self.cut.mesh, LevelSet(self.ramp, None)).values(cells, self.rules.points)
 
     def cell_size_at(self) -> npt.NDArray[np.float64]:
         """``h`` (m) of the cell of every rule point, ``(npoints,)``."""
@@ -160,6 +176,11 @@ class Ops(typing.NamedTuple):
 UFL_OPS = Ops(ufl.min_value, ufl.max_value)
 NUMPY_OPS = Ops(np.minimum, np.maximum)
 
+#: What a closed interface transmits (:attr:`InterfaceLaw.transmits`)
+TRANSMITS = ("none", "normal", "full")
+#: Codes of :meth:`InterfaceLaw.point_status`: open, sticking, slipping
+OPEN, STICK, SLIP = 0, 1, 2
+
 
 class InterfaceLaw(abc.ABC):
     """An interface law (abstract). Subclasses set :attr:`name` and :attr:`linear`."""
@@ -174,10 +195,47 @@ class InterfaceLaw(abc.ABC):
     #: steps may factor LDL^T (:mod:`xfem_contact.solvers.symmetry`); checked on
     #: every matrix factored so
     symmetric: typing.ClassVar[bool] = False
+    #: Whether the law pairs the lips in large sliding (the hybrid element)
+    sliding: typing.ClassVar[bool] = False
+    #: Whether the multiplier has a tangential component in the interface frame
+    #: (``lambda_t`` of a contact law; a Cartesian multiplier has none)
+    tangential: typing.ClassVar[bool] = False
+    #: The LBB treatment of the law's multiplier (``"none"`` without a multiplier)
+    lbb: str = "none"
+
+    @property
+    def transmits(self) -> str:
+        """What a closed interface of the law transmits between its sides (one of
+        :data:`TRANSMITS`): ``"full"`` by default, ``"normal"`` for contact without
+        friction, ``"none"`` for traction-free lips."""
+        return "full"
 
     def multiplier_components(self, gdim: int) -> int:
         """Number of components of the law's multiplier field (0: none)."""
         return 0
+
+    def multipliers(self, u: Fields) -> tuple:
+        """``(lambda_n, lambda_t or None)`` of the law's fields (UFL); by default the
+        multiplier as it is (a Cartesian vector, or None without one)."""
+        return u.multiplier, None
+
+    def traction_vector(self, ctx: InterfaceContext, u: Fields):
+        """The traction ``sigma n`` on side -1 the law's multiplier stands for, as a
+        Cartesian vector (UFL), or None without a multiplier; by default the
+        multiplier itself."""
+        return u.multiplier
+
+    def point_status(self, state: dict[str, np.ndarray], npoints: int) -> np.ndarray:
+        """Per rule point :data:`OPEN`, :data:`STICK` or :data:`SLIP` (int8,
+        ``(npoints,)``) from :meth:`state`; by default what :attr:`transmits` says of
+        a closed interface: open for ``"none"``, sticking otherwise."""
+        code = OPEN if self.transmits == "none" else STICK
+        return np.full(npoints, code, dtype=np.int8)
+
+    def options(self) -> dict:
+        """The law's constructor options and their current values, e.g. to build the
+        same law in another kinematics."""
+        return {name: getattr(self, name) for name in law_options(type(self))}
 
     def residual(self, ctx: InterfaceContext, u: Fields, v: Fields) -> ufl.Form | None:
         """The law's terms of the residual ``F(w; v)`` (UFL), or None.
@@ -207,3 +265,16 @@ class InterfaceLaw(abc.ABC):
     def describe(self) -> dict:
         """The law's name and options (for summaries)."""
         return {"law": self.name}
+
+
+def law_options(law: type[InterfaceLaw]) -> tuple[str, ...]:
+    """The options a law class takes (the named arguments of its constructors)."""
+    names: list[str] = []
+    for cls in law.__mro__:
+        init = vars(cls).get("__init__")
+        if init is None:
+            continue
+        for p in inspect.signature(init).parameters.values():
+            if p.name != "self" and p.kind is p.POSITIONAL_OR_KEYWORD and p.name not in names:
+                names.append(p.name)
+    return tuple(names)

@@ -23,6 +23,10 @@ class Free(InterfaceLaw):
     linear = True
     symmetric = True
 
+    @property
+    def transmits(self) -> str:
+        return "none"
+
 
 class Bonded(MultiplierLaw):
     """Displacement continuity by a vector multiplier (see the module docstring)."""

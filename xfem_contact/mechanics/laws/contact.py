@@ -32,6 +32,9 @@ import ufl
 from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws.base import (
     NUMPY_OPS,
+    OPEN,
+    SLIP,
+    STICK,
     UFL_OPS,
     Fields,
     InterfaceContext,
@@ -62,6 +65,13 @@ class ContactLaw(MultiplierLaw):
 
     def describe(self) -> dict:
         return super().describe() | {"augmentation": self.augmentation}
+
+    @property
+    def transmits(self) -> str:
+        """``"normal"`` without a friction bound above zero, else ``"full"``."""
+        if not self.tangential or self.friction_bound(-1.0, NUMPY_OPS) == 0.0:
+            return "normal"
+        return "full"
 
     def multiplier_components(self, gdim: int) -> int:
         return gdim if self.tangential else 1
@@ -169,14 +179,24 @@ class ContactLaw(MultiplierLaw):
             "trial_t": lam_t + r * slip_increment,
         }
 
-    def status(self, state: dict[str, np.ndarray]) -> dict[str, int]:
-        """Local counts of rule points in contact and, with friction, stick / slip."""
+    def point_status(self, state: dict[str, np.ndarray], npoints: int) -> np.ndarray:
+        """In contact where the applied pressure ``P_n < 0``; sticking where the trial
+        tangential traction lies within the friction bound (always for ``sticking``,
+        never without a tangential multiplier)."""
         contact = state["P_n"] < 0.0
-        counts = {"contact": int(contact.sum())}
-        if self.tangential:
+        if not self.tangential:
+            stick = np.zeros_like(contact)
+        else:
             bound = self.friction_bound(state["P_n"], NUMPY_OPS)
             stick = contact if bound is None else contact & (np.abs(state["trial_t"]) <= bound)
-            counts |= {"stick": int(stick.sum()), "slip": int((contact & ~stick).sum())}
+        return np.where(contact, np.where(stick, STICK, SLIP), OPEN).astype(np.int8)
+
+    def status(self, state: dict[str, np.ndarray]) -> dict[str, int]:
+        """Local counts of rule points in contact and, with friction, stick / slip."""
+        codes = self.point_status(state, state["P_n"].size)
+        counts = {"contact": int(np.sum(codes != OPEN))}
+        if self.tangential:
+            counts |= {"stick": int(np.sum(codes == STICK)), "slip": int(np.sum(codes == SLIP))}
         return counts
 
 
@@ -195,11 +215,13 @@ class Sticking(ContactLaw):
     symmetric = True
 
 
-class Coulomb(ContactLaw):
-    """Coulomb friction, incremental: ``|P_t| <= mu |P_n|`` on the slip of the step.
+class CoulombFriction:
+    """Coulomb's bound ``|P_t| <= mu |P_n|`` on the slip of the step, written once for
+    the small- and large-sliding laws (the first base of :class:`Coulomb` and
+    :class:`~xfem_contact.mechanics.laws.sliding.SlidingCoulomb`).
 
     Args:
-        friction: Coulomb coefficient ``mu`` (>= 0).
+        friction: Coulomb coefficient ``mu`` (>= 0); a Constant of the forms.
     """
 
     name = "coulomb"
@@ -219,3 +241,12 @@ class Coulomb(ContactLaw):
     def friction_bound(self, P_n, ops: Ops):
         mu = self.friction if ops is NUMPY_OPS else constant(self, "friction")
         return -mu * P_n
+
+
+class Coulomb(CoulombFriction, ContactLaw):
+    """Coulomb friction, incremental: ``|P_t| <= mu |P_n|`` on the slip of the step.
+
+    Args:
+        friction: Coulomb coefficient ``mu`` (>= 0).
+        augmentation, lbb, ...: See :class:`ContactLaw`.
+    """

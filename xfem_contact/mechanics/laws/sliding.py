@@ -22,12 +22,10 @@ from ufl.algorithms import extract_arguments, extract_coefficients
 
 from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw
-from xfem_contact.mechanics.laws.contact import ContactLaw, Coulomb, Frictionless
+from xfem_contact.mechanics.laws.contact import ContactLaw, CoulombFriction
 from xfem_contact.mechanics.parameters import constant
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES, SlidingCoupling
 
-#: The laws available in large sliding (by their small-sliding name)
-SLIDING_LAWS = ("frictionless", "coulomb")
 #: LBB treatments available in large sliding (the restriction needs a prolongation
 #: the hybrid element's assembly does not apply)
 SLIDING_LBB = ("stabilized", "none")
@@ -85,12 +83,11 @@ class SlidingContact(ContactLaw):
     def coupling(self, ctx: InterfaceContext) -> SlidingCoupling:
         """The interface's :class:`~xfem_contact.mechanics.sliding.coupling.SlidingCoupling`
         (made once per context; collective then)."""
-        if "coupling" not in ctx._cache:
-            W = ctx.w_old.function_space
-            ctx._cache["coupling"] = SlidingCoupling(
-                ctx, W, self, self.slave, self.radius, self.pairing
-            )
-        return ctx._cache["coupling"]
+        W = ctx.w_old.function_space
+        return ctx.once(
+            "coupling",
+            lambda: SlidingCoupling(ctx, W, self, self.slave, self.radius, self.pairing),
+        )
 
     # -- the UFL part: slave side only -------------------------------------------------
     def slave_traction(self, ctx: InterfaceContext, u: Fields) -> tuple:
@@ -158,7 +155,7 @@ class SlidingFrictionless(SlidingContact):
     tangential = False
 
 
-class SlidingCoulomb(SlidingContact):
+class SlidingCoulomb(CoulombFriction, SlidingContact):
     """Coulomb friction in large sliding, on the slip increment between accepted load
     steps measured along the master surface (:mod:`xfem_contact.mechanics.sliding.friction`;
     Jacobian by complex step).
@@ -168,48 +165,31 @@ class SlidingCoulomb(SlidingContact):
         slave, pairing, radius, ...: See :class:`SlidingContact`.
     """
 
-    name = "coulomb"
-    incremental = True
 
-    friction = Coulomb.friction
-
-    def __init__(self, friction: float | None = None, **options):
-        if friction is None:
-            raise ValueError("The 'coulomb' law needs a friction coefficient (friction=...)")
-        super().__init__(**options)
-        self.friction = friction
-
-    def describe(self) -> dict:
-        return super().describe() | {"friction": self.friction}
-
-    friction_bound = Coulomb.friction_bound
+#: The large-sliding version of each law that has one, by its name
+SLIDING_VERSIONS: dict[str, type[SlidingContact]] = {
+    law.name: law for law in (SlidingFrictionless, SlidingCoulomb)
+}
+#: The laws available in large sliding (by their small-sliding name)
+SLIDING_LAWS = tuple(SLIDING_VERSIONS)
 
 
 def large_sliding(
     law: InterfaceLaw, slave: int = DEFAULT.slave, pairing: str = DEFAULT.pairing
 ) -> InterfaceLaw:
-    """The large-sliding version of a law: contact laws become their hybrid-element
-    counterparts; ``free`` and ``bonded`` (no relative motion or none resisted) stay.
+    """The large-sliding version of a law, with the same options: contact laws become
+    their hybrid-element counterparts; ``free`` and ``bonded`` (no relative motion or
+    none resisted) stay.
 
     Raises:
         ValueError: for a contact law without a large-sliding version, naming the
             valid ones, or an LBB treatment large sliding does not offer.
     """
-    if getattr(law, "sliding", False) or law.linear:
+    if law.sliding or law.linear:
         return law
-    if type(law) not in (Frictionless, Coulomb):
+    if law.name not in SLIDING_VERSIONS:
         raise ValueError(
             f"The {law.name!r} law is not available in large sliding "
             f"(kinematics = 'large'); valid: {SLIDING_LAWS}"
         )
-    options = {
-        "slave": slave,
-        "pairing": pairing,
-        "augmentation": law.augmentation,
-        "lbb": law.lbb,
-        "multiplier_extension": law.multiplier_extension,
-        "multiplier_stabilization": law.multiplier_stabilization,
-    }
-    if isinstance(law, Coulomb):
-        return SlidingCoulomb(law.friction, **options)
-    return SlidingFrictionless(**options)
+    return SLIDING_VERSIONS[law.name](**law.options(), slave=slave, pairing=pairing)

@@ -140,7 +140,7 @@ class SlidingCoupling:
     @property
     def segments(self) -> bool:
         """Whether the Newton system gets segment-to-segment integration (the law's)."""
-        return bool(getattr(self.law, "segments", False))
+        return self.law.segments
 
     @property
     def friction(self) -> float | None:
