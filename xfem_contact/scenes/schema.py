@@ -215,6 +215,14 @@ FIELDS = {
             f"{[list(r) for r in CRACK_RINGS]} tip cell sizes, r_sup kept off the boundary)",
         ),
         "material": Field(Text(), "material of the cracked body (default: the first)"),
+        "reference_K": Field(
+            Vector(2, Number()),
+            "[K_I, K_II] (Pa m^1/2) to compare every tip's K with (printed beside it, with "
+            "the difference)",
+        ),
+        "reference_source": Field(
+            Text(), "where reference_K comes from and what it includes (e.g. the plate's size)"
+        ),
     },
     "material": {
         "E": Field(_POSITIVE, "Young's modulus (Pa) > 0", required=True),
