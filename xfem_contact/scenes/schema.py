@@ -132,7 +132,10 @@ FIELDS = {
         "radii": Field(
             Vector(2, _POSITIVE), "[r_inner, r_outer] (m, annulus centred at the origin)"
         ),
-        "cells": Field(Vector(2, Number(1, integer=True)), "[nx, ny] or [n_radial, n_angular]"),
+        "cells": Field(
+            Vector(2, Number(1, integer=True)),
+            "cells along x and y (rectangle) or [n_radial, n_angular] (annulus)",
+        ),
         "cell": Field(Choice(CELLS), f"one of {CELLS}"),
         "geometry_degree": Field(
             _DEGREE, "1 (straight cells) or 2 (curved cells: annulus, gmsh .geo)"
@@ -258,9 +261,14 @@ FIELDS = {
     "load": {
         "part": Field(Text(), "a boundary part name"),
         "type": Field(Choice(LOAD_TYPES), f"one of {LOAD_TYPES}", required=True),
-        "value": Field(lambda value, key: value, "number, [vx, vy], or expression(s) of x, y"),
+        "value": Field(
+            lambda value, key: value,
+            "number, [vx, vy], or expression(s) of x, y (m): Pa for a pressure (positive "
+            "pushes) or traction, N/m^3 for a body force, m for a displacement, rad for a "
+            "rotation (or angle_deg), Pa/m for a tangential_support's stiffness",
+        ),
         "side": Field(Choice((-1, 1)), "-1 or +1 (default both)"),
-        "component": Field(Choice((0, 1)), "0 or 1 (displacement)"),
+        "component": Field(Choice((0, 1)), "0 (x) or 1 (y): the one prescribed (displacement)"),
         "point": Field(_POINT, "[x, y] (m), the node held (point_displacement)"),
         "centre": Field(_POINT, "[x, y] (m), centre of a rotation (default [0, 0])"),
         "angle_deg": Field(Number(), "rotation angle in degrees (instead of value, in rad)"),
