@@ -200,6 +200,35 @@ def test_pvd_series_opens_every_step(coulomb_run):
         assert not np.allclose(steps[0].point_data[key], steps[1].point_data[key])
 
 
+@pytest.mark.parametrize("cell, per_square", [("quadrilateral", 1), ("triangle", 2)])
+def test_plain_scene_series_holds_the_mesh_nodes(tmp_path, cell, per_square):
+    """A plain (uncut) scene: result.pvd has a P2 / Q2 grid per step (quadratic cells at
+    the nodes of u's space), the linear response scales with the load factor, the last step
+    is result.vtu, the pictures are drawn; no interface series."""
+    data = plate(None, cells=4)
+    data["mesh"]["cell"] = cell
+    data["solver"] = {"load_steps": 2}
+    summary = run(load_scene(data), tmp_path, log=None, progress_bar=False)
+    assert [r["forces"]["balance_relative"] < BALANCE for r in summary["steps"]] == [True] * 2
+    reader = pyvista.get_reader(tmp_path / "result.pvd")
+    assert reader.time_values == [0.5, 1.0]
+    steps = []
+    for t in reader.time_values:
+        reader.set_active_time_value(t)
+        steps.append(reader.read()[0])
+    assert steps[0].n_points == (2 * 4 + 1) ** 2 and steps[0].n_cells == 4 * 4 * per_square
+    # quadratic cells with their nodes in VTK's order: each the area of its mesh cell
+    areas = steps[1].compute_cell_sizes()["Area"]
+    np.testing.assert_allclose(areas, 1 / 16 / per_square, rtol=1e-12)
+    assert {"u", "stress", "von_mises"} <= set(steps[1].point_data.keys())
+    u = [np.asarray(step.point_data["u"]) for step in steps]
+    np.testing.assert_allclose(u[0], 0.5 * u[1], rtol=0, atol=1e-12 * np.abs(u[1]).max())
+    final = pyvista.read(tmp_path / "result.vtu")
+    np.testing.assert_array_equal(final.point_data["u"], u[1])
+    assert not (tmp_path / "interface.pvd").exists()
+    assert (tmp_path / "result.png").exists()
+
+
 def _lips_by_position(grid) -> np.ndarray:
     """Rows ``(side, x, y, ux, uy)`` of a lips grid, one per distinct (side, point),
     sorted: comparable between runs that number and split the points differently."""

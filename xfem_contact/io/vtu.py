@@ -38,6 +38,7 @@ from xfem_contact.fem.evaluation import cell_dofs, evaluate_lattice, evaluate_re
 
 #: VTK cell types (``vtkCellType.h``)
 QUADRATIC_EDGE, QUADRATIC_TRIANGLE, BIQUADRATIC_QUAD = 21, 22, 28
+LAGRANGE_TRIANGLE, LAGRANGE_QUADRILATERAL = 69, 70
 _NODES = {QUADRATIC_EDGE: 3, QUADRATIC_TRIANGLE: 6, BIQUADRATIC_QUAD: 9}
 
 # Reference nodes of the uncut cells' quadratic lattice, in VTK node order
@@ -240,10 +241,10 @@ def interface_arrays(cut: CutMesh) -> GridArrays:
 
 
 def plain_arrays(u, fields: dict | None = None) -> GridArrays:
-    """The mesh at the nodes of ``u``'s Lagrange space (VTK Lagrange cells of its
-    degree) with point data ``u`` (m, padded to 3 components) and ``fields`` (name to
-    Function, e.g. a discontinuous stress, interpolated into ``u``'s degree). This
-    process's cells."""
+    """The mesh at the nodes of ``u``'s Lagrange space (linear cells for degree 1,
+    quadratic ones for 2, VTK Lagrange cells above) with point data ``u`` (m, padded to
+    3 components) and ``fields`` (name to Function, e.g. a discontinuous stress,
+    interpolated into ``u``'s degree). This process's cells."""
     import dolfinx.fem
     import dolfinx.plot
 
@@ -257,10 +258,14 @@ def plain_arrays(u, fields: dict | None = None) -> GridArrays:
         nodal = dolfinx.fem.Function(dolfinx.fem.functionspace(V.mesh, ("Lagrange", degree, shape)))
         nodal.interpolate(f)
         point_data[name] = nodal.x.array.reshape(x.shape[0], -1)
+    types = np.asarray(cell_types, dtype=np.uint8)
+    if degree == 2:  # VTK's Lagrange cells of order 2 are its quadratic cells, same order
+        types = np.where(types == LAGRANGE_TRIANGLE, QUADRATIC_TRIANGLE, types)
+        types = np.where(types == LAGRANGE_QUADRILATERAL, BIQUADRATIC_QUAD, types)
     return GridArrays(
         np.asarray(x, dtype=np.float64),
         np.asarray(topology, dtype=np.int64),
-        np.asarray(cell_types, dtype=np.uint8),
+        types.astype(np.uint8),
         {},
         point_data,
     )
