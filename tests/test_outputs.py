@@ -176,6 +176,12 @@ def test_summary_has_a_balanced_record_per_load_step(coulomb_run):
     bottom = [np.array(r["forces"]["reactions"]["bottom"]) for r in steps]
     assert not np.allclose(bottom[0], bottom[1])
     assert summary["forces"] == steps[-1]["forces"]
+    # the interface's points open / sticking / sliding per step; the last step's are the
+    # samples' of the summary
+    (name,) = summary["interfaces"]
+    codes = np.bincount(summary["interfaces"][name]["samples"]["status"], minlength=3)
+    assert list(steps[-1]["interfaces"][name].values()) == codes.tolist()
+    assert [sum(r["interfaces"][name].values()) for r in steps] == [codes.sum()] * 2
 
 
 def test_pvd_series_opens_every_step(coulomb_run):

@@ -9,6 +9,7 @@ from collections.abc import Callable
 
 import dolfinx.io
 import dolfinx.mesh
+import numpy as np
 from mpi4py import MPI
 
 from xfem_contact._version import versions
@@ -119,9 +120,11 @@ def run(
     Returns:
         The summary: effects built, fields, dof counts, iterations per step, the
         contact status, timings (s); ``steps``, a record per load step (``step``,
-        ``time``, ``iterations``, ``status``, ``forces``: the reactions, loads and
-        balance (N/m) of :func:`~xfem_contact.mechanics.reactions.balance`, and with
-        cracks ``cracks``: K_I, K_II, J, G per tip and ring of each crack); with a crack
+        ``time``, ``iterations``, ``status`` (the solver's), ``forces``: the reactions,
+        loads and balance (N/m) of :func:`~xfem_contact.mechanics.reactions.balance`,
+        ``interfaces``: the rule points open, sticking and sliding per interface
+        (:func:`status_counts`), and with cracks ``cracks``: K_I, K_II, J, G per tip and
+        ring of each crack); with a crack
         its lips and K at the last step (``cracks``, see
         :class:`~xfem_contact.scenes.crack_outputs.CrackOutputs`).
     """
@@ -181,6 +184,8 @@ def run(
             forces_start = time.perf_counter()  # reactions, interface resultants (N/m)
             record["forces"] = balance(problem)
             forces_time += time.perf_counter() - forces_start
+            if problem.laws:
+                record["interfaces"] = status_counts(problem)
             if cracks is not None:
                 tips = cracks.tips()
                 record["cracks"] = cracks.per_crack(tips)
@@ -277,6 +282,17 @@ def _open_series(out: str | pathlib.Path, result: Result) -> list:
         dolfinx.io.VTXWriter(comm, out / f"{name}.bp", fields, engine="BP4")
         for name, fields in groups
     ]
+
+
+def status_counts(problem) -> dict[str, dict[str, int]]:
+    """Per interface (and crack) the number of its rule points open, sticking and
+    sliding (:func:`~xfem_contact.io.interface_data.sample_status`, all processes).
+    Collective."""
+    counts = {}
+    for name in problem.laws:
+        codes = np.bincount(sample_status(problem, name), minlength=3)
+        counts[name] = dict(zip(("open", "stick", "slip"), codes.tolist(), strict=True))
+    return counts
 
 
 class StepGrids:
