@@ -3,8 +3,9 @@
 The pages are markdown (MyST); the API reference comes from the docstrings
 (autodoc + napoleon, Google style); the scene file reference, the solver options
 table, the demo pages and the benchmark pages (from ``bench/results/``) are generated
-at every build (:mod:`reference`), so they cannot drift from what the package accepts
-and measures.
+(:mod:`reference`) into ``docs/generated/``, kept in the repository so that links resolve
+in a checkout too; every build rewrites them, so they cannot drift from what the
+package accepts and measures.
 """
 
 import pathlib
@@ -42,4 +43,4 @@ napoleon_use_ivar = True  # attributes as fields: no second description of tuple
 
 
 def setup(app):
-    reference.write(HERE / "generated")
+    reference.write(reference.FOLDER)

@@ -8,14 +8,20 @@ bench script's docstring and its pictures).
 Defaults of scene keys are read from the loader's source (``table.get("key", default)``
 calls), not typed twice. A built-in part or an expression function without a line in
 :data:`PART_MEANINGS` / :data:`FUNCTION_MEANINGS` fails the build.
+
+The pages live in ``docs/generated/`` in the repository, so that the pages' links
+resolve in a checkout too; ``python docs/reference.py`` rewrites them (the documentation
+build does as well) and ``--check`` exits 1 if one is stale (``tests/test_docs.py``).
 """
 
 from __future__ import annotations
 
+import argparse
 import ast
 import inspect
 import pathlib
 import re
+import sys
 
 #: What each built-in boundary part of :data:`xfem_contact.scenes.schema.BUILTIN_PARTS`
 #: selects (``[mesh] corners = [[x0, y0], [x1, y1]]``, ``radii = [r0, r1]``)
@@ -109,7 +115,7 @@ def scene_reference() -> str:
     lines = [
         "# Scene file reference",
         "",
-        "Generated from `xfem_contact.scenes.schema.FIELDS` at every documentation build.",
+        "Generated from `xfem_contact.scenes.schema.FIELDS` by `python docs/reference.py`.",
         f"Top-level tables: {', '.join(f'`[{t}]`' for t in TOP_LEVEL)}. A key not listed",
         "here is an error naming the valid keys; a bad value is an error naming the key and",
         "the valid choices (one line, exit status 2 from the command line).",
@@ -210,22 +216,47 @@ def solver_options() -> str:
     return "\n".join(lines) + "\n"
 
 
-def write(folder: pathlib.Path) -> None:
-    """Write the generated pages into ``folder`` (created)."""
-    folder.mkdir(parents=True, exist_ok=True)
-    pages = {"scene_reference.md": scene_reference(), "solver_options.md": solver_options()}
-    root = folder.parent.parent
+#: Where the generated pages live: in the repository, so that links between pages
+#: resolve in a checkout as on the site (``python docs/reference.py`` rewrites them)
+FOLDER = pathlib.Path(__file__).resolve().parent / "generated"
+
+
+def pages(root: pathlib.Path) -> dict[str, str]:
+    """The generated pages of the checkout at ``root``: file name to markdown text."""
+    found = {"scene_reference.md": scene_reference(), "solver_options.md": solver_options()}
     for demo in sorted((root / "demos").glob("*.py")):
-        pages[f"demo_{demo.stem}.md"] = demo_page(demo)
+        found[f"demo_{demo.stem}.md"] = demo_page(demo)
     for result in sorted((root / "bench" / "results").glob("*.md")):
-        pages[f"bench_{result.stem}.md"] = bench_page(result)
-    for name, text in pages.items():
+        found[f"bench_{result.stem}.md"] = bench_page(result)
+    return found
+
+
+def stale_pages(folder: pathlib.Path = FOLDER) -> list[str]:
+    """The file names in ``folder`` that :func:`write` would change, add or delete."""
+    wanted = pages(folder.parent.parent)
+    stale = [
+        name
+        for name, text in wanted.items()
+        if not (folder / name).exists() or (folder / name).read_text() != text
+    ]
+    return stale + sorted(p.name for p in folder.glob("*.md") if p.name not in wanted)
+
+
+def write(folder: pathlib.Path = FOLDER) -> list[str]:
+    """Write the generated pages into ``folder`` (created); the names written or deleted."""
+    folder.mkdir(parents=True, exist_ok=True)
+    wanted = pages(folder.parent.parent)
+    changed = []
+    for name, text in wanted.items():
         path = folder / name
         if not path.exists() or path.read_text() != text:  # keep Sphinx's cache valid
             path.write_text(text)
+            changed.append(name)
     for stale in folder.glob("*.md"):  # pages whose source is gone (a renamed result)
-        if stale.name not in pages:
+        if stale.name not in wanted:
             stale.unlink()
+            changed.append(stale.name)
+    return changed
 
 
 def demo_page(path: pathlib.Path) -> str:
@@ -329,7 +360,7 @@ def bench_page(result: pathlib.Path) -> str:
     lines += [
         f"Made by `python bench/{script.name}` (`make bench` runs every bench); the",
         f"numbers are in `bench/results/{result.stem}.json`. Generated from",
-        f"`bench/results/{result.name}` at every documentation build.",
+        f"`bench/results/{result.name}` by `python docs/reference.py`.",
         "",
         "```{include} ../../bench/results/" + result.name,
         "```",
@@ -338,3 +369,28 @@ def bench_page(result: pathlib.Path) -> str:
     for picture in sorted(result.parent.glob(f"{result.stem}*.png")):
         lines += [f"![{picture.stem}](../../bench/results/{picture.name})", ""]
     return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description="Write the generated documentation pages.")
+    parser.add_argument(
+        "--check", action="store_true", help="write nothing; exit 1 if a page is stale"
+    )
+    args = parser.parse_args(argv)
+    if args.check:
+        stale = stale_pages()
+        if stale:
+            print(
+                f"stale generated pages in docs/generated: {', '.join(stale)}: run "
+                "`python docs/reference.py`",
+                file=sys.stderr,
+            )
+            return 1
+        return 0
+    for name in write():
+        print(f"wrote docs/generated/{name}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

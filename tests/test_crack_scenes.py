@@ -105,6 +105,12 @@ BAD_CRACKS = {
     "ring": ({"rings": [[0.2, 0.1]]}, "cracks[0].rings[0]: r_inf must be < r_sup"),
     "tip radius": ({"tip_radius": -1.0}, "cracks[0].tip_radius: must be > 0.0"),
     "material": ({"material": "glass"}, "cracks[0].material: 'glass': no such material"),
+    "reference": ({"reference_K": [1e6]}, "cracks[0].reference_K: expected a list of 2 entries"),
+    "reference value": ({"reference_K": [1e6, "x"]}, "cracks[0].reference_K[1]: expected a"),
+    "source alone": (
+        {"reference_source": "Tada"},
+        "cracks[0].reference_source: a source needs reference_K = [K_I, K_II]",
+    ),
     "expression": (
         {"shape": "expression", "phi": "y - 1"},
         "cracks[0].psi: required for shape 'expression' (its parameters: phi, psi)",
@@ -259,23 +265,64 @@ def test_bundled_crack_scenes_load():
         assert scene.cracks and scene.cracks[0].law == "free" and scene.degree == 2
 
 
+#: Tada's K_I of the edge crack of :func:`edge_crack` (a / W = 0.41, a long strip), Pa m^1/2
+TADA = 2.452e6
+
+
 @pytest.mark.mpi
-def test_edge_crack_run_writes_K_lips_and_opened_fields(tmp_path_factory):
+def test_edge_crack_run_writes_K_lips_and_opened_fields(tmp_path_factory, capsys):
     """The outputs of a crack scene (1 or 2 ranks): K_I, K_II, J, G per tip and ring in
-    summary.json (K_I near the handbook's 2.45 MPa m^1/2 on this coarse mesh), the
-    lips opening to the tip, lips.png and the lips' grid with the opened displacement."""
+    summary.json (K_I near the handbook's 2.45 MPa m^1/2 on this coarse mesh) and printed
+    as a table (units, rings by their radii, the reference and the difference, the law
+    and the loads), the lips opening to the tip, lips.png and the lips' grid with the
+    opened displacement."""
     out = MPI.COMM_WORLD.bcast(
         str(tmp_path_factory.mktemp("crack")) if MPI.COMM_WORLD.rank == 0 else None, root=0
     )
     path = pathlib.Path(out) / "scene.toml"
+    source = "Tada, a long strip"
     if MPI.COMM_WORLD.rank == 0:
-        path.write_text(to_toml(edge_crack()))
+        data = edge_crack(reference_K=[TADA, 0.0], reference_source=source)
+        data["solver"] = {"load_steps": 2}
+        path.write_text(to_toml(data))
     MPI.COMM_WORLD.barrier()
-    assert cli.main(["run", str(path), "--out", out, "--quiet"]) == 0
+    capsys.readouterr()
+    assert cli.main(["run", str(path), "--out", out, "--no-progress"]) == 0
+    printed = capsys.readouterr().out.splitlines()
     MPI.COMM_WORLD.barrier()
     summary = json.loads((pathlib.Path(out) / "summary.json").read_text())
     crack = summary["cracks"]["crack"]
+    assert crack["reference"] == {"K_I": TADA, "K_II": 0.0, "source": source}
+    assert crack["law"] == {"law": "free"}
     (tip,) = crack["tips"]
+    # K at every load step: the problem is linear, the first step's is half the last's
+    steps = summary["steps"]
+    assert [r["time"] for r in steps] == [0.5, 1.0] and steps[-1]["cracks"]["crack"] == [tip]
+    (half,) = steps[0]["cracks"]["crack"]
+    for r_half, r in zip(half["rings"], tip["rings"], strict=True):
+        assert r_half["K_I"] == pytest.approx(0.5 * r["K_I"], rel=1e-9)
+        assert r_half["J"] == pytest.approx(0.25 * r["J"], rel=1e-9)
+    for record in steps:
+        assert record["forces"]["balance_relative"] < 1e-8
+    if MPI.COMM_WORLD.rank == 0:
+        start = printed.index("crack 'crack': law of the lips free")
+        table = printed[start:]
+        loads = "traction on 'top' (0, 1e+06) Pa, traction on 'bottom' (0, -1e+06) Pa"
+        assert table[1] == f"  loads: {loads}"
+        assert table[2].startswith("  K in MPa m^1/2, J and G in J/m^2")
+        for r, row in zip(tip["rings"], table[4:], strict=False):
+            assert row.split() == [
+                "0",
+                f"{r['r_inf']:.4g}..{r['r_sup']:.4g}",
+                f"{r['K_I'] / 1e6:.4f}",
+                f"{r['K_II'] / 1e6:.4f}",
+                f"{r['J']:.4g}",
+                f"{r['G']:.4g}",
+                f"{100 * (r['K_I'] / TADA - 1):+.2f}%",
+                f"{100 * r['K_II'] / TADA:+.2f}%",
+            ]
+        assert table[4 + len(tip["rings"])].split()[:4] == ["0", "reference", "2.4520", "0.0000"]
+        assert any(line.startswith(f"  reference: {source}") for line in table)
     assert np.allclose(tip["position"], [0.41, 1.013]) and np.allclose(tip["direction"], [1, 0])
     assert len(tip["rings"]) >= 1  # those of the default rings that fit
     for ring in tip["rings"]:
@@ -291,4 +338,5 @@ def test_edge_crack_run_writes_K_lips_and_opened_fields(tmp_path_factory):
     if MPI.COMM_WORLD.rank == 0:
         names = {p.name for p in pathlib.Path(out).iterdir()}
         assert {"lips.png", "result.png", "displacement.bp", "summary.json"} <= names
+        assert {"result.pvd", "interface.pvd", "result_steps"} <= names
         assert any(n.startswith("result") and n.endswith(".vtu") for n in names)

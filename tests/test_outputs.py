@@ -4,6 +4,8 @@ pictures coloured from exact zero."""
 import xfem_contact  # noqa: F401
 
 # isort: split
+import pathlib
+
 import dolfinx.fem
 import dolfinx.mesh
 import numpy as np
@@ -186,6 +188,128 @@ def test_interface_vtu_carries_the_laws_state(coulomb_run):
     # closed where in contact (up to the weak enforcement between the rule points)
     u = np.abs(pyvista.read(out / "result.vtu").point_data["u"]).max()
     assert np.all(np.abs(data["gap"][status > 0]) < 1e-2 * u)
+
+
+def test_summary_has_a_balanced_record_per_load_step(coulomb_run):
+    """One record per load step (pseudo-times 0.5, 1): the loads follow the factor t, the
+    reactions balance them at every step, the last record's forces are the summary's."""
+    _, summary = coulomb_run
+    steps = summary["steps"]
+    assert [(r["step"], r["time"]) for r in steps] == [(1, 0.5), (2, 1.0)]
+    assert [r["iterations"] for r in steps] == summary["iterations_per_step"]
+    for record in steps:
+        assert record["forces"]["balance_relative"] < BALANCE, record["forces"]
+        assert {"open", "stick", "slip"} & set(record["status"]), record["status"]
+    half, full = (np.array(r["forces"]["applied_loads"]) for r in steps)
+    assert np.abs(full).max() > 1e4 and np.allclose(half, 0.5 * full, rtol=1e-12, atol=0)
+    bottom = [np.array(r["forces"]["reactions"]["bottom"]) for r in steps]
+    assert not np.allclose(bottom[0], bottom[1])
+    assert summary["forces"] == steps[-1]["forces"]
+    # the interface's points open / sticking / sliding per step; the last step's are the
+    # samples' of the summary
+    (name,) = summary["interfaces"]
+    codes = np.bincount(summary["interfaces"][name]["samples"]["status"], minlength=3)
+    assert list(steps[-1]["interfaces"][name].values()) == codes.tolist()
+    assert [sum(r["interfaces"][name].values()) for r in steps] == [codes.sum()] * 2
+
+
+def test_pvd_series_opens_every_step(coulomb_run):
+    """result.pvd and interface.pvd: pyvista (ParaView's reader) opens them, one data set
+    per load step at its pseudo-time, each with the arrays and size of the final grids."""
+    out, _ = coulomb_run
+    final = {name: pyvista.read(out / f"{name}.vtu") for name in ("result", "interface")}
+    arrays = {"result": {"u", "stress", "von_mises"}, "interface": {"lambda_n", "status"}}
+    for name, grid in final.items():
+        reader = pyvista.get_reader(out / f"{name}.pvd")
+        assert reader.time_values == [0.5, 1.0]
+        steps = []
+        for t in reader.time_values:
+            reader.set_active_time_value(t)
+            (step,) = reader.read()
+            assert step.n_points == grid.n_points and step.n_cells == grid.n_cells
+            assert arrays[name] <= set(step.point_data.keys())
+            assert set(step.cell_data.keys()) == set(grid.cell_data.keys())
+            steps.append(step)
+        key = "u" if name == "result" else "lambda_n"
+        np.testing.assert_array_equal(steps[-1].point_data[key], grid.point_data[key])
+        assert not np.allclose(steps[0].point_data[key], steps[1].point_data[key])
+
+
+@pytest.mark.parametrize("cell, per_square", [("quadrilateral", 1), ("triangle", 2)])
+def test_plain_scene_series_holds_the_mesh_nodes(tmp_path, cell, per_square):
+    """A plain (uncut) scene: result.pvd has a P2 / Q2 grid per step (quadratic cells at
+    the nodes of u's space), the linear response scales with the load factor, the last step
+    is result.vtu, the pictures are drawn; no interface series."""
+    data = plate(None, cells=4)
+    data["mesh"]["cell"] = cell
+    data["solver"] = {"load_steps": 2}
+    summary = run(load_scene(data), tmp_path, log=None, progress_bar=False)
+    assert [r["forces"]["balance_relative"] < BALANCE for r in summary["steps"]] == [True] * 2
+    reader = pyvista.get_reader(tmp_path / "result.pvd")
+    assert reader.time_values == [0.5, 1.0]
+    steps = []
+    for t in reader.time_values:
+        reader.set_active_time_value(t)
+        steps.append(reader.read()[0])
+    assert steps[0].n_points == (2 * 4 + 1) ** 2 and steps[0].n_cells == 4 * 4 * per_square
+    # quadratic cells with their nodes in VTK's order: each the area of its mesh cell
+    areas = steps[1].compute_cell_sizes()["Area"]
+    np.testing.assert_allclose(areas, 1 / 16 / per_square, rtol=1e-12)
+    assert {"u", "stress", "von_mises"} <= set(steps[1].point_data.keys())
+    u = [np.asarray(step.point_data["u"]) for step in steps]
+    np.testing.assert_allclose(u[0], 0.5 * u[1], rtol=0, atol=1e-12 * np.abs(u[1]).max())
+    final = pyvista.read(tmp_path / "result.vtu")
+    np.testing.assert_array_equal(final.point_data["u"], u[1])
+    assert not (tmp_path / "interface.pvd").exists()
+    assert (tmp_path / "result.png").exists()
+
+
+def _lips_by_position(grid) -> np.ndarray:
+    """Rows ``(side, x, y, ux, uy)`` of a lips grid, one per distinct (side, point),
+    sorted: comparable between runs that number and split the points differently."""
+    side = np.zeros(grid.n_points)
+    side[grid.cell_connectivity] = np.repeat(
+        np.asarray(grid.cell_data["side"]), np.diff(grid.cell_offsets)
+    )
+    rows = np.c_[side, grid.points[:, :2], np.asarray(grid.point_data["u"])[:, :2]]
+    _, first = np.unique(np.round(rows[:, :3], 9), axis=0, return_index=True)
+    return rows[first]
+
+
+@pytest.mark.mpi
+def test_parallel_series_has_pvtu_pieces_and_equals_serial(tmp_path_factory):
+    """Under MPI each step is a .pvtu of the ranks' pieces; read through the .pvd, every
+    step equals a serial run's (same points per side, displacements to 1e-9)."""
+    comm = MPI.COMM_WORLD
+    folder = tmp_path_factory.mktemp("series") if comm.rank == 0 else None
+    folder = pathlib.Path(comm.bcast(str(folder), root=0))
+    data = plate("coulomb", cells=8, friction=0.3)
+    data["solver"] = {"load_steps": 2}
+    summary = run(load_scene(data), folder / "parallel", log=None, progress_bar=False)
+    assert len(summary["steps"]) == 2
+    if comm.rank == 0:
+        run(load_scene(data), folder / "serial", log=None, progress_bar=False, comm=MPI.COMM_SELF)
+    comm.barrier()
+    steps = folder / "parallel" / "result_steps"
+    if comm.size > 1:
+        assert (steps / "result_000002.pvtu").exists()
+        assert (steps / f"result_000002_r{comm.rank}.vtu").exists()
+        assert (folder / "parallel" / "result.pvtu").exists()
+    if comm.rank == 0:
+        readers = [
+            pyvista.get_reader(folder / run_ / "result.pvd") for run_ in ("serial", "parallel")
+        ]
+        assert readers[0].time_values == readers[1].time_values == [0.5, 1.0]
+        for t in readers[0].time_values:
+            rows = []
+            for reader in readers:
+                reader.set_active_time_value(t)
+                (grid,) = reader.read()
+                rows.append(_lips_by_position(grid.cast_to_unstructured_grid()))
+            assert rows[0].shape == rows[1].shape
+            np.testing.assert_allclose(rows[1][:, :3], rows[0][:, :3], atol=1e-12)
+            scale = np.abs(rows[0][:, 3:]).max()
+            np.testing.assert_allclose(rows[1][:, 3:], rows[0][:, 3:], atol=1e-9 * scale)
 
 
 def test_show_draws_von_mises_and_the_traction(coulomb_run):

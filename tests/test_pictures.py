@@ -163,6 +163,12 @@ def test_lips_grid_carries_each_sides_field(tmp_path_factory, cell):
         ]
     import pyvista
 
+    if MPI.COMM_WORLD.size > 1:  # the pieces of every process, as ParaView opens them
+        whole = pyvista.read(folder / "lips.pvtu")
+        assert whole.n_cells == MPI.COMM_WORLD.allreduce(grid.n_cells)
+        assert set(whole.point_data.keys()) == {"u"}
+        assert set(whole.cell_data.keys()) == {"side", "cut", "cell"}
+
     back = pyvista.read(path)  # written by VTK directly: the same grid as pyvista's
     assert np.array_equal(back.points, grid.points)
     assert np.array_equal(back.cells, grid.cells)

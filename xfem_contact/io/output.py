@@ -7,6 +7,11 @@
   of its own side: the lips of the interface appear separate and discontinuous.
 - :func:`write_cut_geometry`: the cut itself (sub-triangles and interface pieces)
   as ``.vtu`` files, for ``xfem-contact show`` and ParaView.
+
+In parallel every ``.vtu`` is written in pieces, one per process (``NAME_r{rank}.vtu``),
+and rank 0 writes ``NAME.pvtu``, the file ParaView opens
+(:func:`~xfem_contact.io.series.write_grid`); time series of such grids are
+:class:`~xfem_contact.io.series.StepSeries`.
 - :func:`write_json`: a JSON summary (numpy values converted), written atomically.
 """
 
@@ -16,12 +21,12 @@ import json
 import os
 import pathlib
 
-import dolfinx.fem
 import dolfinx.io
 import numpy as np
 
 from xfem_contact.fem.cutmesh import CutMesh
-from xfem_contact.io.vtu import interface_arrays, lips_arrays, subcell_arrays, write_vtu
+from xfem_contact.io.series import write_grid
+from xfem_contact.io.vtu import interface_arrays, lips_arrays, plain_arrays, subcell_arrays
 
 #: Compression of the ``.vtu`` files: LZ4 (ParaView >= 5.6 reads it) wrote the
 #: 160 x 160 case-2 lips grid in 0.03 s against zlib's 0.13 s (and 0.11 s raw)
@@ -51,54 +56,30 @@ def write_sides(directory: str | pathlib.Path, cut: CutMesh) -> pathlib.Path:
     return path
 
 
-def _rank_path(path: pathlib.Path, comm) -> pathlib.Path:
-    """``path`` with suffix ``_r{rank}`` before the extension when run in parallel."""
-    if comm.size > 1:
-        path = path.with_name(f"{path.stem}_r{comm.rank}{path.suffix}")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return path
-
-
 def write_lips(
     path: str | pathlib.Path, cut: CutMesh, u_minus, u_plus, fields: dict | None = None
 ) -> pathlib.Path:
     """Write a ``.vtu`` grid of uncut cells and sub-triangles with each side's displacement.
 
     The grid is :func:`xfem_contact.io.pictures.deformed_lips_grid` (quadratic cells,
-    point data ``u`` in m, cell data ``side``, ``cut``, ``cell``). Local to each
-    process: rank ``r`` writes ``path`` with suffix ``_r{r}`` when run in parallel.
-    ``u_minus``, ``u_plus``: displacement Functions of sides -1 and +1; ``fields``:
-    more point data, name to ``{-1: Function, 1: Function}`` ((discontinuous)
-    Lagrange, e.g. ``stress`` and ``von_mises`` of
-    :class:`~xfem_contact.mechanics.stress.StressFields`).
+    point data ``u`` in m, cell data ``side``, ``cut``, ``cell``). Collective: in
+    parallel rank ``r`` writes its cells to ``path`` with suffix ``_r{r}`` and rank 0
+    the ``.pvtu`` of the pieces. ``u_minus``, ``u_plus``: displacement Functions of sides
+    -1 and +1; ``fields``: more point data, name to ``{-1: Function, 1: Function}``
+    ((discontinuous) Lagrange, e.g. ``stress`` and ``von_mises`` of
+    :class:`~xfem_contact.mechanics.stress.StressFields`). Returns this process's file.
     """
-    path = _rank_path(pathlib.Path(path), cut.mesh.comm)
-    write_vtu(path, lips_arrays(cut, u_minus, u_plus, fields), VTU_COMPRESSION)
-    return path
+    arrays = lips_arrays(cut, u_minus, u_plus, fields)
+    return write_grid(path, arrays, cut.mesh.comm, VTU_COMPRESSION)
 
 
 def write_plain(path: str | pathlib.Path, u, fields: dict | None = None) -> pathlib.Path:
     """Write a ``.vtu`` grid of the mesh at the nodes of ``u``'s Lagrange space with point
     data ``u`` (m) and ``fields`` (name to Function, e.g. a discontinuous stress, taken
-    at the nodes by interpolation into ``u``'s degree). Local to each process (suffix
-    ``_r{rank}`` in parallel)."""
-    import dolfinx.plot
-    import pyvista
-
-    V = u.function_space
-    path = _rank_path(pathlib.Path(path), V.mesh.comm)
-    topology, cell_types, x = dolfinx.plot.vtk_mesh(V)
-    grid = pyvista.UnstructuredGrid(topology, cell_types, x)
-    values = u.x.array.reshape(-1, 2)
-    grid.point_data["u"] = np.c_[values, np.zeros(values.shape[0])]
-    degree = V.ufl_element().embedded_superdegree
-    for name, f in (fields or {}).items():
-        shape = f.function_space.value_shape
-        nodal = dolfinx.fem.Function(dolfinx.fem.functionspace(V.mesh, ("Lagrange", degree, shape)))
-        nodal.interpolate(f)
-        grid.point_data[name] = nodal.x.array.reshape(values.shape[0], -1)
-    grid.save(path)
-    return path
+    at the nodes by interpolation into ``u``'s degree): :func:`~xfem_contact.io.vtu.plain_arrays`.
+    Collective (pieces and ``.pvtu`` in parallel, as :func:`write_lips`)."""
+    arrays = plain_arrays(u, fields)
+    return write_grid(path, arrays, u.function_space.mesh.comm, VTU_COMPRESSION)
 
 
 def write_cut_geometry(
@@ -110,18 +91,24 @@ def write_cut_geometry(
     :func:`~xfem_contact.io.interface_data.interface_point_data`) into ``directory``:
     the cut region only, the uncut cells are in ``result.vtu`` (:func:`write_lips`).
 
-    Local to each process (not collective): in parallel rank ``r`` writes
-    ``subcells_r{r}.vtu`` and ``interface_r{r}.vtu``. See :mod:`xfem_contact.io.pictures`.
+    Collective: in parallel rank ``r`` writes ``subcells_r{r}.vtu`` and
+    ``interface_r{r}.vtu``, rank 0 ``subcells.pvtu`` and ``interface.pvtu``. Returns this
+    process's files. See :mod:`xfem_contact.io.pictures`.
     """
     directory, comm = pathlib.Path(directory), cut.mesh.comm
     paths = []
-    interface = interface_arrays(cut)
-    interface = interface._replace(point_data=dict(interface_data or {}))
-    for name, arrays in (("subcells", subcell_arrays(cut, uncut=False)), ("interface", interface)):
-        path = _rank_path(directory / f"{name}.vtu", comm)
-        write_vtu(path, arrays, VTU_COMPRESSION)
-        paths.append(path)
+    for name, arrays in (
+        ("subcells", subcell_arrays(cut, uncut=False)),
+        ("interface", interface_grid_arrays(cut, interface_data)),
+    ):
+        paths.append(write_grid(directory / f"{name}.vtu", arrays, comm, VTU_COMPRESSION))
     return paths
+
+
+def interface_grid_arrays(cut: CutMesh, interface_data: dict | None = None):
+    """:func:`~xfem_contact.io.vtu.interface_arrays` with point data ``interface_data``
+    (name to an array over its nodes)."""
+    return interface_arrays(cut)._replace(point_data=dict(interface_data or {}))
 
 
 def _jsonable(value):

@@ -38,6 +38,7 @@ from xfem_contact.fem.evaluation import cell_dofs, evaluate_lattice, evaluate_re
 
 #: VTK cell types (``vtkCellType.h``)
 QUADRATIC_EDGE, QUADRATIC_TRIANGLE, BIQUADRATIC_QUAD = 21, 22, 28
+LAGRANGE_TRIANGLE, LAGRANGE_QUADRILATERAL = 69, 70
 _NODES = {QUADRATIC_EDGE: 3, QUADRATIC_TRIANGLE: 6, BIQUADRATIC_QUAD: 9}
 
 # Reference nodes of the uncut cells' quadratic lattice, in VTK node order
@@ -239,6 +240,47 @@ def interface_arrays(cut: CutMesh) -> GridArrays:
     return arrays._replace(cell_data={"cell": arrays.cell_data["cell"]})
 
 
+def plain_arrays(u, fields: dict | None = None) -> GridArrays:
+    """The mesh at the nodes of ``u``'s Lagrange space (linear cells for degree 1,
+    quadratic ones for 2, VTK Lagrange cells above) with point data ``u`` (m, padded to
+    3 components) and ``fields`` (name to Function, e.g. a discontinuous stress,
+    interpolated into ``u``'s degree). This process's cells."""
+    import dolfinx.fem
+    import dolfinx.plot
+
+    V = u.function_space
+    topology, cell_types, x = dolfinx.plot.vtk_mesh(V)
+    values = u.x.array.reshape(x.shape[0], -1)
+    point_data = {"u": _pad3(values) if values.shape[1] == 2 else values}
+    degree = V.ufl_element().embedded_superdegree
+    for name, f in (fields or {}).items():
+        shape = f.function_space.value_shape
+        nodal = dolfinx.fem.Function(dolfinx.fem.functionspace(V.mesh, ("Lagrange", degree, shape)))
+        nodal.interpolate(f)
+        point_data[name] = nodal.x.array.reshape(x.shape[0], -1)
+    types = np.asarray(cell_types, dtype=np.uint8)
+    if degree == 2:  # VTK's Lagrange cells of order 2 are its quadratic cells, same order
+        types = np.where(types == LAGRANGE_TRIANGLE, QUADRATIC_TRIANGLE, types)
+        types = np.where(types == LAGRANGE_QUADRILATERAL, BIQUADRATIC_QUAD, types)
+    return GridArrays(
+        np.asarray(x, dtype=np.float64),
+        np.asarray(topology, dtype=np.int64),
+        types.astype(np.uint8),
+        {},
+        point_data,
+    )
+
+
+def _node_counts(arrays: GridArrays) -> np.ndarray:
+    """Nodes per cell of ``arrays`` (its legacy layout): the VTK type's, or, for cells of
+    one type (e.g. VTK Lagrange cells), the count of the first cell."""
+    if arrays.types.size and np.all(arrays.types == arrays.types[0]):
+        return np.full(arrays.types.size, arrays.cells[0], dtype=np.int64)
+    table = np.zeros(max(_NODES) + 1, dtype=np.int64)
+    table[list(_NODES)] = list(_NODES.values())
+    return table[arrays.types]
+
+
 def write_vtu(path, arrays: GridArrays, compression: str = "lz4") -> None:
     """Write ``arrays`` as a VTK XML unstructured grid (binary, compressed with
     ``compression``: ``"lz4"``, ``"zlib"`` or ``"none"``). Not collective."""
@@ -251,9 +293,7 @@ def write_vtu(path, arrays: GridArrays, compression: str = "lz4") -> None:
     points = vtkPoints()
     points.SetData(numpy_to_vtk(np.ascontiguousarray(arrays.points, dtype=np.float64), deep=True))
     grid.SetPoints(points)
-    table = np.zeros(max(_NODES) + 1, dtype=np.int64)
-    table[list(_NODES)] = list(_NODES.values())
-    nodes = table[arrays.types]  # nodes per cell
+    nodes = _node_counts(arrays)
     offsets = np.zeros(nodes.size + 1, dtype=np.int64)
     np.cumsum(nodes, out=offsets[1:])
     keep = np.ones(arrays.cells.size, dtype=bool)

@@ -10,8 +10,9 @@ from __future__ import annotations
 import numpy as np
 
 from xfem_contact.io.crack_data import lip_samples
+from xfem_contact.io.crack_report import Reference, crack_table, load_words, tip_records
 from xfem_contact.io.plots import interface_abscissa
-from xfem_contact.mechanics.fracture import TipIntegrals
+from xfem_contact.mechanics.fracture import TipIntegrals, effective_modulus
 from xfem_contact.scenes.crack_builder import crack_path, default_rings
 from xfem_contact.scenes.schema import Scene, SceneError
 
@@ -37,33 +38,28 @@ class CrackOutputs:
             raise SceneError("cracks[0].rings", " ".join(str(error).split())) from None
         self.rings = [(float(a), float(b)) for a, b in rings]
 
-    def summary(self) -> dict:
+    def tips(self) -> list[dict]:
+        """K_I, K_II, J, G of every tip on every ring, now (:func:`tip_records`, the
+        order of ``problem.cut.crack.tips``). Collective."""
+        crack = self.problem.cut.crack
+        return tip_records(crack.tips, crack.directions, self.integrals.evaluate())
+
+    def per_crack(self, tips: list[dict]) -> dict[str, list[dict]]:
+        """``tips`` (:meth:`tips`) grouped by crack: name to its tips' records."""
+        names = self.problem.cut.crack.tip_names
+        return {
+            spec.name: [tip for tip, name in zip(tips, names, strict=True) if name == spec.name]
+            for spec in self.specs
+        }
+
+    def summary(self, tips: list[dict] | None = None) -> dict:
         """``{name: {law, tips: [{position, direction, rings: [{r_inf, r_sup, K_I, K_II,
         J, G}]}], lips: {x, y, s, opening, slip[, lambda_n, lambda_t, status]},
-        abscissa}}`` (SI units; ``s`` the arc length from the crack's first point, or
-        a coordinate along it for expressions, ``abscissa`` says which). Collective."""
-        crack = self.problem.cut.crack
-        names = crack.tip_names
-        tips = [
-            {
-                "position": position.tolist(),
-                "direction": direction.tolist(),
-                "rings": [
-                    {
-                        "r_inf": r.ring.r_inf,
-                        "r_sup": r.ring.r_sup,
-                        "K_I": r.K_I,
-                        "K_II": r.K_II,
-                        "J": r.J,
-                        "G": r.G,
-                    }
-                    for r in results
-                ],
-            }
-            for position, direction, results in zip(
-                crack.tips, crack.directions, self.integrals.evaluate(), strict=True
-            )
-        ]
+        abscissa[, reference: {K_I, K_II, source}]}}`` (SI units; ``s`` the arc length
+        from the crack's first point, or a coordinate along it for expressions,
+        ``abscissa`` says which) of the current solution; ``tips``: :meth:`tips` if
+        evaluated already. Collective."""
+        grouped = self.per_crack(self.tips() if tips is None else tips)
         summary = {}
         for spec in self.specs:
             lips = lip_samples(self.problem, spec.name)
@@ -74,18 +70,22 @@ class CrackOutputs:
             else:
                 s, label = interface_abscissa(np.array(lips["x"]), np.array(lips["y"]))
                 lips["s"] = s.tolist()
-            mine = [tip for tip, name in zip(tips, names, strict=True) if name == spec.name]
-            entry = {"law": self.problem.laws[spec.name].describe(), "tips": mine}
+            entry = {"law": self.problem.laws[spec.name].describe(), "tips": grouped[spec.name]}
+            if spec.reference_K is not None:
+                K_I, K_II = spec.reference_K
+                entry["reference"] = {"K_I": K_I, "K_II": K_II, "source": spec.reference_source}
             summary[spec.name] = entry | {"lips": lips, "abscissa": label}
         return summary
 
     def lines(self, summary: dict) -> list[str]:
-        """One log line per tip: its position and K on each ring (Pa m^1/2)."""
+        """The table of each crack (:func:`~xfem_contact.io.crack_report.crack_table`):
+        K per tip and ring, J, G, the reference, the law and the loads."""
+        material = self.problem.bulk.materials[1]
+        modulus = effective_modulus(material.E, material.nu, material.plane)
+        loads = load_words(self.problem.loads)
         lines = []
         for name, entry in summary.items():
-            label = "crack" if len(summary) == 1 else f"crack {name!r}"
-            for k, tip in enumerate(entry["tips"]):
-                ks = ", ".join(f"{r['K_I']:.4g} / {r['K_II']:.4g}" for r in tip["rings"])
-                x, y = tip["position"]
-                lines.append(f"{label} tip {k} at ({x:.4g}, {y:.4g}): K_I / K_II per ring {ks}")
+            given = entry.get("reference")
+            reference = None if given is None else Reference(**given)
+            lines += crack_table(name, entry["tips"], entry["law"], loads, reference, modulus)
         return lines

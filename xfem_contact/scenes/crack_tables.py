@@ -40,6 +40,10 @@ def crack_spec(table, k: int, materials: dict) -> CrackSpec:
     law = table.get("law", "free")
     options = law_options(table, where, law)
     material = material_name(table, "material", where, materials)
+    reference = table.get("reference_K")
+    if "reference_source" in table and reference is None:
+        message = "a source needs reference_K = [K_I, K_II] (Pa m^1/2) to describe"
+        raise SceneError(f"{where}.reference_source", message)
     return CrackSpec(
         shape=shape,
         params=params,
@@ -48,6 +52,8 @@ def crack_spec(table, k: int, materials: dict) -> CrackSpec:
         law=law,
         tip_radius=table.get("tip_radius"),
         rings=table.get("rings"),
+        reference_K=None if reference is None else tuple(float(k) for k in reference),
+        reference_source=table.get("reference_source", ""),
         **options,
     )
 

@@ -31,8 +31,9 @@ class InterfaceSpec:
 class CrackSpec:
     """A crack: its shape's parameters (``points``; ``centre``, ``radius``,
     ``angles_deg``; or ``phi``, ``psi`` expressions), the law of its lips, the tip
-    enrichment radius (m; None: the tip cells' nodes) and the rings of K (m; None:
-    the default, in tip cell sizes)."""
+    enrichment radius (m; None: the tip cells' nodes), the rings of K (m; None:
+    the default, in tip cell sizes) and the reference ``(K_I, K_II)`` (Pa m^1/2) of
+    every tip with its source (None: no reference)."""
 
     shape: str
     params: dict
@@ -44,6 +45,8 @@ class CrackSpec:
     lbb: str | None = None
     tip_radius: float | None = None
     rings: tuple | None = None
+    reference_K: tuple | None = None
+    reference_source: str = ""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -9,6 +9,7 @@ from collections.abc import Callable
 
 import dolfinx.io
 import dolfinx.mesh
+import numpy as np
 from mpi4py import MPI
 
 from xfem_contact._version import versions
@@ -109,13 +110,23 @@ def run(
     the steps when there are several and ``progress_bar`` is true
     (:func:`xfem_contact.io.progress.progress`). With ``out``, the
     fields of every step go to VTX files (``displacement.bp``, ``multiplier.bp``,
-    time = pseudo-time), the final state to ``result.vtu``, last the summary to
-    ``summary.json`` (atomic; a stale one is removed first: a failed run leaves none).
+    time = pseudo-time), each step's grids to ``result.pvd`` (the lips, or the plain
+    mesh, with the displacement and stresses) and, for a cut scene, ``interface.pvd``
+    (the interface with the laws' state), series ParaView opens
+    (:class:`StepGrids`, ``.pvtu`` pieces in parallel), the final state to
+    ``result.vtu``, last the summary to ``summary.json`` (atomic; a stale one is removed
+    first: a failed run leaves none).
 
     Returns:
         The summary: effects built, fields, dof counts, iterations per step, the
-        contact status, timings (s); with a crack its K_I, K_II, J, G per tip and ring
-        and its lips (``cracks``, see :class:`~xfem_contact.scenes.crack_outputs.CrackOutputs`).
+        contact status, timings (s); ``steps``, a record per load step (``step``,
+        ``time``, ``iterations``, ``status`` (the solver's), ``forces``: the reactions,
+        loads and balance (N/m) of :func:`~xfem_contact.mechanics.reactions.balance`,
+        ``interfaces``: the rule points open, sticking and sliding per interface
+        (:func:`status_counts`), and with cracks ``cracks``: K_I, K_II, J, G per tip and
+        ring of each crack); with a crack
+        its lips and K at the last step (``cracks``, see
+        :class:`~xfem_contact.scenes.crack_outputs.CrackOutputs`).
     """
     if log is print:  # printed lines go above the progress bar, not through it
         log = note
@@ -131,9 +142,11 @@ def run(
     cracks = CrackOutputs(problem, scene) if scene.cracks else None
     result = Result(problem)
     series = _open_series(out, result) if (out is not None and scene.outputs["vtx"]) else []
+    grids = None if out is None else StepGrids(out, problem, result)
     end_time = scene.end_time or problem.loads.end_time
     steps, iterations, residuals, status = load_steps(scene.load_steps, end_time), [], [], {}
-    pairing = []
+    pairing, records, tips = [], [], None
+    forces_time = output_time = 0.0
     solve_start = time.perf_counter()
     try:
         bar = progress(steps, f"{scene.name}: load steps", progress_bar and len(steps) > 1, comm)
@@ -169,8 +182,22 @@ def run(
                     if key not in ("unpaired", "unpaired_points")  # status has the count
                 }
             result.update(solution)
+            record = {"step": k, "time": float(t), "iterations": its, "status": status}
+            forces_start = time.perf_counter()  # reactions, interface resultants (N/m)
+            record["forces"] = balance(problem, problem.w)
+            forces_time += time.perf_counter() - forces_start
+            if problem.laws:
+                record["interfaces"] = status_counts(problem)
+            if cracks is not None:
+                tips = cracks.tips()
+                record["cracks"] = cracks.per_crack(tips)
+            records.append(record)
+            output_start = time.perf_counter()
             for writer in series:
                 writer.write(float(t))
+            if grids is not None:
+                grids.write(float(t))
+            output_time += time.perf_counter() - output_start
             say(
                 f"load step {k}/{len(steps)} (time {t:.4g}): {its} iteration(s)"
                 + "".join(f", {key} {value}" for key, value in status.items())
@@ -178,7 +205,7 @@ def run(
     finally:
         for writer in series:
             writer.close()
-    solve_time = time.perf_counter() - solve_start
+    solve_time = time.perf_counter() - solve_start - forces_time - output_time
     summary = {
         "scene": scene.name,
         "effects": effects,
@@ -206,12 +233,11 @@ def run(
         if not problem.linear and len(samples) == 1:
             summary["interface_samples"] = next(iter(samples.values()))
     if cracks is not None:
-        summary["cracks"] = cracks.summary()
+        summary["cracks"] = cracks.summary(tips)
         for line in cracks.lines(summary["cracks"]):
             say(line)
-    forces_start = time.perf_counter()  # reactions, interface resultants, balance (N/m)
-    summary["forces"] = balance(problem, problem.w)
-    forces_time = time.perf_counter() - forces_start
+    summary["steps"] = records
+    summary["forces"] = records[-1]["forces"]  # the last step's
     reactions = ", ".join(f"{k} {v}" for k, v in summary["forces"]["reactions"].items())
     say(
         f"reactions (N/m): {reactions or 'none'}; balance (relative) "
@@ -226,8 +252,8 @@ def run(
     }
     if out is not None:
         output_start = time.perf_counter()
-        _write_grid(out, problem, result)
-        timings["output"] = time.perf_counter() - output_start
+        grids.write_last()
+        timings["output"] = output_time + time.perf_counter() - output_start
     summary["timings"] = timings | {"total": time.perf_counter() - start}
     if out is not None:
         comm.barrier()  # every rank's files are on disk before rank 0 renders them
@@ -260,21 +286,69 @@ def _open_series(out: str | pathlib.Path, result: Result) -> list:
     ]
 
 
-def _write_grid(out: pathlib.Path, problem, result: Result) -> None:
-    """``result.vtu`` (per process): the lips of a cut scene, or the plain mesh, with the
-    displacement and the stresses; for a cut scene ``subcells.vtu`` and ``interface.vtu``
-    (the cut geometry; the laws' state at the interface nodes). Collective."""
-    from xfem_contact.io.interface_data import interface_point_data
-    from xfem_contact.io.output import write_cut_geometry, write_lips, write_plain
+def status_counts(problem) -> dict[str, dict[str, int]]:
+    """Per interface (and crack) the number of its rule points open, sticking and
+    sliding (:func:`~xfem_contact.io.interface_data.sample_status`, all processes).
+    Collective."""
+    counts = {}
+    for name in problem.laws:
+        codes = np.bincount(sample_status(problem, name), minlength=3)
+        counts[name] = dict(zip(("open", "stick", "slip"), codes.tolist(), strict=True))
+    return counts
 
-    stress = result.stress
-    if problem.cut is None:  # a plain problem
-        named = {"stress": stress.stress[0], "von_mises": stress.von_mises[0]}
-        write_plain(out / "result.vtu", result.fields[0], named)
-    else:
+
+class StepGrids:
+    """The grids of every load step: ``result.pvd`` (the lips of a cut scene, or the
+    plain mesh, with the displacement and the stresses) and, for a cut scene,
+    ``interface.pvd`` (the interface pieces with the laws' state at their nodes), then
+    the last step's as ``result.vtu`` and ``interface.vtu`` with ``subcells.vtu`` (the
+    cut geometry) for ``xfem-contact show``. Collective."""
+
+    def __init__(self, out: pathlib.Path, problem, result: Result):
+        from xfem_contact.io.output import VTU_COMPRESSION
+        from xfem_contact.io.series import StepSeries
+
+        self.out, self.problem, self.result = out, problem, result
+        comm = problem.mesh.comm
+        self.series = {"result": StepSeries(out, "result", comm, VTU_COMPRESSION)}
+        if problem.cut is not None:
+            self.series["interface"] = StepSeries(out, "interface", comm, VTU_COMPRESSION)
+        self.last = {}
+
+    def arrays(self) -> dict:
+        """The grids of the current state (name to :class:`~xfem_contact.io.vtu.GridArrays`)."""
+        from xfem_contact.io.interface_data import interface_point_data
+        from xfem_contact.io.output import interface_grid_arrays
+        from xfem_contact.io.vtu import lips_arrays, plain_arrays
+
+        problem, fields, stress = self.problem, self.result.fields, self.result.stress
+        if problem.cut is None:  # a plain problem
+            named = {"stress": stress.stress[0], "von_mises": stress.von_mises[0]}
+            return {"result": plain_arrays(fields[0], named)}
         named = {
             "stress": dict(zip((-1, 1), stress.stress, strict=True)),
             "von_mises": dict(zip((-1, 1), stress.von_mises, strict=True)),
         }
-        write_lips(out / "result.vtu", problem.cut, result.fields[0], result.fields[1], named)
-        write_cut_geometry(out, problem.cut, interface_point_data(problem))
+        return {
+            "result": lips_arrays(problem.cut, fields[0], fields[1], named),
+            "interface": interface_grid_arrays(problem.cut, interface_point_data(problem)),
+        }
+
+    def write(self, t: float) -> None:
+        """Add the current state as the step at pseudo-time ``t`` to each series."""
+        self.last = self.arrays()
+        for name, arrays in self.last.items():
+            self.series[name].write(t, arrays)
+
+    def write_last(self) -> None:
+        """``result.vtu``, ``interface.vtu`` of the last step written, ``subcells.vtu``."""
+        from xfem_contact.io.output import VTU_COMPRESSION
+        from xfem_contact.io.series import write_grid
+        from xfem_contact.io.vtu import subcell_arrays
+
+        comm = self.problem.mesh.comm
+        grids = dict(self.last)
+        if self.problem.cut is not None:
+            grids["subcells"] = subcell_arrays(self.problem.cut, uncut=False)
+        for name, arrays in grids.items():
+            write_grid(self.out / f"{name}.vtu", arrays, comm, VTU_COMPRESSION)

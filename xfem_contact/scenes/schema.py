@@ -132,7 +132,10 @@ FIELDS = {
         "radii": Field(
             Vector(2, _POSITIVE), "[r_inner, r_outer] (m, annulus centred at the origin)"
         ),
-        "cells": Field(Vector(2, Number(1, integer=True)), "[nx, ny] or [n_radial, n_angular]"),
+        "cells": Field(
+            Vector(2, Number(1, integer=True)),
+            "cells along x and y (rectangle) or [n_radial, n_angular] (annulus)",
+        ),
         "cell": Field(Choice(CELLS), f"one of {CELLS}"),
         "geometry_degree": Field(
             _DEGREE, "1 (straight cells) or 2 (curved cells: annulus, gmsh .geo)"
@@ -146,14 +149,28 @@ FIELDS = {
     "interface": {
         "name": Field(NAME, "label (names the multiplier field)"),
         "shape": Field(Choice(SHAPES), f"one of {SHAPES}", required=True),
-        "centre": Field(_POINT, "[x, y] (m)"),
-        "radius": Field(_POSITIVE, "(m) > 0"),
-        "axes": Field(Vector(2, _POSITIVE), "[a, b] (m) > 0"),
-        "angle": Field(Number(), "(rad) in [-2 pi, 2 pi]; or angle_deg"),
+        "centre": Field(_POINT, "[x, y] (m), centre of a circle or an ellipse"),
+        "radius": Field(_POSITIVE, "(m) > 0, radius of a circle"),
+        "axes": Field(
+            Vector(2, _POSITIVE),
+            "[a, b] (m) > 0, the semi-axes of an ellipse: a along the direction at angle "
+            "from the x axis, b across it",
+        ),
+        "angle": Field(
+            Number(),
+            "(rad) in [-2 pi, 2 pi], of an ellipse's axis a from the x axis, "
+            "counter-clockwise; or angle_deg",
+        ),
         "angle_deg": Field(Number(), "(degrees), instead of angle"),
-        "point": Field(_POINT, "[x, y]"),
-        "normal": Field(_POINT, "[nx, ny], non-zero"),
-        "expression": Field(Expression(), "phi(x, y), negative inside"),
+        "point": Field(_POINT, "[x, y] (m), a point of a line or half-plane's boundary"),
+        "normal": Field(
+            _POINT,
+            "[nx, ny], non-zero, any length: the normal of a line, pointing to side +1 (outside)",
+        ),
+        "expression": Field(
+            Expression(),
+            "phi(x, y) of x, y in m: the interface is phi = 0, side -1 (inside) phi < 0",
+        ),
         "law": Field(Choice(LAWS), f"one of {LAWS}"),
         "friction": Field(Number(0.0), "Coulomb coefficient >= 0"),
         "augmentation": Field(_POSITIVE, "> 0"),
@@ -179,7 +196,8 @@ FIELDS = {
         "radius": Field(_POSITIVE, "(m) > 0, radius of an arc"),
         "angles_deg": Field(
             Vector(2, Number()),
-            "[start, end] polar angles (degrees) of an arc, |end - start| < 360",
+            "[start, end] polar angles (degrees, counter-clockwise from the x axis, about "
+            "centre) of an arc's ends, |end - start| < 360",
         ),
         "phi": Field(
             Expression(), "normal level set phi(x, y): the crack is phi = 0 where psi < 0"
@@ -200,6 +218,14 @@ FIELDS = {
             f"{[list(r) for r in CRACK_RINGS]} tip cell sizes, r_sup kept off the boundary)",
         ),
         "material": Field(Text(), "material of the cracked body (default: the first)"),
+        "reference_K": Field(
+            Vector(2, Number()),
+            "[K_I, K_II] (Pa m^1/2) to compare every tip's K with (printed beside it, with "
+            "the difference)",
+        ),
+        "reference_source": Field(
+            Text(), "where reference_K comes from and what it includes (e.g. the plate's size)"
+        ),
     },
     "material": {
         "E": Field(_POSITIVE, "Young's modulus (Pa) > 0", required=True),
@@ -235,10 +261,15 @@ FIELDS = {
     "load": {
         "part": Field(Text(), "a boundary part name"),
         "type": Field(Choice(LOAD_TYPES), f"one of {LOAD_TYPES}", required=True),
-        "value": Field(lambda value, key: value, "number, [vx, vy], or expression(s) of x, y"),
+        "value": Field(
+            lambda value, key: value,
+            "number, [vx, vy], or expression(s) of x, y (m): Pa for a pressure (positive "
+            "pushes) or traction, N/m^3 for a body force, m for a displacement, rad for a "
+            "rotation (or angle_deg), Pa/m for a tangential_support's stiffness",
+        ),
         "side": Field(Choice((-1, 1)), "-1 or +1 (default both)"),
-        "component": Field(Choice((0, 1)), "0 or 1 (displacement)"),
-        "point": Field(_POINT, "[x, y] (point_displacement)"),
+        "component": Field(Choice((0, 1)), "0 (x) or 1 (y): the one prescribed (displacement)"),
+        "point": Field(_POINT, "[x, y] (m), the node held (point_displacement)"),
         "centre": Field(_POINT, "[x, y] (m), centre of a rotation (default [0, 0])"),
         "angle_deg": Field(Number(), "rotation angle in degrees (instead of value, in rad)"),
         "history": Field(
