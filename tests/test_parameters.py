@@ -102,3 +102,37 @@ def test_a_parameter_states_its_range():
     assert Parameter("Pa", minimum=0.0, strict=True).requirement() == "> 0 Pa"
     with pytest.raises(ValueError, match=r"finite and >= 0"):
         Parameter(minimum=0.0).check(float("inf"), "x")
+
+
+def given_as(form: str, material: Material, name: str = "interface"):
+    """``material`` on both sides, given as one Material, a pair or per interface name
+    (a single level set's interface is named ``"interface"``)."""
+    return {
+        "one": material,
+        "pair": {-1: material, 1: Material(material.E, material.nu)},
+        "per interface": {-1: {name: material}, 1: material},
+    }[form]
+
+
+@pytest.mark.parametrize("given", ["one", "pair", "per interface"])
+def test_each_side_owns_its_material(given):
+    """Equal materials on the two sides are two materials: a new E inside leaves the
+    outside's alone, and the solution equals that of a problem built with the new
+    moduli, with no new compile."""
+    soft, stiff = Material(100e6, 0.3), Material(1e9, 0.3)
+    name = "interface"
+    problem = inclusion_problem(8, 2, "sticking", materials=given_as(given, soft))
+    problem.solve()
+    compiled = forms.compiled_forms()
+    inside = problem.materials[-1]
+    inside = inside[name] if given == "per interface" else inside
+    inside.E = stiff.E
+    assert problem.materials[1].E == soft.E
+    problem.w.x.array[:] = 0.0
+    problem.solve()
+    assert forms.compiled_forms() == compiled, "a new modulus compiled a new form"
+    inside_given = {name: stiff} if given == "per interface" else stiff
+    fresh = inclusion_problem(8, 2, "sticking", materials={-1: inside_given, 1: soft})
+    fresh.solve()
+    w, reference = problem.w.x.array, fresh.w.x.array
+    assert np.abs(w - reference).max() <= 1e-12 * np.abs(reference).max()
