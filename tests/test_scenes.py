@@ -528,29 +528,40 @@ def test_cli_error_at_build_is_one_line_and_leaves_no_stale_summary(tmp_path, ca
     assert not (out / "summary.json").exists()
 
 
+def circle(centre, radius) -> dict:
+    return {"shape": "circle", "centre": centre, "radius": radius}
+
+
 @pytest.mark.parametrize(
     "interfaces, key, fragment",
     [
         (
-            [{"centre": [0.45, 0.45], "radius": 0.01}],  # between the nodes
+            [circle([0.45, 0.45], 0.01)],  # between the nodes
             "interfaces[0]",
             "so no node lies inside it. Move or enlarge",
         ),
-        ([{"radius": 5.0}], "interfaces[0]", "so every node lies inside it. Move or shrink"),
+        ([circle([0.5, 0.5], 5.0)], "interfaces[0]", "every node lies inside it. Move or shrink"),
         (
-            [{"centre": [0.25, 0.5], "radius": 0.2}, {"centre": [0.3, 0.5], "radius": 0.2}],
+            [circle([0.25, 0.5], 0.2), circle([0.3, 0.5], 0.2)],
             "interfaces[1]",
             "overlaps interface 'i0' (mesh nodes lie inside both)",
         ),
+        (
+            [circle([0.25, 0.5], 0.2), {"shape": "expression", "expression": "sqrt(x - 0.5)"}],
+            "interfaces[1]",
+            "node(s), the first at x = (0, 0): give one that is finite on the whole mesh",
+        ),
     ],
-    ids=["between nodes", "around the mesh", "overlapping"],
+    ids=["between nodes", "around the mesh", "overlapping", "NaN"],
 )
+@pytest.mark.filterwarnings("ignore:invalid value encountered in sqrt")
 def test_a_bad_interface_is_named_by_its_key(interfaces, key, fragment):
-    """An interface that misses the mesh or overlaps another: one line starting with
-    its key (``interfaces[1]: ...``), saying what to do."""
+    """An interface that misses the mesh, overlaps another or is NaN: one line starting
+    with its key (``interfaces[1]: ...``), saying what to do."""
     data = base(law="bonded")
-    circle = data["interfaces"][0]
-    data["interfaces"] = [circle | {"name": f"i{k}"} | spec for k, spec in enumerate(interfaces)]
+    data["interfaces"] = [
+        {"name": f"i{k}", "law": "bonded"} | spec for k, spec in enumerate(interfaces)
+    ]
     with pytest.raises(ValueError) as raised:
         build(load_scene(data))
     text = str(raised.value)

@@ -103,9 +103,14 @@ def interpolate(
     values = phi.x.array
     bad = np.flatnonzero(~np.isfinite(values))
     comm = mesh.comm
-    if comm.allreduce(bad.size, op=MPI.SUM):
-        where = V.tabulate_dof_coordinates()[bad[:1]] if bad.size else None
-        raise ValueError(f"The level set has NaN/inf values (first at x = {where})")
+    count = comm.allreduce(bad.size, op=MPI.SUM)
+    if count:
+        points = comm.allgather(V.tabulate_dof_coordinates()[bad[:1], :2])
+        x, y = np.round(next(p[0] for p in points if len(p)), 12) + 0.0  # no -0 or 1e-18
+        raise ValueError(
+            f"The level set is NaN or inf at {count} node(s), the first at x = ({x:.6g}, "
+            f"{y:.6g}): give one that is finite on the whole mesh"
+        )
     lo = comm.allreduce(values.min(initial=np.inf), op=MPI.MIN)
     hi = comm.allreduce(values.max(initial=-np.inf), op=MPI.MAX)
     # Canonical nodal values. A node shared by several cells is interpolated from one
