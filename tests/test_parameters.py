@@ -115,6 +115,7 @@ def given_as(form: str, material: Material, name: str = "interface"):
     }[form]
 
 
+@pytest.mark.mpi
 @pytest.mark.parametrize("given", ["one", "pair", "per interface"])
 def test_each_side_owns_its_material(given):
     """Equal materials on the two sides are two materials: a new E inside leaves the

@@ -555,6 +555,7 @@ def circle(centre, radius) -> dict:
     ids=["between nodes", "around the mesh", "overlapping", "NaN"],
 )
 @pytest.mark.filterwarnings("ignore:invalid value encountered in sqrt")
+@pytest.mark.mpi
 def test_a_bad_interface_is_named_by_its_key(interfaces, key, fragment):
     """An interface that misses the mesh, overlaps another or is NaN: one line starting
     with its key (``interfaces[1]: ...``), saying what to do."""
