@@ -549,7 +549,7 @@ def circle(centre, radius) -> dict:
         (
             [circle([0.25, 0.5], 0.2), {"shape": "expression", "expression": "sqrt(x - 0.5)"}],
             "interfaces[1]",
-            "node(s), the first at x = (0, 0): give one that is finite on the whole mesh",
+            "node(s), e.g. at x = (0, 0): give one that is finite on the whole mesh",
         ),
     ],
     ids=["between nodes", "around the mesh", "overlapping", "NaN"],

@@ -101,14 +101,17 @@ def interpolate(
     else:
         raise ValueError(f"A level set is a callable or a dolfinx Function, not {type(levelset)}")
     values = phi.x.array
-    bad = np.flatnonzero(~np.isfinite(values))
+    owned = V.dofmap.index_map.size_local
+    bad = np.flatnonzero(~np.isfinite(values[:owned]))
     comm = mesh.comm
     count = comm.allreduce(bad.size, op=MPI.SUM)
     if count:
-        points = comm.allgather(V.tabulate_dof_coordinates()[bad[:1], :2])
-        x, y = np.round(next(p[0] for p in points if len(p)), 12) + 0.0  # no -0 or 1e-18
+        # the lowest such node (by y, then x) of all processes: one message for any partition
+        local = np.round(V.tabulate_dof_coordinates()[bad, :2], 12) + 0.0  # no 1e-18 or -0
+        points = np.concatenate(comm.allgather(local[np.lexsort(local.T)[:1]]))
+        x, y = points[np.lexsort(points.T)[0]]
         raise ValueError(
-            f"The level set is NaN or inf at {count} node(s), the first at x = ({x:.6g}, "
+            f"The level set is NaN or inf at {count} node(s), e.g. at x = ({x:.6g}, "
             f"{y:.6g}): give one that is finite on the whole mesh"
         )
     lo = comm.allreduce(values.min(initial=np.inf), op=MPI.MIN)
