@@ -91,10 +91,16 @@ def build(n: int, a: float, beta: float, friction: float, comm) -> tuple:
 
 # %%
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, default=48, help="cells per side of the plate")
-    parser.add_argument("--out", default="results/crack_contact")
-    parser.add_argument("--no-progress", action="store_true")
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument(
+        "--n", type=int, default=48, help="cells per side of the plate (default %(default)s)"
+    )
+    parser.add_argument(
+        "--out",
+        default="results/crack_contact",
+        help="folder of the results: PNG, VTX, summary.json (default %(default)s)",
+    )
+    parser.add_argument("--no-progress", action="store_true", help="print no progress lines")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
     say = print if comm.rank == 0 and not args.no_progress else (lambda *a: None)

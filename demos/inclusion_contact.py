@@ -46,25 +46,59 @@ from xfem_contact.solvers.options import LINEAR_PRESETS, preset
 
 # %%
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, default=40, help="cells per side (even)")
-    parser.add_argument("--degree", type=int, default=2, choices=[1, 2])
-    parser.add_argument("--cell", default="quadrilateral", choices=["quadrilateral", "triangle"])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
-        "--law", default="sticking", choices=["sticking", "coulomb", "frictionless"]
+        "--n", type=int, default=40, help="cells per side, even (default %(default)s)"
     )
-    parser.add_argument("--friction", type=float, default=1.0, help="Coulomb coefficient")
-    parser.add_argument("--lbb", default="stabilized", choices=["stabilized", "restriction"])
+    parser.add_argument(
+        "--degree",
+        type=int,
+        default=2,
+        choices=[1, 2],
+        help="polynomial degree of the displacement; the multipliers are linear "
+        "(default %(default)s)",
+    )
+    parser.add_argument(
+        "--cell",
+        default="quadrilateral",
+        choices=["quadrilateral", "triangle"],
+        help="cell shape of the mesh (default %(default)s)",
+    )
+    parser.add_argument(
+        "--law",
+        default="sticking",
+        choices=["sticking", "coulomb", "frictionless"],
+        help="contact law of the interface (default %(default)s)",
+    )
+    parser.add_argument(
+        "--friction",
+        type=float,
+        default=1.0,
+        help="Coulomb friction coefficient, with --law coulomb (default %(default)s)",
+    )
+    parser.add_argument(
+        "--lbb",
+        default="stabilized",
+        choices=["stabilized", "restriction"],
+        help="treatment of the multipliers' inf-sup condition: the Barbosa-Hughes "
+        "stabilisation or the vital-vertex restriction (default %(default)s)",
+    )
     parser.add_argument(
         "--solver",
         default="direct",
         choices=sorted(LINEAR_PRESETS),
         help="linear solver of the Newton steps: MUMPS (LDL^T of a symmetric Jacobian, "
-        "else LU), or GMRES + band multigrid",
+        "else LU), or GMRES + band multigrid (default %(default)s)",
     )
-    parser.add_argument("--out", default="results/inclusion_contact")
-    parser.add_argument("--json", default=None)
-    parser.add_argument("--quiet", action="store_true", help="no progress lines")
+    parser.add_argument(
+        "--out",
+        default="results/inclusion_contact",
+        help="folder of the results: VTX, .vtu, PNG, summary.json (default %(default)s)",
+    )
+    parser.add_argument(
+        "--json", default=None, help="path of the JSON summary (default OUT/summary.json)"
+    )
+    parser.add_argument("--quiet", action="store_true", help="print no progress lines")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
     say = (lambda *a: None) if args.quiet or comm.rank else print

@@ -43,7 +43,7 @@ from xfem_contact.cases.rotation import (
 from xfem_contact.io.output import write_fields, write_json, write_lips
 from xfem_contact.io.plots import Series, line_plot
 from xfem_contact.io.progress import progress
-from xfem_contact.mechanics.laws import CONTACT_LAWS
+from xfem_contact.mechanics.laws import SLIDING_LAWS
 from xfem_contact.mechanics.loads import load_steps
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
 from xfem_contact.solvers.newton import NewtonFailure
@@ -56,20 +56,62 @@ from xfem_contact.solvers.newton import NewtonFailure
 
 # %%
 def arguments():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, default=20, help="cells across the annulus")
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument(
+        "--n", type=int, default=20, help="cells across the annulus (default %(default)s)"
+    )
     parser.add_argument("--nc", type=int, default=None, help="cells around (default 4 n)")
-    parser.add_argument("--degree", default="2", choices=["1", "2", "both"])
-    parser.add_argument("--alpha", type=float, default=np.pi / 2, help="rotation (rad)")
-    parser.add_argument("--steps", type=int, default=4, help="load steps")
-    parser.add_argument("--law", default="frictionless", choices=list(CONTACT_LAWS))
-    parser.add_argument("--friction", type=float, default=None, help="Coulomb coefficient")
-    parser.add_argument("--outer", default="point", choices=list(OUTER_SUPPORTS))
-    parser.add_argument("--pairing", default="iterate", choices=list(PAIRING_UPDATES))
-    parser.add_argument("--out", default="results/rotating_inclusion")
-    parser.add_argument("--json", default=None)
-    parser.add_argument("--quiet", action="store_true", help="no progress lines")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument(
+        "--degree",
+        default="2",
+        choices=["1", "2", "both"],
+        help="polynomial degree of the displacement, or both one after the other "
+        "(default %(default)s)",
+    )
+    parser.add_argument(
+        "--alpha",
+        type=float,
+        default=np.pi / 2,
+        help="rotation of the inner boundary (rad, default pi/2)",
+    )
+    parser.add_argument(
+        "--steps", type=int, default=4, help="number of load steps (default %(default)s)"
+    )
+    parser.add_argument(
+        "--law",
+        default="frictionless",
+        choices=list(SLIDING_LAWS),
+        help="contact law of the interface in large sliding (default %(default)s)",
+    )
+    parser.add_argument(
+        "--friction",
+        type=float,
+        default=None,
+        help="Coulomb friction coefficient, needed with --law coulomb",
+    )
+    parser.add_argument(
+        "--outer",
+        default="point",
+        choices=list(OUTER_SUPPORTS),
+        help="support of the outer boundary: u_y = 0 at one point, or u_t = 0 all "
+        "along it (default %(default)s)",
+    )
+    parser.add_argument(
+        "--pairing",
+        default="iterate",
+        choices=list(PAIRING_UPDATES),
+        help="pair the lips at every Newton iterate or once per load step (default %(default)s)",
+    )
+    parser.add_argument(
+        "--out",
+        default="results/rotating_inclusion",
+        help="folder of the results: VTX, .vtu, PNG, summary.json (default %(default)s)",
+    )
+    parser.add_argument(
+        "--json", default=None, help="path of the JSON summary (default OUT/summary.json)"
+    )
+    parser.add_argument("--quiet", action="store_true", help="print no progress lines")
+    parser.add_argument("--no-progress", action="store_true", help="show no progress bar")
     return parser.parse_args()
 
 

@@ -47,14 +47,37 @@ from xfem_contact.io.plots import Series, line_plot
 
 # %%
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--degree", type=int, default=2, choices=[1, 2])
-    parser.add_argument("--cell", default="quadrilateral", choices=["quadrilateral", "triangle"])
-    parser.add_argument("--nx", type=int, default=20)
-    parser.add_argument("--ny", type=int, default=29, help="odd: the interface stays inside a row")
-    parser.add_argument("--out", default="results/straight_interface")
-    parser.add_argument("--json", default=None)
-    parser.add_argument("--quiet", action="store_true")
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument(
+        "--degree",
+        type=int,
+        default=2,
+        choices=[1, 2],
+        help="polynomial degree of the displacement (default %(default)s)",
+    )
+    parser.add_argument(
+        "--cell",
+        default="quadrilateral",
+        choices=["quadrilateral", "triangle"],
+        help="cell shape of the mesh (default %(default)s)",
+    )
+    parser.add_argument("--nx", type=int, default=20, help="cells along x (default %(default)s)")
+    parser.add_argument(
+        "--ny",
+        type=int,
+        default=29,
+        help="cells along y, odd so that the interface stays inside a row of cells "
+        "(default %(default)s)",
+    )
+    parser.add_argument(
+        "--out",
+        default="results/straight_interface",
+        help="folder of the results: VTX, .vtu, PNG, summary.json (default %(default)s)",
+    )
+    parser.add_argument(
+        "--json", default=None, help="path of the JSON summary (default OUT/summary.json)"
+    )
+    parser.add_argument("--quiet", action="store_true", help="print no progress lines")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
     say = (lambda *a: None) if args.quiet or comm.rank else print

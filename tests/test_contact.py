@@ -263,7 +263,7 @@ def test_bad_contact_input_raises():
     problem = inclusion_problem(4, 1, "bonded")
     cut = problem.cut
     material = Material(1.0, 0.3)
-    with pytest.raises(ValueError, match="friction must be finite and >= 0"):
+    with pytest.raises(ValueError, match="friction must be a finite number >= 0"):
         ContactProblem(cut, 1, material, "coulomb", friction=-0.1)
     with pytest.raises(ValueError, match="needs a friction coefficient"):
         ContactProblem(cut, 1, material, "coulomb")

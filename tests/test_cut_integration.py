@@ -255,7 +255,7 @@ def test_parallel_equals_serial_integrals():
     [
         (lambda x: 1.0, r"Interface 'interface': the level set must return one value per point"),
         (lambda x: np.array([x[0], x[1]]), r"returned shape \(2, "),
-        (lambda x: x[0] + 2.0, r"Interface 'interface': The level set never crosses zero"),
+        (lambda x: x[0] + 2.0, r"Interface 'interface': The interface does not cross the mesh"),
         (lambda x: np.full(x.shape[1], np.nan), r"Interface 'interface': .*NaN"),
         ({"a": lambda x: x[0] - 0.5, "b": lambda x: x[0] + 3.0}, "Interface 'b': .*never crosses"),
     ],

@@ -411,13 +411,6 @@ def test_bundled_rotating_inclusion_turns_a_right_angle():
     assert np.abs(lam / reference - 1.0).max() < 1e-3
 
 
-def test_level_set_that_never_crosses_is_refused():
-    data = base(law="bonded")
-    data["interfaces"][0]["centre"] = [5.0, 5.0]
-    with pytest.raises(ValueError, match="never crosses"):
-        build(load_scene(data))
-
-
 def test_bundled_scenes_load():
     names = bundled_scenes()
     assert {
@@ -525,8 +518,55 @@ def test_cli_error_at_build_is_one_line_and_leaves_no_stale_summary(tmp_path, ca
     (out / "summary.json").write_text('{"scene": "an earlier run"}')
     assert cli.main(["run", str(path), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err.splitlines()
-    assert len(err) == 1 and err[0].startswith(f"error: {path}: ") and "never crosses" in err[0]
+    # the nearest node (1, 1) lies 4 sqrt(2) - 0.2 m outside the circle, (0, 0) 5 sqrt(2) - 0.2
+    assert err == [
+        f"error: {path}: interfaces[0]: The interface does not cross the mesh: its level set "
+        "never crosses zero (it is >= 0 at every node, from 5.45685 to 6.87107), so no node "
+        "lies inside it. Move or enlarge the interface, or refine the mesh, so that it "
+        "crosses the mesh"
+    ]
     assert not (out / "summary.json").exists()
+
+
+def circle(centre, radius) -> dict:
+    return {"shape": "circle", "centre": centre, "radius": radius}
+
+
+@pytest.mark.parametrize(
+    "interfaces, key, fragment",
+    [
+        (
+            [circle([0.45, 0.45], 0.01)],  # between the nodes
+            "interfaces[0]",
+            "so no node lies inside it. Move or enlarge",
+        ),
+        ([circle([0.5, 0.5], 5.0)], "interfaces[0]", "every node lies inside it. Move or shrink"),
+        (
+            [circle([0.25, 0.5], 0.2), circle([0.3, 0.5], 0.2)],
+            "interfaces[1]",
+            "overlaps interface 'i0' (mesh nodes lie inside both)",
+        ),
+        (
+            [circle([0.25, 0.5], 0.2), {"shape": "expression", "expression": "sqrt(x - 0.5)"}],
+            "interfaces[1]",
+            "node(s), e.g. at x = (0, 0): give one that is finite on the whole mesh",
+        ),
+    ],
+    ids=["between nodes", "around the mesh", "overlapping", "NaN"],
+)
+@pytest.mark.filterwarnings("ignore:invalid value encountered in sqrt")
+@pytest.mark.mpi
+def test_a_bad_interface_is_named_by_its_key(interfaces, key, fragment):
+    """An interface that misses the mesh, overlaps another or is NaN: one line starting
+    with its key (``interfaces[1]: ...``), saying what to do."""
+    data = base(law="bonded")
+    data["interfaces"] = [
+        {"name": f"i{k}", "law": "bonded"} | spec for k, spec in enumerate(interfaces)
+    ]
+    with pytest.raises(ValueError) as raised:
+        build(load_scene(data))
+    text = str(raised.value)
+    assert text.startswith(f"{key}: ") and fragment in text and text.splitlines() == [text], text
 
 
 def test_cli_newton_failure_exit_3_with_the_iterations(tmp_path, capsys):
@@ -709,7 +749,7 @@ def test_two_inclusions_under_hydrostatic_pressure():
     [
         ({"centre": [0.3, 0.5]}, ValueError, "overlap"),  # intersecting
         ({"centre": [0.28, 0.5], "radius": 0.05}, ValueError, "overlap"),  # nested
-        ({"centre": [0.5, 0.5]}, ValueError, "cut the same"),  # 1 mesh cell apart
+        ({"centre": [0.5, 0.5]}, ValueError, "cuts the same"),  # 1 mesh cell apart
         ({"outside": "other"}, NotImplementedError, "interfaces\\[1\\].outside"),
         ({"name": "inc0"}, ValueError, "unique"),
     ],

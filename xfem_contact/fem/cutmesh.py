@@ -22,6 +22,7 @@ from xfem_contact.geometry import cut
 from xfem_contact.geometry.crack_union import CrackUnion, crack_union, interpolate_tangent
 from xfem_contact.geometry.levelset import (
     CellMaps,
+    InterfaceError,
     LevelSet,
     LevelSetCallable,
     interpolate,
@@ -140,7 +141,7 @@ class CutMesh:
         except ValueError as error:
             if len(names) > 1:  # the union: each interface was checked by name
                 raise
-            raise ValueError(f"Interface {names[0]!r}: {error}") from None
+            raise InterfaceError(names[0], str(error)) from None
         maps = CellMaps(mesh, self.levelset)
         num_owned = mesh.topology.index_map(tdim).size_local
         owned = np.arange(num_owned, dtype=np.int32)

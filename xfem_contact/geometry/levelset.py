@@ -19,6 +19,15 @@ from mpi4py import MPI
 LevelSetCallable = Callable[[np.ndarray], np.ndarray]
 
 
+class InterfaceError(ValueError):
+    """A level set refused for the interface ``name``: ``message`` says why (a scene
+    prefixes it with the interface's key)."""
+
+    def __init__(self, name: str, message: str):
+        self.name, self.message = name, message
+        super().__init__(f"Interface {name!r}: {message}")
+
+
 class LevelSet(typing.NamedTuple):
     """A level set interpolated into Lagrange degree 1 or 2.
 
@@ -92,11 +101,19 @@ def interpolate(
     else:
         raise ValueError(f"A level set is a callable or a dolfinx Function, not {type(levelset)}")
     values = phi.x.array
-    bad = np.flatnonzero(~np.isfinite(values))
+    owned = V.dofmap.index_map.size_local
+    bad = np.flatnonzero(~np.isfinite(values[:owned]))
     comm = mesh.comm
-    if comm.allreduce(bad.size, op=MPI.SUM):
-        where = V.tabulate_dof_coordinates()[bad[:1]] if bad.size else None
-        raise ValueError(f"The level set has NaN/inf values (first at x = {where})")
+    count = comm.allreduce(bad.size, op=MPI.SUM)
+    if count:
+        # the lowest such node (by y, then x) of all processes: one message for any partition
+        local = np.round(V.tabulate_dof_coordinates()[bad, :2], 12) + 0.0  # no 1e-18 or -0
+        points = np.concatenate(comm.allgather(local[np.lexsort(local.T)[:1]]))
+        x, y = points[np.lexsort(points.T)[0]]
+        raise ValueError(
+            f"The level set is NaN or inf at {count} node(s), e.g. at x = ({x:.6g}, "
+            f"{y:.6g}): give one that is finite on the whole mesh"
+        )
     lo = comm.allreduce(values.min(initial=np.inf), op=MPI.MIN)
     hi = comm.allreduce(values.max(initial=-np.inf), op=MPI.MAX)
     # Canonical nodal values. A node shared by several cells is interpolated from one
@@ -108,10 +125,17 @@ def interpolate(
     # take their owner's value.
     values[np.abs(values) <= ZERO_TOLERANCE * max(abs(lo), abs(hi))] = 0.0
     phi.x.scatter_forward()
-    if not (lo < 0.0 <= hi):
+    if lo >= 0.0:
         raise ValueError(
-            f"The level set never crosses zero on the mesh (its nodal values lie in "
-            f"[{lo:.6g}, {hi:.6g}]): there is no interface; the side phi < 0 is side -1"
+            f"The interface does not cross the mesh: its level set never crosses zero (it "
+            f"is >= 0 at every node, from {lo:.6g} to {hi:.6g}), so no node lies inside it. "
+            "Move or enlarge the interface, or refine the mesh, so that it crosses the mesh"
+        )
+    if hi < 0.0:
+        raise ValueError(
+            f"The interface does not cross the mesh: its level set never crosses zero (it "
+            f"is < 0 at every node, from {lo:.6g} to {hi:.6g}), so every node lies inside "
+            "it. Move or shrink the interface so that it crosses the mesh"
         )
     if into is not None:
         into.x.array[:] = phi.x.array
@@ -207,8 +231,8 @@ def union(
         degree: Interpolation degree (1 or 2) used for the checks.
 
     Raises:
-        ValueError: naming the interface that never crosses the mesh, or the two
-            interfaces whose insides overlap or that cut the same cells.
+        InterfaceError: naming the interface that does not cross the mesh, or the
+            second of two interfaces whose insides overlap or that cut the same cells.
     """
     names = list(levelsets)
     inside, cut = {}, {}
@@ -216,7 +240,7 @@ def union(
         try:
             phi = interpolate(mesh, levelsets[name], degree).function
         except ValueError as error:
-            raise ValueError(f"Interface {name!r}: {error}") from None
+            raise InterfaceError(name, str(error)) from None
         values = phi.x.array
         owned = phi.function_space.dofmap.index_map.size_local
         inside[name] = values[:owned] < 0.0
@@ -227,15 +251,17 @@ def union(
     for i, a in enumerate(names):
         for b in names[i + 1 :]:
             if comm.allreduce(int(np.count_nonzero(inside[a] & inside[b])), op=MPI.SUM):
-                raise ValueError(
-                    f"Interfaces {a!r} and {b!r} overlap (mesh nodes lie inside both): "
-                    "nested or intersecting interfaces are not supported"
+                raise InterfaceError(
+                    b,
+                    f"overlaps interface {a!r} (mesh nodes lie inside both): nested or "
+                    "intersecting interfaces are not supported",
                 )
             shared = comm.allreduce(int(np.count_nonzero(cut[a] & cut[b])), op=MPI.SUM)
             if shared:
-                raise ValueError(
-                    f"Interfaces {a!r} and {b!r} cut the same {shared} cell(s): keep at "
-                    "least one cell between them (refine the mesh or move them apart)"
+                raise InterfaceError(
+                    b,
+                    f"cuts the same {shared} cell(s) as interface {a!r}: keep at least one "
+                    "cell between them (refine the mesh or move them apart)",
                 )
     functions = [levelsets[name] for name in names]
 

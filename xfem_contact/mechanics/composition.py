@@ -61,7 +61,7 @@ class SideMaterials(typing.NamedTuple):
     """A problem's materials as its forms see them (see :func:`side_and_law_materials`)."""
 
     #: Per side, what the bulk uses: ``Moduli``, or a ``MaterialField`` on side -1
-    #: when the inclusions differ
+    #: when several interfaces have a material each
     bulk: dict[int, Moduli | MaterialField]
     #: Per interface name, ``{-1: Moduli, 1: Moduli}`` (the laws' view)
     laws: dict[str, dict[int, Moduli]]
@@ -70,9 +70,11 @@ class SideMaterials(typing.NamedTuple):
 
 
 def side_and_law_materials(cut: CutMesh, materials: Materials) -> SideMaterials:
-    """The :class:`Moduli` (Constants on ``cut.mesh``) of the materials given: one
-    per distinct :class:`Material`, shared by the bulk and the laws, so that setting
-    its ``E`` or ``nu`` changes every form that uses it. Collective (DG0 fields)."""
+    """The :class:`Moduli` (Constants on ``cut.mesh``) of the materials given: one for
+    side +1, and one for side -1 or, when side -1 maps interface names to materials,
+    one per interface. Each is shared by the bulk and the laws, so that setting its
+    ``E`` or ``nu`` changes every form that uses it, and no other material, even where
+    the values given were equal. Collective (DG0 fields)."""
     if isinstance(materials, Material):
         materials = {-1: materials, 1: materials}
     if not isinstance(materials, Mapping):
@@ -89,24 +91,23 @@ def side_and_law_materials(cut: CutMesh, materials: Materials) -> SideMaterials:
             raise ValueError(
                 f"materials[-1] must name the interfaces {list(names)}; got {sorted(inside)}"
             )
-        per_interface = dict(inside)
+        given = dict(inside)
     else:
-        per_interface = {name: inside for name in names}
-    for key, m in [*per_interface.items(), (1, materials[1])]:
+        given = {-1: inside}
+    for key, m in [*given.items(), (1, materials[1])]:
         if not isinstance(m, Material):
             raise ValueError(f"materials[{key!r}]: give a Material, got {m!r}")
-    moduli: dict[Material, Moduli] = {}
-    for m in [*per_interface.values(), materials[1]]:
-        if m not in moduli:
-            moduli[m] = Moduli(m, cut.mesh)
-    inside_moduli = {name: moduli[per_interface[name]] for name in names}
-    outside = moduli[materials[1]]
-    distinct = list(dict.fromkeys(inside_moduli.values()))
-    side_minus = (
-        MaterialField(cut.cell_regions(), [inside_moduli[n] for n in names])
-        if len(distinct) > 1
-        else distinct[0]
-    )
-    laws = {name: {-1: inside_moduli[name], 1: outside} for name in names}
-    user_inside = inside_moduli if isinstance(inside, Mapping) else distinct[0]
+    outside = Moduli(materials[1], cut.mesh)
+    if isinstance(inside, Mapping):
+        per_interface = {name: Moduli(inside[name], cut.mesh) for name in names}
+        user_inside = per_interface
+        side_minus = (
+            MaterialField(cut.cell_regions(), [per_interface[n] for n in names])
+            if len(names) > 1
+            else per_interface[names[0]]
+        )
+    else:
+        side_minus = user_inside = Moduli(inside, cut.mesh)
+        per_interface = {name: side_minus for name in names}
+    laws = {name: {-1: per_interface[name], 1: outside} for name in names}
     return SideMaterials({-1: side_minus, 1: outside}, laws, {-1: user_inside, 1: outside})

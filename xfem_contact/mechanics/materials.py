@@ -100,9 +100,21 @@ class Moduli:
     nu = Parameter("1", minimum=-1.0, strict=True, maximum=0.5)
 
     def __init__(self, material: Material, mesh: dolfinx.mesh.Mesh):
-        self.plane = material.plane
+        self._plane = material.plane
         self.E, self.nu = material.E, material.nu
         bind(self, mesh)
+
+    @property
+    def plane(self) -> str:
+        """``"strain"`` or ``"stress"``: fixed, the forms are built with it."""
+        return self._plane
+
+    @plane.setter
+    def plane(self, value) -> None:
+        raise ValueError(
+            f"plane is fixed when the forms are built (it is {self._plane!r}); build the "
+            f"problem with Material(E, nu, plane={value!r}) instead"
+        )
 
     @property
     def material(self) -> Material:

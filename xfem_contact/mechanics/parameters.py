@@ -16,10 +16,12 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import numbers
 from collections.abc import Callable
 
 import dolfinx.fem
 import dolfinx.mesh
+import numpy as np
 
 _STORE = "_parameters"
 
@@ -33,6 +35,12 @@ class _Store:
     mesh: dolfinx.mesh.Mesh | None = None
     #: Called with (name, value) after every change (e.g. to refill a DG0 field)
     listeners: list[Callable[[str, float], None]] = dataclasses.field(default_factory=list)
+
+
+def is_number(value) -> bool:
+    """Whether ``value`` is a real number (Python's or NumPy's), neither a bool nor a
+    string: what every parameter, magnitude and time accepts."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool | np.bool_)
 
 
 def _store(obj) -> _Store:
@@ -94,17 +102,15 @@ class Parameter:
         return " and ".join(parts) + ("" if self.unit == "1" else f" {self.unit}")
 
     def check(self, value, what: str) -> float:
-        """``value`` as a float, or a ValueError naming ``what`` and the valid range."""
-        try:
-            x = float(value)
-        except (TypeError, ValueError):
-            raise ValueError(f"{what} must be a number, got {value!r}") from None
+        """``value`` as a float, or a one-line ValueError naming ``what`` and the valid
+        range (strings and bools are refused: ``"0.3"`` is not a number)."""
+        x = float(value) if is_number(value) else math.nan
         low = self.minimum is not None and (x <= self.minimum if self.strict else x < self.minimum)
         high = self.maximum is not None and x >= self.maximum
         if not math.isfinite(x) or low or high:
             valid = self.requirement()
             raise ValueError(
-                f"{what} must be finite{' and ' + valid if valid else ''}, got {value!r}"
+                f"{what} must be a finite number{' ' + valid if valid else ''}, got {value!r}"
             )
         return x
 

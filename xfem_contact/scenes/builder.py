@@ -14,6 +14,7 @@ import ufl
 from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.geometry.levelset import InterfaceError
 from xfem_contact.io.gmsh import GmshMesh, facets, read_gmsh
 from xfem_contact.io.meshes import annulus
 from xfem_contact.mechanics.laws import make_law
@@ -119,6 +120,13 @@ def interface_levelsets(scene: Scene) -> dict[str, Callable]:
     return {spec.name: levelset(spec) for spec in scene.interfaces}
 
 
+def interface_error(scene: Scene, error: InterfaceError) -> SceneError:
+    """A level set refused for an interface, as a SceneError naming its key
+    (``interfaces[1]``)."""
+    index = [spec.name for spec in scene.interfaces].index(error.name)
+    return SceneError(f"interfaces[{index}]", error.message)
+
+
 def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
     """Create the mesh and the problem of a scene (collective). Returns (problem, effects)."""
     meshed = create_mesh(scene, comm)
@@ -140,12 +148,15 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
         if scene.cracks:
             cut, laws, materials, options = crack_cut(scene, mesh, interface_levelsets(scene))
         else:
-            cut = CutMesh(
-                mesh,
-                interface_levelsets(scene),
-                degree=scene.levelset_degree,
-                quadrature_degree=scene.quadrature_degree,
-            )
+            try:
+                cut = CutMesh(
+                    mesh,
+                    interface_levelsets(scene),
+                    degree=scene.levelset_degree,
+                    quadrature_degree=scene.quadrature_degree,
+                )
+            except InterfaceError as error:
+                raise interface_error(scene, error) from None
             laws = {
                 spec.name: make_law(
                     spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb

@@ -23,12 +23,14 @@ from ufl.algorithms import extract_arguments, extract_coefficients
 from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw
 from xfem_contact.mechanics.laws.contact import ContactLaw, CoulombFriction
-from xfem_contact.mechanics.parameters import constant
+from xfem_contact.mechanics.parameters import Parameter, constant
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES, SlidingCoupling
 
 #: LBB treatments available in large sliding (the restriction needs a prolongation
 #: the hybrid element's assembly does not apply)
 SLIDING_LBB = ("stabilized", "none")
+#: The pairing's search radius (m), when given
+RADIUS = Parameter("m", minimum=0.0, strict=True)
 
 
 class SlidingContact(ContactLaw):
@@ -69,8 +71,21 @@ class SlidingContact(ContactLaw):
             raise ValueError(f"slave must be the side -1 or +1, got {slave!r}")
         if pairing not in PAIRING_UPDATES:
             raise ValueError(f"pairing must be one of {PAIRING_UPDATES}, got {pairing!r}")
+        if radius is not None:
+            radius = RADIUS.check(radius, "radius (of the pairing search)")
         self.slave, self.pairing, self.radius = slave, pairing, radius
-        self.segments = bool(segments)
+        self.segments = segments
+
+    @property
+    def segments(self) -> bool:
+        """Whether the pairing integrates segment to segment (settable between solves)."""
+        return self._segments
+
+    @segments.setter
+    def segments(self, value: bool) -> None:
+        if not isinstance(value, bool | np.bool_):
+            raise ValueError(f"segments must be True or False, got {value!r}")
+        self._segments = bool(value)
 
     def describe(self) -> dict:
         return super().describe() | {

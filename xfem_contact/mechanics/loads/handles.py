@@ -7,6 +7,7 @@ set, and ``apply(t)`` sets its factor ``history(t)``. Setting a value changes da
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping
 
 import dolfinx.fem
@@ -14,6 +15,23 @@ import numpy as np
 
 from xfem_contact.mechanics.loads.history import History
 from xfem_contact.mechanics.loads.values import finite_number, nodal_values, set_constant
+from xfem_contact.mechanics.parameters import Parameter
+
+#: A tangential spring's stiffness (Pa/m)
+STIFFNESS = Parameter("Pa/m", minimum=0.0, strict=True)
+
+
+def rotation_angle(angle, name: str = "angle") -> float:
+    """``angle`` (rad) as a float: a finite number, refused in one line naming ``name``;
+    warns (at the caller's caller) beyond a full turn: degrees given as radians?"""
+    angle = finite_number(angle, name)
+    if abs(angle) > 2 * np.pi:
+        warnings.warn(
+            f"{name}={angle} rad is more than a full turn; for degrees use angle_deg=",
+            UserWarning,
+            stacklevel=3,
+        )
+    return angle
 
 
 class Load:
@@ -120,7 +138,8 @@ class RotationLoad(Load):
         self.functions, self.arms, self.centre = functions, arms, centre
         #: ``(dofs (k, 2), reference nodes (k, 2))`` of the rotated bodies (predictor)
         self.nodes = nodes
-        self.value = angle
+        self._angle = angle  # checked by the caller
+        self.apply(self._t)
 
     @property
     def value(self) -> float:
@@ -129,7 +148,7 @@ class RotationLoad(Load):
 
     @value.setter
     def value(self, angle: float) -> None:
-        self._angle = finite_number(angle, "angle")
+        self._angle = rotation_angle(angle)
         self.apply(self._t)
 
     def apply(self, t: float) -> None:
@@ -167,7 +186,4 @@ class SpringSupport(Load):
 
     @value.setter
     def value(self, stiffness: float) -> None:
-        stiffness = finite_number(stiffness, "stiffness")
-        if not stiffness > 0.0:
-            raise ValueError(f"The spring stiffness must be > 0 Pa/m, got {stiffness}")
-        self.stiffness.value = stiffness
+        self.stiffness.value = STIFFNESS.check(stiffness, "The spring stiffness")

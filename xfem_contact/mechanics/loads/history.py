@@ -9,10 +9,11 @@ the ramp from 0 at ``start`` to 1 at ``end``.
 
 from __future__ import annotations
 
-import numbers
 from collections.abc import Mapping, Sequence
 
 import numpy as np
+
+from xfem_contact.mechanics.parameters import is_number
 
 
 class History:
@@ -67,7 +68,7 @@ def check_stage(name, start, end) -> tuple[float, float]:
     if not isinstance(name, str) or not name:
         raise ValueError(f"A stage name must be a non-empty string, got {name!r}")
     for label, value in (("start", start), ("end", end)):
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        if not is_number(value):
             raise ValueError(f"stage {name!r}: {label} must be a number, got {value!r}")
         if not np.isfinite(value):
             raise ValueError(f"stage {name!r}: {label} must be finite, got {value}")
@@ -80,6 +81,6 @@ def load_steps(n: int, end: float = 1.0) -> np.ndarray:
     """The pseudo-times ``t_k = k end / n``, k = 1..n, of ``n`` equal steps (n >= 1)."""
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
         raise ValueError(f"The number of load steps must be an integer >= 1, got {n!r}")
-    if not (np.isfinite(end) and end > 0):
+    if not (is_number(end) and np.isfinite(end) and end > 0):
         raise ValueError(f"The end time must be a finite number > 0, got {end!r}")
     return np.arange(1, n + 1) * (end / n)

@@ -9,7 +9,6 @@ the residual, the tangential springs and the rotations, each with its own load p
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 
 import dolfinx.fem
@@ -24,13 +23,18 @@ from xfem_contact.mechanics.loads.handles import (
     Load,
     RotationLoad,
     SpringSupport,
+    rotation_angle,
 )
 from xfem_contact.mechanics.loads.history import History, check_stage, stage_history
 from xfem_contact.mechanics.loads.parts import Part, boundary_facets, named_parts
 from xfem_contact.mechanics.loads.values import finite_number, form_magnitude
+from xfem_contact.mechanics.parameters import Parameter
 
 #: A load path: None (factor = t), ``[(t, factor), ...]``, or a stage name
 Path = None | str | Sequence[Sequence[float]]
+#: The pseudo-time: from 0 (no load) on; a negative time would flip every load of the
+#: default path ``f = t``
+TIME = Parameter(minimum=0.0)
 
 
 class Loads:
@@ -90,9 +94,10 @@ class Loads:
         return self._time
 
     def set_time(self, t: float) -> None:
-        """Set the pseudo-time ``t``: every load takes its value ``history(t)`` times its
-        magnitude. Not collective (sets local data)."""
-        t = finite_number(t, "t")
+        """Set the pseudo-time ``t`` (>= 0; the unloaded state is ``t = 0``): every load
+        takes its value ``history(t)`` times its magnitude. Not collective (sets local
+        data)."""
+        t = TIME.check(t, "pseudo-time t")
         self._time = t
         for load in self.items:
             load.apply(t)
@@ -217,13 +222,8 @@ class Loads:
             raise ValueError("Give the rotation as angle= (rad) or angle_deg= (degrees), once")
         if angle_deg is not None:
             angle = np.deg2rad(finite_number(angle_deg, "angle_deg"))
-        angle = finite_number(angle, "angle")
-        if abs(angle) > 2 * np.pi:
-            warnings.warn(
-                f"angle={angle} rad is more than a full turn; for degrees use angle_deg=",
-                UserWarning,
-                stacklevel=2,
-            )
+        else:
+            angle = rotation_angle(angle)
         try:
             centre = np.asarray(centre, dtype=float)
         except (TypeError, ValueError):

@@ -9,34 +9,29 @@ check raises a one-line ValueError naming the argument.
 
 from __future__ import annotations
 
-import numbers
 from collections.abc import Callable
 
 import dolfinx.fem
 import numpy as np
 import ufl
 
-
-def _is_number(value) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+from xfem_contact.mechanics.parameters import is_number
 
 
 def numeric(value, shape: tuple[int, ...], name: str) -> np.ndarray | None:
     """``value`` as a finite float array of ``shape`` if it is a number or a sequence of
     numbers (None if it is something else: an expression, a callable)."""
-    if _is_number(value):
+    if is_number(value):
         array = np.asarray(float(value))
     elif isinstance(value, list | tuple | np.ndarray) and all(
-        _is_number(v) for v in np.ravel(np.asarray(value, dtype=object))
+        is_number(v) for v in np.ravel(np.asarray(value, dtype=object))
     ):
         array = np.asarray(value, dtype=float)
     else:
         return None
-    if array.shape != shape:
-        expected = "a number" if shape == () else f"{shape[0]} numbers (a vector)"
+    if array.shape != shape or not np.isfinite(array).all():
+        expected = "a finite number" if shape == () else f"{shape[0]} finite numbers (a vector)"
         raise ValueError(f"{name} must be {expected}, got {value!r}")
-    if not np.isfinite(array).all():
-        raise ValueError(f"{name} must be finite, got {value!r}")
     return array
 
 
@@ -112,11 +107,10 @@ def nodal_values(
             message = f"{name}: the callable returned values that are not finite"
         values = array.T.ravel() if not message else None
     else:
-        array = numeric(value, () if _is_number(value) else shape, name)  # a number: each
+        array = numeric(value, () if is_number(value) else shape, name)  # a number: each
         if array is None:
-            raise ValueError(
-                f"{name} must be a number, {bs} numbers or a callable of x, got {value!r}"
-            )
+            numbers = "" if bs == 1 else f", {bs} numbers"
+            raise ValueError(f"{name} must be a number{numbers} or a callable of x, got {value!r}")
         nodes = V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts
         values = np.broadcast_to(array, (nodes, bs)).ravel().copy()
     messages = [m for m in V.mesh.comm.allgather(message) if m]
@@ -127,6 +121,6 @@ def nodal_values(
 
 def finite_number(value, name: str) -> float:
     """``value`` as a float; ValueError naming ``name`` unless a finite number."""
-    if not _is_number(value) or not np.isfinite(value):
+    if not is_number(value) or not np.isfinite(value):
         raise ValueError(f"{name} must be a finite number, got {value!r}")
     return float(value)
