@@ -81,9 +81,9 @@ def evaluate(C: np.ndarray, X: np.ndarray) -> np.ndarray:
     """Values at points ``X`` ``(m, 3)`` of polynomials ``C`` ``(m, p+1, p+1, p+1)`` (one
     polynomial per point), shape ``(m,)``."""
     p = C.shape[1] - 1
-    return np.einsum(
-        "mijk,mi,mj,mk->m", C, _powers(X[:, 0], p), _powers(X[:, 1], p), _powers(X[:, 2], p)
-    )
+    along_z = np.einsum("mijk,mk->mij", C, _powers(X[:, 2], p))
+    along_y = np.einsum("mij,mj->mi", along_z, _powers(X[:, 1], p))
+    return np.einsum("mi,mi->m", along_y, _powers(X[:, 0], p))
 
 
 def derivative(C: np.ndarray, axis: int) -> np.ndarray:
@@ -119,15 +119,13 @@ def bernstein(C: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     p = C.shape[1] - 1
     t = np.arange(p + 1) / p
     grid = lo[:, None, :] + (hi - lo)[:, None, :] * t[None, :, None]  # (m, p+1, 3)
-    values = np.einsum(
-        "mijk,mai,mbj,mck->mabc",
-        C,
-        _powers(grid[:, :, 0], p),
-        _powers(grid[:, :, 1], p),
-        _powers(grid[:, :, 2], p),
-    )
+    values = np.einsum("mijk,mck->mijc", C, _powers(grid[:, :, 2], p))
+    values = np.einsum("mijc,mbj->mibc", values, _powers(grid[:, :, 1], p))
+    values = np.einsum("mibc,mai->mabc", values, _powers(grid[:, :, 0], p))
     T = _to_bernstein(p)
-    return np.einsum("ia,jb,kc,mabc->mijk", T, T, T, values)
+    values = np.einsum("ia,mabc->mibc", T, values)
+    values = np.einsum("jb,mibc->mijc", T, values)
+    return np.einsum("kc,mijc->mijk", T, values)
 
 
 def line_coefficients(C: np.ndarray, axis: int, X: np.ndarray) -> np.ndarray:
@@ -136,7 +134,8 @@ def line_coefficients(C: np.ndarray, axis: int, X: np.ndarray) -> np.ndarray:
     p = C.shape[1] - 1
     others = [d for d in range(3) if d != axis]
     Cp = np.moveaxis(C, axis + 1, 3)  # (m, i, j, t) with i, j the other axes in order
-    return np.einsum("mijt,mi,mj->mt", Cp, _powers(X[:, others[0]], p), _powers(X[:, others[1]], p))
+    along = np.einsum("mijt,mj->mit", Cp, _powers(X[:, others[1]], p))
+    return np.einsum("mit,mi->mt", along, _powers(X[:, others[0]], p))
 
 
 def line_roots(c: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:

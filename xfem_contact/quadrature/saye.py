@@ -25,7 +25,7 @@ On a box ``U = [lo, hi]`` of the reference cube, with ``psi`` the cell's level s
 4. When no pair is valid the box is split in eight, down to ``max_depth`` levels; a box
    at that depth that still has none uses the best monotone height axis alone (a
    lower-order rule on a box of size ``2^-max_depth``; the cell is reported in
-   :attr:`HexCutRules.reduced`), and one with no monotone axis at all (a singular
+   :attr:`CutRules.reduced`), and one with no monotone axis at all (a singular
    point of the zero set: a saddle or a cone) is refused with a ``ValueError`` naming
    the cell and the box.
 
@@ -62,7 +62,15 @@ from xfem_contact.geometry.tensor_levelset import (
 from xfem_contact.quadrature.rules import RuleSet
 from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
 
-__all__ = ["MAX_DEPTH", "HexCutRules", "classify_hexes", "hex_cut_rules"]
+__all__ = [
+    "MAX_DEPTH",
+    "CutRules",
+    "SayePoints",
+    "certified_sides",
+    "classify_hexes",
+    "hex_cut_rules",
+    "saye_points",
+]
 
 MAX_DEPTH = 6
 """Default number of box subdivision levels of :func:`hex_cut_rules`."""
@@ -71,15 +79,16 @@ _PAIRS = [(k3, k2) for k3 in range(3) for k2 in range(3) if k2 != k3]
 
 
 @dataclass(frozen=True)
-class HexCutRules:
-    """Rules of hexahedra cut by Q1/Q2 level sets, one rule per cell (row of ``phi``).
+class CutRules:
+    """Rules of cells cut by a level set, one rule per cell (row of ``phi``).
 
     Attributes:
         minus: Side -1, points ``(N, 3)`` in reference coordinates, weights in the
             reference measure (all positive).
         plus: Side +1, likewise.
         interface: Interface, weights ``ds / |det J|`` and unit normals ``(N, 3)`` from
-            side -1 to side +1 (see :func:`~xfem_contact.quadrature.surface_rules.surface_rules`).
+            side -1 to side +1 (see
+            :func:`~xfem_contact.quadrature.surface_rules.surface_rules`).
         reduced: Rows of the cells where a box at the maximum depth used the lower-order
             rule (see the module), sorted.
     """
@@ -101,7 +110,12 @@ def classify_hexes(phi: npt.ArrayLike, degree: int) -> npt.NDArray[np.int8]:
     Returns:
         ``int8`` array of shape ``(ncells,)``.
     """
-    C = coefficients(phi, degree)
+    return certified_sides(coefficients(phi, degree))
+
+
+def certified_sides(C: np.ndarray) -> npt.NDArray[np.int8]:
+    """-1 / +1 / 0 per polynomial ``C`` ``(n, p+1, p+1, p+1)`` on the unit cube by its
+    Bernstein coefficients (see :func:`classify_hexes`)."""
     n = C.shape[0]
     B = bernstein(C, np.zeros((n, 3)), np.ones((n, 3))).reshape(n, -1)
     return np.where((B < 0).all(axis=1), -1, np.where((B >= 0).all(axis=1), 1, 0)).astype(np.int8)
@@ -114,7 +128,7 @@ def hex_cut_rules(
     *,
     max_depth: int = MAX_DEPTH,
     jacobian: Jacobian | None = None,
-) -> HexCutRules:
+) -> CutRules:
     """Saye's rules of both sides and of the interface of every cell (see the module).
 
     Args:
@@ -127,17 +141,64 @@ def hex_cut_rules(
             ``None``: reference cells.
 
     Returns:
-        A :class:`HexCutRules`; a cell entirely on one side gets a tensor rule there.
+        A :class:`CutRules`; a cell entirely on one side gets a tensor rule there.
 
     Raises:
         ValueError: Bad input, or a cell whose zero set has a singular point (no monotone
             axis in a box at ``max_depth``); the message names the cell and the box.
     """
+    C = coefficients(phi, degree)
+    ncells = C.shape[0]
+    points = saye_points(C, order, max_depth=max_depth)
+    rows, X, w, area = points.interface
+    return CutRules(
+        _side_rule(*points.minus, ncells),
+        _side_rule(*points.plus, ncells),
+        surface_rules(X, area, w, rows, ncells, jacobian),
+        points.reduced,
+    )
+
+
+@dataclass(frozen=True)
+class SayePoints:
+    """Saye's rules on the unit cube of tensor polynomials, as point lists sorted by row.
+
+    Attributes:
+        minus: ``(rows (N,), X (N, 3), w (N,))`` of side -1, weights in the cube's measure.
+        plus: Likewise for side +1.
+        interface: ``(rows, X, w, area)``: weights in the surface parameter and area
+            vectors ``(N, 3)`` (see :mod:`xfem_contact.quadrature.surface_rules`).
+        reduced: Rows where a box at the maximum depth used the lower-order rule, sorted.
+    """
+
+    minus: tuple[np.ndarray, np.ndarray, np.ndarray]
+    plus: tuple[np.ndarray, np.ndarray, np.ndarray]
+    interface: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+    reduced: npt.NDArray[np.int64]
+
+
+def saye_points(
+    C: np.ndarray, order: int, *, max_depth: int = MAX_DEPTH, kind: str = "hexahedron"
+) -> SayePoints:
+    """Saye's rules (see the module) of polynomials on the unit cube.
+
+    Args:
+        C: Monomial coefficients, shape ``(ncells, p + 1, p + 1, p + 1)``
+            (:func:`~xfem_contact.geometry.tensor_levelset.coefficients`).
+        order: Gauss-Legendre points per interval.
+        max_depth: Box subdivision levels.
+        kind: The cells' name in error messages.
+
+    Returns:
+        A :class:`SayePoints`.
+
+    Raises:
+        ValueError: Bad ``order`` or ``max_depth``, or a singular point of a zero set.
+    """
     if not (isinstance(order, int) and order >= 1):
         raise ValueError(f"order must be a positive int (Gauss points per interval), got {order!r}")
     if not (isinstance(max_depth, int) and max_depth >= 0):
         raise ValueError(f"max_depth must be a non-negative int, got {max_depth!r}")
-    C = coefficients(phi, degree)
     ncells = C.shape[0]
     gx, gw = np.polynomial.legendre.leggauss(order)
     gauss = (0.5 * (gx + 1.0), 0.5 * gw)
@@ -156,14 +217,13 @@ def hex_cut_rules(
         if cell.size == 0:
             break
         pair, height = _choose_axes(C[cell], lo, hi)
-        last = depth == max_depth
-        if last:
+        if depth == max_depth:
             bad = np.flatnonzero((pair < 0) & (height < 0))
             if bad.size:
                 b = bad[0]
                 raise ValueError(
-                    f"hexahedron {cell[b]}: the level set has a singular point on its zero set "
-                    f"in the box {lo[b].tolist()} .. {hi[b].tolist()} (reference coordinates; "
+                    f"{kind} {cell[b]}: the level set has a singular point on its zero set "
+                    f"in the box {lo[b].tolist()} .. {hi[b].tolist()} (unit-cube coordinates; "
                     f"no monotone axis after {max_depth} subdivisions); {bad.size} box(es)"
                 )
             fallback = pair < 0
@@ -175,11 +235,10 @@ def hex_cut_rules(
                 _box_rules(C, cell[group], lo[group], hi[group], k3, k2, gauss, parts)
         split = pair < 0
         cell, lo, hi = _subdivide(cell[split], lo[split], hi[split])
-    rows, X, w, area = _gather(parts["interface"], (1, 3, 1, 3))
-    return HexCutRules(
-        _side_rule(parts["minus"], ncells),
-        _side_rule(parts["plus"], ncells),
-        surface_rules(X, area, w, rows, ncells, jacobian),
+    return SayePoints(
+        tuple(_gather(parts["minus"], (1, 3, 1))),
+        tuple(_gather(parts["plus"], (1, 3, 1))),
+        tuple(_gather(parts["interface"], (1, 3, 1, 3))),
         np.unique(np.concatenate(reduced)).astype(np.int64) if reduced else np.zeros(0, np.int64),
     )
 
@@ -337,7 +396,6 @@ def _gather(parts, widths: tuple[int, ...]) -> list[np.ndarray]:
     return columns
 
 
-def _side_rule(parts, ncells: int) -> RuleSet:
-    """A :class:`RuleSet` of ``ncells`` rules from pieces ``(rows, X, w)``."""
-    rows, X, w = _gather(parts, (1, 3, 1))
+def _side_rule(rows: np.ndarray, X: np.ndarray, w: np.ndarray, ncells: int) -> RuleSet:
+    """A :class:`RuleSet` of ``ncells`` rules from points sorted by row."""
     return RuleSet(X, w, np.searchsorted(rows, np.arange(ncells + 1)).astype(np.int64))
