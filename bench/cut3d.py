@@ -52,10 +52,31 @@ def origins(n: int) -> np.ndarray:
     return np.array(list(itertools.product(range(n), repeat=3)), dtype=float) / n
 
 
+def kuhn_mesh(n: int, perturb: float = 0.0) -> np.ndarray:
+    """Vertices ``(6 n^3, 4, 3)`` of the Kuhn tetrahedra of ``n^3`` cubes; with ``perturb``
+    every mesh vertex moves by a random vector of at most ``perturb h`` per coordinate
+    (seeded; an unstructured-like mesh)."""
+    index = (
+        np.array(list(itertools.product(range(n), repeat=3)))[:, None, None]
+        + np.array(KUHN, dtype=int)[None]
+    ).reshape(-1, 3)
+    move = np.random.default_rng(0).uniform(-perturb, perturb, size=(n + 1, n + 1, n + 1, 3))
+    vertices = ((index + move[index[:, 0], index[:, 1], index[:, 2]]) / n).reshape(-1, 4, 3)
+    grid = index.reshape(-1, 4, 3).astype(float)
+    before = np.linalg.det(grid[:, 1:] - grid[:, :1])
+    after = np.linalg.det(vertices[:, 1:] - vertices[:, :1])
+    if (before * after <= 0).any():
+        raise ValueError(f"perturb = {perturb} inverts tetrahedra; use a smaller value")
+    return vertices
+
+
+PERTURB = 0.0
+"""Vertex perturbation of the tetrahedral meshes (``--perturb``)."""
+
+
 def sphere_tets(n: int, degree: int = 4) -> tuple[float, float, int]:
     """Volume, area and cut-cell count on ``6 n^3`` tetrahedra (P1 level set)."""
-    h = 1.0 / n
-    vertices = (origins(n)[:, None, None] + h * np.array(KUHN, dtype=float)[None]).reshape(-1, 4, 3)
+    vertices = kuhn_mesh(n, PERTURB)
     J = np.transpose(vertices[:, 1:] - vertices[:, :1], (0, 2, 1))
     detJ = np.abs(np.linalg.det(J))
     phi = level_set(vertices)
@@ -71,9 +92,8 @@ def sphere_tets(n: int, degree: int = 4) -> tuple[float, float, int]:
 
 def sphere_p2_tets(n: int, order: int = 4) -> tuple[float, float, int]:
     """Volume, area and cut-cell count on ``6 n^3`` tetrahedra (P2 level set, Saye's
-    rules on the collapsed cube)."""
-    h = 1.0 / n
-    vertices = (origins(n)[:, None, None] + h * np.array(KUHN, dtype=float)[None]).reshape(-1, 4, 3)
+    rules on its four hexahedra)."""
+    vertices = kuhn_mesh(n, PERTURB)
     J = np.transpose(vertices[:, 1:] - vertices[:, :1], (0, 2, 1))
     detJ = np.abs(np.linalg.det(J))
     element = basix.create_element(
@@ -214,7 +234,15 @@ def main() -> None:
         metavar="N",
         help="random cuts of one cell per kind (0: none)",
     )
+    parser.add_argument(
+        "--perturb",
+        type=float,
+        default=0.0,
+        help="random vertex moves of the tetrahedral meshes, in units of h",
+    )
     args = parser.parse_args()
+    global PERTURB
+    PERTURB = args.perturb
     for kind in args.kinds if args.fuzz else []:
         start = time.perf_counter()
         counts = fuzz_cells(kind, args.fuzz)

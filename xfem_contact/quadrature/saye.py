@@ -10,9 +10,10 @@ On a box ``U = [lo, hi]`` of the reference cube, with ``psi`` the cell's level s
    coefficients of ``d psi / d x_k3`` have one strict sign) and an axis ``k2`` along which
    each face function ``psi(x_k3 = lo_k3)``, ``psi(x_k3 = hi_k3)`` is monotone or free of
    zeros (coefficients of one strict sign, or all zero); ``k1`` is the third axis. Of the
-   valid pairs the one with the largest certified lower bound of ``|d psi / d x_k3|`` and
-   of the slopes ``|d psi / d x_k2|`` of the face functions that have zeros wins (steep
-   slopes keep the breakpoints smooth functions of the outer coordinates).
+   valid pairs the one whose certified slopes are steepest wins: the lower bound of
+   ``|d psi / d x_k3|`` relative to the bound of ``|grad psi|``, and of
+   ``|d psi / d x_k2|`` relative to the face gradient for face functions with zeros
+   (steep slopes keep the roots smooth functions of the outer coordinates).
 3. Nested one-dimensional Gauss-Legendre rules (``order`` points per interval): along
    ``k1`` on the intervals between the roots of ``psi`` on the four box edges parallel to
    ``k1``; at each such point, along ``k2`` between the roots of the two face functions;
@@ -255,18 +256,25 @@ def _choose_axes(C: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndar
     m = C.shape[0]
     B = bernstein(C, lo, hi)
     D = [bernstein(derivative(C, k), lo, hi) for k in range(3)]
-    margin = [np.abs(d).reshape(m, -1).min(axis=1) for d in D]
+    size = [np.abs(d).reshape(m, -1) for d in D]
+    steepest = np.maximum.reduce([a.max(axis=1) for a in size])
+    margin = [a.min(axis=1) / np.where(steepest > 0, steepest, 1.0) for a in size]
     monotone = [_certain(d)[0] for d in D]
     best, score = np.full(m, -1), np.full(m, -np.inf)
     for index, (k3, k2) in enumerate(_PAIRS):
+        k1 = 3 - k3 - k2
         valid = monotone[k3].copy()
         pair_score = margin[k3].copy()
         for end in (0, B.shape[1] - 1):
             face_sign, face_zero = _certain(np.take(B, end, axis=k3 + 1))
-            face_slope = np.take(D[k2], end, axis=k3 + 1)
-            face_monotone, _ = _certain(face_slope)
+            face_slope = np.abs(np.take(D[k2], end, axis=k3 + 1)).reshape(m, -1)
+            face_monotone, _ = _certain(np.take(D[k2], end, axis=k3 + 1))
             valid &= face_sign | face_zero | face_monotone
-            face_margin = np.abs(face_slope).reshape(m, -1).min(axis=1)
+            face_steepest = np.maximum(
+                face_slope.max(axis=1),
+                np.abs(np.take(D[k1], end, axis=k3 + 1)).reshape(m, -1).max(axis=1),
+            )
+            face_margin = face_slope.min(axis=1) / np.where(face_steepest > 0, face_steepest, 1.0)
             pair_score = np.minimum(
                 pair_score, np.where(face_sign | face_zero, np.inf, face_margin)
             )
