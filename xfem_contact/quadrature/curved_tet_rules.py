@@ -28,8 +28,13 @@ import numpy as np
 import numpy.typing as npt
 
 from xfem_contact.geometry.tensor_levelset import coefficients
-from xfem_contact.quadrature.rules import RuleSet
-from xfem_contact.quadrature.saye import MAX_DEPTH, CutRules, certified_sides, saye_points
+from xfem_contact.quadrature.saye import (
+    MAX_DEPTH,
+    CutRules,
+    certified_sides,
+    rules_from_points,
+    saye_points,
+)
 from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
 
 __all__ = ["HEXAHEDRA", "classify_p2_tets", "hexahedron_map", "p2_tet_cut_rules"]
@@ -152,16 +157,13 @@ def p2_tet_cut_rules(
     for rows, U, w in (points.minus, points.plus):
         X, J = _mapped(rows, U)
         weights = w * np.linalg.det(J)
-        sides.append(_rules(rows // 4, X, weights, ncells))
+        sides.append(rules_from_points(rows // 4, X, weights, ncells))
     rows, U, w, area = points.interface
     X, J = _mapped(rows, U)
     c0, c1, c2 = J[:, :, 0], J[:, :, 1], J[:, :, 2]
     cofactor = np.stack([np.cross(c1, c2), np.cross(c2, c0), np.cross(c0, c1)], axis=2)
     area = np.einsum("nij,nj->ni", cofactor, area)  # det(J) J^{-T} a
-    order_ = np.argsort(rows // 4, kind="stable")
-    interface = surface_rules(
-        X[order_], area[order_], w[order_], (rows // 4)[order_], ncells, jacobian
-    )
+    interface = surface_rules(X, area, w, rows // 4, ncells, jacobian)  # rows are sorted
     reduced = np.unique(points.reduced // 4).astype(np.int64)
     return CutRules(*sides, interface, reduced)
 
@@ -174,10 +176,3 @@ def _mapped(rows: np.ndarray, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         mine = rows % 4 == k
         X[mine], J[mine] = hexahedron_map(U[mine], k)
     return X, J
-
-
-def _rules(cells: np.ndarray, X: np.ndarray, w: np.ndarray, ncells: int) -> RuleSet:
-    """A :class:`RuleSet` of ``ncells`` rules from points of cells ``cells`` (sorted)."""
-    order = np.argsort(cells, kind="stable")
-    offsets = np.searchsorted(cells[order], np.arange(ncells + 1)).astype(np.int64)
-    return RuleSet(X[order], w[order], offsets)

@@ -70,6 +70,7 @@ __all__ = [
     "certified_sides",
     "classify_hexes",
     "hex_cut_rules",
+    "rules_from_points",
     "saye_points",
 ]
 
@@ -153,8 +154,8 @@ def hex_cut_rules(
     points = saye_points(C, order, max_depth=max_depth)
     rows, X, w, area = points.interface
     return CutRules(
-        _side_rule(*points.minus, ncells),
-        _side_rule(*points.plus, ncells),
+        rules_from_points(*points.minus, ncells),
+        rules_from_points(*points.plus, ncells),
         surface_rules(X, area, w, rows, ncells, jacobian),
         points.reduced,
     )
@@ -246,7 +247,7 @@ def saye_points(
 
 def _certain(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Strict sign certificates of Bernstein coefficients ``(m, ...)``: (one sign, all zero)."""
-    flat = B.reshape(B.shape[0], B[0].size if B.shape[0] else 1)
+    flat = B.reshape(B.shape[0], int(np.prod(B.shape[1:])))
     return (flat > 0).all(axis=1) | (flat < 0).all(axis=1), (flat == 0).all(axis=1)
 
 
@@ -404,6 +405,7 @@ def _gather(parts, widths: tuple[int, ...]) -> list[np.ndarray]:
     return columns
 
 
-def _side_rule(rows: np.ndarray, X: np.ndarray, w: np.ndarray, ncells: int) -> RuleSet:
-    """A :class:`RuleSet` of ``ncells`` rules from points sorted by row."""
+def rules_from_points(rows: np.ndarray, X: np.ndarray, w: np.ndarray, ncells: int) -> RuleSet:
+    """A :class:`~xfem_contact.quadrature.rules.RuleSet` of ``ncells`` rules from points
+    ``X`` ``(N, 3)`` with weights ``w`` ``(N,)`` of cells ``rows`` ``(N,)`` (sorted)."""
     return RuleSet(X, w, np.searchsorted(rows, np.arange(ncells + 1)).astype(np.int64))
