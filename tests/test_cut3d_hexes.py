@@ -50,6 +50,11 @@ def check_planes(normals, offsets, degree, h=(1.0, 1.0, 1.0), tol=1e-13):
             r.weights[r.offsets[row] : r.offsets[row + 1]].sum() for r in (rules.minus, rules.plus)
         )
         assert abs(total - 1.0) <= 1e-14
+        gamma = rules.interface
+        normals = gamma.normals[gamma.offsets[row] : gamma.offsets[row + 1]]
+        np.testing.assert_allclose(
+            normals, np.broadcast_to(g / np.linalg.norm(g), normals.shape), atol=1e-13
+        )
         if side[row] == -1:  # a certificate: sound, not complete (0 = possibly cut)
             assert exact[1][0] == 0 and exact[2][0] == 0
         if side[row] == 1:

@@ -64,6 +64,11 @@ def test_planes_converge_to_exact_moments(order, tol):
         for rule, cells in ((rules.minus, minus), (rules.plus, plus), (rules.interface, face)):
             exact = simplex_moments(cells, EXPS)
             assert np.abs(moments(rule, row) - exact).max() <= tol, (order, n, c)
+        gamma = rules.interface
+        normals = gamma.normals[gamma.offsets[row] : gamma.offsets[row + 1]]
+        np.testing.assert_allclose(
+            normals, np.broadcast_to(n / np.linalg.norm(n), normals.shape), atol=1e-12
+        )
         volume = sum(moments(r, row)[0] for r in (rules.minus, rules.plus))
         assert abs(volume - 1.0 / 6.0) <= 1e-14
     for rule in (rules.minus, rules.plus, rules.interface):
