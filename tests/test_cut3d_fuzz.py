@@ -1,0 +1,23 @@
+"""A short fuzz of random 3D cuts (bench/cut3d.py runs the long one): spheres, ellipsoids,
+tori and planes, a third through a node exactly; every weight positive and the side
+volumes adding up to the cell volume to 1e-12, with no failure."""
+
+import importlib.util
+import pathlib
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+_spec = importlib.util.spec_from_file_location("cut3d_bench", ROOT / "bench" / "cut3d.py")
+cut3d = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(cut3d)
+
+
+@pytest.mark.parametrize(
+    "kind, count", [("tet-P1", 2000), ("hex-Q1", 1000), ("hex-Q2", 500), ("tet-P2", 500)]
+)
+def test_fuzz(kind, count):
+    counts = cut3d.fuzz_cells(kind, count, seed=7)
+    print(kind, counts)
+    assert counts["cut"] > count // 4  # the cases do cut cells
+    assert counts["weights"] == counts["volume"] == counts["errors"] == 0, counts
