@@ -231,8 +231,7 @@ class EnrichedSpace:
             active |= support
         for field, _, name in self.multiplier_fields:
             rules = cut.interface_rules_of(name)
-            length = np.zeros(cut.cut_cells.size)
-            np.add.at(length, rules.point_rows, rules.weights * _abs_det_at(cut, rules))
+            length = rules.sums(rules.weights * _abs_det_at(cut, rules))
             if cut.crack is not None:  # a crack's: the crossed cells' vertices only
                 length = np.where(cut.crack.kind == CROSSED, length, 0.0)
             carrying = cut.cut_cells[length > 0.0]
@@ -301,13 +300,7 @@ class EnrichedSpace:
         areas = _cell_areas(cut)
         side_area = np.where(cut.cell_sides == side, areas, 0.0)
         rules = cut.side_rules(side)
-        cut_area = (
-            np.add.reduceat(rules.weights * _abs_det_at(cut, rules), rules.offsets[:-1])
-            if rules.weights.size
-            else np.zeros(0)
-        )
-        cut_area = np.where(np.diff(rules.offsets) > 0, cut_area, 0.0)
-        side_area[cut.cut_cells] = cut_area
+        side_area[cut.cut_cells] = rules.sums(rules.weights * _abs_det_at(cut, rules))
         on_side = self._mark(field, np.arange(areas.size, dtype=np.int32), side_area)
         total = self._mark(field, np.arange(areas.size, dtype=np.int32), areas)
         return np.divide(on_side, total, out=np.zeros_like(total), where=total > 0)
