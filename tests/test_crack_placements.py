@@ -101,12 +101,13 @@ def test_measures_with_nodes_on_the_line(cell, degree, tip):
 
 
 @pytest.mark.mpi
+@pytest.mark.parametrize("tip", [None, "cell", "node", "edge"])
 @pytest.mark.parametrize("degree", [1, 2])
-def test_measures_with_nodes_on_the_line_parallel(cell, degree):
+def test_measures_with_nodes_on_the_line_parallel(cell, degree, tip):
     """The same measures on all ranks as on one (each rank's own serial copy) and exact."""
-    serial = _measures(_cut(cell, degree, "cell", MPI.COMM_SELF))
-    parallel = _measures(_cut(cell, degree, "cell"))
-    for key, value in _exact("cell").items():
+    serial = _measures(_cut(cell, degree, tip, MPI.COMM_SELF))
+    parallel = _measures(_cut(cell, degree, tip))
+    for key, value in _exact(tip).items():
         assert parallel[key] == pytest.approx(serial[key], abs=1e-13), key
         assert parallel[key] == pytest.approx(value, abs=1e-12), key
 
@@ -287,3 +288,34 @@ def test_tip_radius_below_the_tip_cells(caplog):
     assert "tip_radius = 0.01 m is smaller than the tip cells" in caplog.text
     K = _griffith_K(case, np.array([1.0, 0.0]))
     assert np.abs(K - np.array(case.K)).max() < 2e-3 * case.K[0][0]
+
+
+@pytest.mark.mpi
+@pytest.mark.parallel
+@pytest.mark.parametrize("placement", ["along edges, tips mid-edge", "along edges, tips on nodes"])
+def test_closed_crack_on_mesh_lines_equal_serial(placement):
+    """K and the lips' fields of the closed crack along a row of cell edges are the same
+    on all ranks as on one (the tip cell and the cut cell of an edge chosen per cell)."""
+    from parallel import gathered_fields, max_relative_difference
+
+    angle, offset = PLACEMENTS[placement]
+    runs = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        case = frictional_crack_case(
+            4,
+            2,
+            friction=0.3,
+            tip_radius=0.5,
+            lbb="restriction",
+            angle=angle,
+            offset=offset,
+            comm=comm,
+        )
+        case.problem.solve()
+        runs.append(
+            (_griffith_K(case, np.array([1.0, 0.0]), solve=False), gathered_fields(case.problem))
+        )
+    (K_all, fields_all), (K_one, fields_one) = runs
+    assert np.abs(K_all - K_one).max() <= 1e-10 * np.abs(K_one).max()
+    differences = max_relative_difference(fields_all, fields_one)
+    assert all(v <= 1e-10 for v in differences.values()), differences

@@ -29,6 +29,9 @@ from xfem_contact.fem.subspaces import collapse
 from xfem_contact.geometry.crack import CROSSED, TIP
 
 _logger = logging.getLogger(__name__)
+#: Relative tolerance of the tip radius: the mesh generator rounds a node's coordinates
+#: differently on 1 and 2 processes (1 ulp)
+_RADIUS_TOLERANCE = 1e-10
 
 
 class DofCounts(typing.NamedTuple):
@@ -271,7 +274,8 @@ class EnrichedSpace:
         else:
             x = R.function_space.tabulate_dof_coordinates()[:, : crack.tips.shape[1]]
             distance = np.linalg.norm(x[:, None, :] - crack.tips[None], axis=2).min(axis=1)
-            R.x.array[:] = distance <= self.tip_radius
+            # a node at the radius is in, whatever rounding its coordinates carry
+            R.x.array[:] = distance <= self.tip_radius * (1.0 + _RADIUS_TOLERANCE)
         R.x.scatter_forward()
         ramp_cells = R.function_space.dofmap.list[: self.cut.cell_sides.size]
         flags = self._mark(field, np.flatnonzero(R.x.array[ramp_cells].max(axis=1) > 0)) > 0
