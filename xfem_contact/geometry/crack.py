@@ -134,7 +134,7 @@ def classify_crack(
     point = np.hypot(*(seg[:, 1] - seg[:, 0]).T) == 0  # phi touches the cell at a node
     values[point & ends.any(axis=1)] = 0.0  # ... where the tip is: no crack in the cell
     below = values < 0
-    changes = _sign_changes(values)
+    changes, first, second = _sign_changes(values)
     if np.any(changes > 1):
         raise ValueError(
             f"the crack ends twice in {describe_cells(simple[changes > 1])}: psi changes sign "
@@ -149,10 +149,10 @@ def classify_crack(
         )
     kind[simple] = np.where((changes == 1) | at_end, TIP, np.where(crack_side, CROSSED, NONE))
     tips = np.flatnonzero(changes == 1)
-    k = np.argmax(below[tips, 1:] != below[tips, :-1], axis=1)
-    v0, v1 = values[tips, k], values[tips, k + 1]
+    i, j = first[tips], second[tips]
+    v0, v1 = values[tips, i], values[tips, j]
     t = v0 / (v0 - v1)
-    start = (1 - t)[:, None] * X[tips, k] + t[:, None] * X[tips, k + 1]
+    start = (1 - t)[:, None] * X[tips, i] + t[:, None] * X[tips, j]
     tip = _newton_tip(data, phi[simple[tips]], psi[simple[tips]], start, simple[tips])
     _refuse_outside(data, simple[tips], tip, tip_tol)
     boundary = np.flatnonzero(at_end)
@@ -162,15 +162,23 @@ def classify_crack(
     return CrackCells(kind, rows[order], tip[order])
 
 
-def _sign_changes(values: np.ndarray) -> np.ndarray:
-    """Per row of ``values`` ``(n, q)``: how often the sign changes between the nonzero
-    samples (exact zeros, a tip on the cell's boundary, are skipped)."""
-    changes = np.zeros(values.shape[0], dtype=np.int64)
-    last = np.zeros(values.shape[0])  # the sign of the last nonzero sample, 0: none yet
-    for column in np.sign(values).T:
-        changes += (column != 0) & (last != 0) & (column != last)
-        last = np.where(column != 0, column, last)
-    return changes
+def _sign_changes(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per row of ``values`` ``(n, q)``: how often the sign changes between its nonzero
+    samples (exact zeros, a tip on the cell's boundary, are skipped), and the columns
+    ``(i, j)`` of the two nonzero samples the first change lies between; each ``(n,)``."""
+    n = values.shape[0]
+    count, i, j = (np.zeros(n, dtype=np.int64) for _ in range(3))
+    last = np.full(n, -1)  # the column of the last nonzero sample, -1: none yet
+    signs = np.sign(values)
+    for column in range(values.shape[1]):
+        here = signs[:, column] != 0
+        change = here & (last >= 0)
+        change &= signs[:, column] != signs[np.arange(n), np.maximum(last, 0)]
+        first = change & (count == 0)
+        i, j = np.where(first, last, i), np.where(first, column, j)
+        count += change
+        last = np.where(here, column, last)
+    return count, i, j
 
 
 def _values(data: CellData, values: np.ndarray, X: np.ndarray) -> np.ndarray:
