@@ -111,18 +111,47 @@ def test_classification(cell_type):
 
 
 @pytest.mark.parametrize("cell_type", CELLS)
+def test_crack_ending_twice_refused_by_name(cell_type):
+    phi, psi = lambda x, y: y - 0.2, lambda x, y: -(x - 0.1) * (0.3 - x)
+    with pytest.raises(ValueError, match="ends twice"):
+        classify_crack(cell_type, 2, *_unit_cell(cell_type, 2, phi, psi))
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+@pytest.mark.parametrize("cell_type", CELLS)
 @pytest.mark.parametrize(
-    ("phi", "psi", "case"),
+    ("phi", "psi", "tip", "entry", "case"),
     [
-        (lambda x, y: y - 0.5 * (1 - x), lambda x, y: x - 1.0, "on a node"),  # tip at (1, 0)
-        (lambda x, y: x - 0.5 + 0.2 * y, lambda x, y: -y, "on an edge"),  # tip at (0.5, 0)
-        (lambda x, y: y, lambda x, y: x - 2.0, "along a mesh edge"),
-        (lambda x, y: y - 0.2, lambda x, y: -(x - 0.1) * (0.3 - x), "ends twice"),
+        (lambda x, y: y - 0.5 * (1 - x), lambda x, y: x - 1.0, (1.0, 0.0), (0, 0.5), "node"),
+        (lambda x, y: x - 0.5 + 0.2 * y, lambda x, y: -y, (0.5, 0.0), "top", "edge"),
+        (lambda x, y: -y, lambda x, y: x - 0.5, (0.5, 0.0), (0.0, 0.0), "along an edge"),
+        (lambda x, y: -y, lambda x, y: x - 1.0, (1.0, 0.0), (0.0, 0.0), "along, at a node"),
     ],
 )
-def test_degenerate_positions_refused_by_name(cell_type, phi, psi, case):
-    with pytest.raises(ValueError, match=case):
-        classify_crack(cell_type, 2, *_unit_cell(cell_type, 2, phi, psi))
+def test_tip_on_the_cell_boundary(cell_type, degree, phi, psi, tip, entry, case):
+    """A tip on a node or an edge of its cell, also with the crack along an edge: one
+    tip cell, the tip exact, the fans tile both sides exactly and the lip rule
+    measures the crack from where it enters to the tip (these were refused)."""
+    values = _unit_cell(cell_type, degree, phi, psi)
+    cells = classify_crack(cell_type, degree, *values)
+    assert cells.kind.tolist() == [TIP], case
+    np.testing.assert_allclose(cells.tip, [tip], atol=1e-15)
+    cut = cut_tip_cells(cell_type, degree, *values, cells.tip)
+    vertices = _nodes(cell_type, 1)[[0, 1, 3, 2] if cell_type == "quadrilateral" else [0, 1, 2]]
+    gradient = np.array(
+        [phi(1.0, 0.0) - phi(0.0, 0.0), phi(0.0, 1.0) - phi(0.0, 0.0)]
+    )  # phi is affine
+    below = _clip(vertices, gradient, -phi(0.0, 0.0))
+    areas = [tip_side_rules(cut, side, 4).weights.sum() for side in (-1, 1)]
+    total = _polygon_area(vertices)
+    np.testing.assert_allclose(
+        areas, [_polygon_area(below), total - _polygon_area(below)], atol=1e-14
+    )
+    if entry == "top":  # x = 0.5 - 0.2 y meets x + y = 1 (triangle) or y = 1
+        entry = (0.375, 0.625) if cell_type == "triangle" else (0.3, 1.0)
+    identity = lambda rows, X: np.broadcast_to(np.eye(2), (len(rows), 2, 2))  # noqa: E731
+    lip = tip_lip_rule(cut, 4, identity, lambda rows, X: np.tile(gradient, (len(rows), 1)))
+    assert lip.weights.sum() == pytest.approx(np.hypot(*(np.array(tip) - entry)), abs=1e-14)
 
 
 @pytest.mark.parametrize("cell_type", CELLS)

@@ -242,7 +242,6 @@ BUILD_ERRORS = {
         {"shape": "expression", "phi": "y - 1.013", "psi": "x + 5"},
         "cracks[0]: The crack's tangential level set psi never changes sign on the mesh",
     ),
-    "tip radius": ({"tip_radius": 0.01}, "cracks[0].tip_radius: tip_radius = 0.01 m is smaller"),
     "rings": ({"rings": [[0.01, 0.2]]}, "cracks[0].rings: ring r_inf = 0.01 m does not cover"),
 }
 

@@ -930,8 +930,8 @@ def test_facet_pieces_of_subdivided_cells(cell: str):
     covered = np.zeros((len(phi), len(fverts)))
     negative = np.zeros((len(phi), len(fverts)))
     for side in (-1, 1):
-        rows, facets, ends = boundary.facet_pieces(geom, side, cell)
-        lengths = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
+        rows, facets, ends, signs = boundary.facet_pieces(geom, side, cell)
+        lengths = signs * np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
         np.add.at(covered, (rows, facets), lengths)
         if side == -1:
             np.add.at(negative, (rows, facets), lengths)
@@ -964,3 +964,51 @@ def test_random_circles_batch(cell: str, degree: int):
     else:  # a linear interpolant of a circle is a line (triangle) or a hyperbola (quad)
         assert geom.subdivided.size == 0
     check_subdivided(cell, degree, phi[rows], geom)
+
+
+@pytest.mark.parametrize("eps", [0.0, 1e-17, -1e-17, 1e-16, -1e-16, 1e-15, -1e-15])
+@pytest.mark.parametrize("degree", DEGREES)
+@pytest.mark.parametrize("cell", CELLS)
+def test_line_through_a_vertex(cell: str, degree: int, eps: float):
+    """The line X + 2 Y = 1 through vertex (1, 0), its nodal value there 0 or a rounding
+    error away: the crossing is the vertex (no sliver beside it, no folded fallback
+    fan), each facet's pieces cover it once on each side (a value of -1e-17 there
+    counted facet (0, 1) three times on side -1, 1e-16 nine times on side +1)."""
+    X = nodes(cell, degree)
+    phi = X[:, 0] + 2.0 * X[:, 1] - 1.0
+    phi[np.flatnonzero((X == [1.0, 0.0]).all(axis=1))] = eps
+    geom = cut.subtriangulate(cell, degree, phi[None])
+    assert len(geom.tri_minus) <= 2 and len(geom.tri_plus) <= 2  # apex fans
+    fverts, _ = boundary.reference_facets(cell)
+    for side in (-1, 1):
+        rows, facets, ends, signs = boundary.facet_pieces(geom, side, cell)
+        assert (signs == 1).all()
+        lengths = np.bincount(facets, np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1), len(fverts))
+        for f, (P, Q) in enumerate(fverts):
+            t = np.linspace(0.0, 1.0, 100001)
+            values = (P[0] + t * (Q - P)[0]) + 2.0 * (P[1] + t * (Q - P)[1]) - 1.0
+            exact = np.mean(side * values > 0) * np.linalg.norm(Q - P)  # sampled: to 1e-5
+            assert lengths[f] == pytest.approx(exact, abs=2e-5), (side, f)
+
+
+def test_facet_pieces_of_a_fold_cancel():
+    """Pieces carry their sub-triangle's orientation: a triangle and a reversed copy (the
+    overlap of a folded fallback fan) cancel, so the facet counts once."""
+    whole = np.array([[0, 0], [1, 0], [0, 1], [0.5, 0.5], [0, 0.5], [0.5, 0]], dtype=float)
+    inner = np.array([[0, 0], [1, 0], [0.2, 0.2], [0.6, 0.1], [0.1, 0.1], [0.5, 0]])
+    reversed_ = inner[[1, 0, 2, 4, 3, 5]]
+    tri = np.stack([whole, inner, reversed_])
+    geom = cut.CutGeometry(
+        tri,
+        np.zeros(3, dtype=np.int64),
+        np.zeros((0, 6, 2)),
+        np.zeros(0, dtype=np.int64),
+        np.zeros((0, 3, 2)),
+        np.zeros(0, dtype=np.int64),
+        1,
+        np.zeros(0, dtype=np.int64),
+    )
+    rows, facets, ends, signs = boundary.facet_pieces(geom, -1, "triangle")
+    lengths = signs * np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
+    assert sorted(signs.tolist()) == [-1.0, 1.0, 1.0, 1.0, 1.0]
+    np.testing.assert_allclose(np.bincount(facets, lengths, 3), [np.sqrt(2), 1.0, 1.0])

@@ -2,8 +2,8 @@
 crack and the closed inclined crack with Coulomb friction.
 
 Shared by the tests and the benchmarks. SI units; the material is E = 1 Pa, nu = 0.3,
-plane strain unless given. Every crack is straight, turned so that no mesh line follows
-it, and its tips lie inside cells (never on a node or an edge).
+plane strain unless given. Every crack is straight; by default turned so that no mesh
+line follows it, its tips inside cells (never on a node or an edge).
 """
 
 from __future__ import annotations
@@ -71,8 +71,21 @@ def _on_boundary(half: float) -> Callable[[np.ndarray], np.ndarray]:
     return lambda x: np.isclose(np.abs(x[0]), half) | np.isclose(np.abs(x[1]), half)
 
 
-def _frame() -> tuple[np.ndarray, np.ndarray]:
-    d = np.array([math.cos(ANGLE), math.sin(ANGLE)])
+def _boundary_values(half: float, field: Callable) -> Callable[[np.ndarray], np.ndarray]:
+    """``field`` (values (2, n)) on the boundary of the square of half width ``half``, 0
+    inside: a Dirichlet value that never evaluates an exact field at a tip on a node."""
+
+    def values(x: np.ndarray) -> np.ndarray:
+        on = _on_boundary(half)(x)
+        out = np.zeros((2, x.shape[1]))
+        out[:, on] = field(x[:, on])
+        return out
+
+    return values
+
+
+def _frame(angle: float = ANGLE) -> tuple[np.ndarray, np.ndarray]:
+    d = np.array([math.cos(angle), math.sin(angle)])
     return d, np.array([-d[1], d[0]])
 
 
@@ -155,16 +168,22 @@ def griffith_case(
     tip_radius: float | None = 0.3,
     width: float = 2.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
+    angle: float = ANGLE,
+    offset: tuple[float, float] = tuple(OFFSET),
+    cell: str = "triangle",
 ) -> CrackCase:
     """A Griffith crack of half length ``a = 1`` m, inclined at ``beta`` (rad) to a
     remote tension of 1 Pa, in the square of half width ``width`` (m) meshed with
-    ``h = a / N``; Westergaard's exact displacement on the boundary, so that the plate's
-    size adds no error. Tip enrichment radius ``tip_radius`` (m)."""
-    a, (d, normal) = 1.0, _frame()
-    centre = OFFSET * a
+    ``h = a / N`` (``cell``: triangles or quadrilaterals); Westergaard's exact
+    displacement on the boundary, so that the plate's size adds no error. Tip enrichment
+    radius ``tip_radius`` (m). The crack runs at ``angle`` (rad) from the x axis through
+    ``offset`` (m): by default off every mesh line (``angle = 0``, ``offset = (0, 0)``:
+    along a row of cell edges, tips on nodes)."""
+    a, (d, normal) = 1.0, _frame(angle)
+    centre = np.asarray(offset, dtype=float) * a
     crack = GriffithCrack.uniaxial(a, 1.0, beta, center=tuple(centre), direction=tuple(d))
     cut = CutMesh(
-        _square(width, int(round(2 * width * N / a)), "triangle", comm),
+        _square(width, int(round(2 * width * N / a)), cell, comm),
         lambda x: (x[0] - centre[0]) * normal[0] + (x[1] - centre[1]) * normal[1],
         degree=degree,
         tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
@@ -174,7 +193,7 @@ def griffith_case(
     def displacement(side: int) -> Callable:
         return lambda x: crack.displacement(x, MATERIAL.E, MATERIAL.nu, MATERIAL.plane)
 
-    problem.loads.add_displacement(_on_boundary(width), displacement(1))
+    problem.loads.add_displacement(_on_boundary(width), _boundary_values(width, displacement(1)))
     K = crack.stress_intensity_factors
     return CrackCase(problem, [K] * len(cut.crack.tips), displacement, a)
 
@@ -188,6 +207,8 @@ def frictional_crack_case(
     width: float = 2.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
     lbb: str = "none",
+    angle: float = ANGLE,
+    offset: tuple[float, float] = tuple(OFFSET),
 ) -> CrackCase:
     """A closed crack of half length ``a = 1`` m inclined at ``beta`` to a remote
     compression of 1 Pa, Coulomb friction ``friction`` on its lips, in the square of half
@@ -195,9 +216,9 @@ def frictional_crack_case(
     ``|tau| > friction |sigma_n|``): the uniform stress plus Westergaard's mode II field of
     the crack loaded by the effective shear ``tau_eff = |tau| - friction |sigma_n|``;
     imposed on the boundary. ``K_I = 0``, ``K_II = sign(tau) tau_eff sqrt(pi a)``. ``lbb``:
-    the law's LBB treatment."""
-    a, (d, normal) = 1.0, _frame()
-    centre = OFFSET * a
+    the law's LBB treatment; ``angle``, ``offset``: as for :func:`griffith_case`."""
+    a, (d, normal) = 1.0, _frame(angle)
+    centre = np.asarray(offset, dtype=float) * a
     S11, S22, S12 = GriffithCrack.uniaxial(a, -1.0, beta).remote
     T = math.copysign(max(abs(S12) - friction * abs(S22), 0.0), S12)
     sliding = GriffithCrack(a, (0.0, 0.0, T), center=tuple(centre), direction=tuple(d))
@@ -223,7 +244,7 @@ def frictional_crack_case(
     )
     law = make_law("coulomb", friction=friction, lbb=lbb)
     problem = Problem(cut, degree, MATERIAL, law, ghost_penalty=0.0, tip_radius=tip_radius)
-    problem.loads.add_displacement(_on_boundary(width), exact)
+    problem.loads.add_displacement(_on_boundary(width), _boundary_values(width, exact))
     K = (0.0, T * math.sqrt(math.pi * a))
     return CrackCase(problem, [K] * len(cut.crack.tips), lambda side: exact, a)
 

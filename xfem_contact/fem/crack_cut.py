@@ -85,8 +85,8 @@ def crack_rules(
 
     Raises:
         ValueError: the degenerate positions refused by
-            :func:`~xfem_contact.geometry.crack.classify_crack` (tip on a node or an
-            edge, a crack along a mesh edge, ...), naming the case.
+            :func:`~xfem_contact.geometry.crack.classify_crack` (a crack ending twice in
+            a cell, ...), naming the case.
     """
     mesh, degree = maps.mesh, tangent.degree
     cell_name = mesh.topology.cell_name()

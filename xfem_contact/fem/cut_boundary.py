@@ -57,11 +57,11 @@ def boundary_parts(cut, side: int, facets: np.ndarray) -> list[IntegrationPart]:
     keep = cut.cell_sides[pairs[:, 0]] == side
     parts = [IntegrationPart("exterior_facet", entities=pairs[keep].ravel())]
     # Pieces on cut cells: only those on facets of the set
-    rows, local, ends = boundary.facet_pieces(cut.geometry, side, cell_name)
+    rows, local, ends, signs = boundary.facet_pieces(cut.geometry, side, cell_name)
     c2f = mesh.topology.connectivity(tdim, tdim - 1)
     cell_facets = c2f.array.reshape(-1, c2f.offsets[1] - c2f.offsets[0])
     in_set = np.isin(cell_facets[cut.cut_cells[rows], local], facets)
-    rows, local, ends = rows[in_set], local[in_set], ends[in_set]
+    rows, local, ends, signs = rows[in_set], local[in_set], ends[in_set], signs[in_set]
     _, ref_normals = boundary.reference_facets(cell_name)
     J = ufl.Jacobian(mesh)
     # A reference facet no cut cell has on the set, on any rank, gets no integral
@@ -74,6 +74,7 @@ def boundary_parts(cut, side: int, facets: np.ndarray) -> list[IntegrationPart]:
         rule = boundary.facet_rules(
             np.searchsorted(cells_rows, rows[mine]),
             ends[mine],
+            signs[mine],
             cells_rows.size,
             cut.quadrature_degree,
             lambda r, X, cr=cells_rows: cut.maps.jacobian(cut.cut_cells[cr[r]], X),

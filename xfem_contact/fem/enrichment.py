@@ -11,6 +11,7 @@ system has exactly standard + enriched dofs.
 
 from __future__ import annotations
 
+import logging
 import typing
 from collections.abc import Sequence
 
@@ -26,6 +27,11 @@ from xfem_contact.fem.branch import UFL, branch_values, null_pins
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.subspaces import collapse
 from xfem_contact.geometry.crack import CROSSED, TIP
+
+_logger = logging.getLogger(__name__)
+#: Relative tolerance of the tip radius: the mesh generator rounds a node's coordinates
+#: differently on 1 and 2 processes (1 ulp)
+_RADIUS_TOLERANCE = 1e-10
 
 
 class DofCounts(typing.NamedTuple):
@@ -59,6 +65,8 @@ class EnrichedSpace:
         tip_radius: For a cut by a crack (``cut.crack``): the tip enrichment's radius
             (m): the vertices within it of a tip carry the four branch functions
             (geometric enrichment, with the ramp below); ``None``: the tip cells' nodes.
+            A radius below the tip cells' diameter takes the ramp 1 on the tip cells'
+            vertices instead, with a logged warning.
 
     A crack's multipliers live on the vertices of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillated, K_I of a closed crack 0.23 instead
@@ -231,8 +239,7 @@ class EnrichedSpace:
             active |= support
         for field, _, name in self.multiplier_fields:
             rules = cut.interface_rules_of(name)
-            length = np.zeros(cut.cut_cells.size)
-            np.add.at(length, rules.point_rows, rules.weights * _abs_det_at(cut, rules))
+            length = rules.sums(rules.weights * _abs_det_at(cut, rules))
             if cut.crack is not None:  # a crack's: the crossed cells' vertices only
                 length = np.where(cut.crack.kind == CROSSED, length, 0.0)
             carrying = cut.cut_cells[length > 0.0]
@@ -252,15 +259,24 @@ class EnrichedSpace:
         tip_cells = crack.cells(TIP, self.cut.cut_cells).astype(np.int32)
         local = float(mesh.h(2, tip_cells).max()) if tip_cells.size else 0.0
         h = mesh.comm.allreduce(local, op=MPI.MAX)
-        if self.tip_radius < h:
-            raise ValueError(
-                f"tip_radius = {self.tip_radius:.6g} m is smaller than the tip cells "
-                f"(diameter {h:.6g} m): take at least that, or None for the tip cells' nodes"
-            )
         R = self.ramp
-        x = R.function_space.tabulate_dof_coordinates()[:, : crack.tips.shape[1]]
-        distance = np.linalg.norm(x[:, None, :] - crack.tips[None], axis=2).min(axis=1)
-        R.x.array[:] = distance <= self.tip_radius
+        if self.tip_radius < h:
+            _logger.warning(
+                "tip_radius = %.6g m is smaller than the tip cells (diameter %.6g m): the "
+                "branch functions enrich the tip cells' nodes",
+                self.tip_radius,
+                h,
+            )
+            R.x.array[:] = 0.0
+            R.x.array[R.function_space.dofmap.list[tip_cells].ravel()] = 1.0
+            R.x.scatter_reverse(dolfinx.la.InsertMode.add)
+            R.x.array[:] = R.x.array > 0
+        else:
+            x = R.function_space.tabulate_dof_coordinates()[:, : crack.tips.shape[1]]
+            distance = np.linalg.norm(x[:, None, :] - crack.tips[None], axis=2).min(axis=1)
+            # a node at the radius is in, whatever rounding its coordinates carry
+            R.x.array[:] = distance <= self.tip_radius * (1.0 + _RADIUS_TOLERANCE)
+        R.x.scatter_forward()
         ramp_cells = R.function_space.dofmap.list[: self.cut.cell_sides.size]
         flags = self._mark(field, np.flatnonzero(R.x.array[ramp_cells].max(axis=1) > 0)) > 0
         V, parent = self.field_space(field)  # F_1, F_2 dropped at one node: no null vectors
@@ -301,13 +317,7 @@ class EnrichedSpace:
         areas = _cell_areas(cut)
         side_area = np.where(cut.cell_sides == side, areas, 0.0)
         rules = cut.side_rules(side)
-        cut_area = (
-            np.add.reduceat(rules.weights * _abs_det_at(cut, rules), rules.offsets[:-1])
-            if rules.weights.size
-            else np.zeros(0)
-        )
-        cut_area = np.where(np.diff(rules.offsets) > 0, cut_area, 0.0)
-        side_area[cut.cut_cells] = cut_area
+        side_area[cut.cut_cells] = rules.sums(rules.weights * _abs_det_at(cut, rules))
         on_side = self._mark(field, np.arange(areas.size, dtype=np.int32), side_area)
         total = self._mark(field, np.arange(areas.size, dtype=np.int32), areas)
         return np.divide(on_side, total, out=np.zeros_like(total), where=total > 0)

@@ -16,14 +16,17 @@ it: the tip is inside; cut by :mod:`xfem_contact.geometry.crack_tip_cell`).
 
 Tolerance policy: ``psi`` is sampled at :data:`SAMPLES` points of the SEG3 of the
 ``phi`` cut; the tip is the Newton solution of ``(phi, psi) = 0`` started from the
-sampled sign change, converged to ``16 eps``. Degenerate positions are refused
-with a ``ValueError`` naming the case and the cell: a tip within ``tip_tol``
-(reference units) of an edge (*tip on an edge*) or of a vertex (*tip on a node*),
-``|psi| <= tip_tol * (max psi - min psi)`` where the crack leaves a crossed cell,
-a crack along a mesh edge (``phi`` vanishing on an edge where ``psi < 0``),
-``psi`` changing sign more than once in a cell (*crack ends twice*), a tip in a
-cell that ``phi`` does not cut simply, and level sets tangent at the tip. A crack
-through a vertex of a crossed or tip cell is handled.
+sampled sign change, converged to ``16 eps``. Where ``|psi| <= tip_tol * (max psi -
+min psi)`` at an end of the SEG3, the tip is that end, on the cell's boundary (a node
+or an edge): the cell the crack comes from (``psi < 0`` along the rest of its SEG3) is
+the tip cell, the one it goes on into is of the extension (:data:`NONE`), and a cell
+``phi`` touches at that node only is :data:`NONE`. A crack along a mesh edge (``phi``
+vanishing on it) is cut as an interface along the edge: by the cell on its side -1,
+the other side's cell is uncut; a tip on such an edge is inside the SEG3 of that cell.
+Refused with a ``ValueError`` naming the case and the cell: ``psi`` changing sign more
+than once in a cell, or vanishing at both ends of a crack piece (*crack ends twice*), a
+tip in a cell that ``phi`` does not cut simply, a tip Newton finds outside its cell,
+and level sets tangent at the tip.
 """
 
 from __future__ import annotations
@@ -44,7 +47,6 @@ from xfem_contact.geometry.cut_topology import (
     interior_values,
     seg3_basis,
     topology,
-    zero_edges,
 )
 
 __all__ = ["NONE", "CROSSED", "TIP", "KIND_NAMES", "CrackCells", "classify_crack", "polar"]
@@ -99,7 +101,9 @@ def classify_crack(
         degree: Level-set degree, 1 or 2 (both level sets).
         phi: Normal level set, nodal values ``(ncells, ndofs)``.
         psi: Tangential level set, nodal values ``(ncells, ndofs)``.
-        tip_tol: Distance (reference units) below which a tip is on an edge or node.
+        tip_tol: ``|psi|`` (relative to its range in the cell) below which an end of
+            the ``phi`` cut is the tip, on the cell's boundary; and the distance
+            (reference units) by which a Newton tip may lie outside its cell.
 
     Returns:
         The :class:`CrackCells`.
@@ -115,7 +119,6 @@ def classify_crack(
     if not tip_tol > 0:
         raise ValueError(f"tip_tol must be positive, got {tip_tol!r}")
     scale = np.ptp(psi, axis=1)
-    _refuse_mesh_aligned(data, phi, psi)
     neg, flags = topology(data, phi)
     mixed = neg.any(axis=1) & ~neg.all(axis=1)
     kind = np.full(phi.shape[0], NONE, dtype=np.int8)
@@ -125,49 +128,63 @@ def classify_crack(
     s = np.linspace(0.0, 1.0, SAMPLES)
     X = np.einsum("qk,ckd->cqd", seg3_basis(s)[0], seg)
     values = _values(data, psi[simple], X)
+    # A tip on the cell's boundary (on a node or an edge) ends the zero line: psi = 0 there
+    ends = np.abs(values[:, [0, -1]]) <= tip_tol * scale[simple, None]
+    values[:, [0, -1]] = np.where(ends, 0.0, values[:, [0, -1]])
+    point = np.hypot(*(seg[:, 1] - seg[:, 0]).T) == 0  # phi touches the cell at a node
+    values[point & ends.any(axis=1)] = 0.0  # ... where the tip is: no crack in the cell
     below = values < 0
-    changes = (below[:, 1:] != below[:, :-1]).sum(axis=1)
+    changes, first, second = _sign_changes(values)
     if np.any(changes > 1):
         raise ValueError(
             f"the crack ends twice in {describe_cells(simple[changes > 1])}: psi changes sign "
             "more than once along phi = 0 (a crack shorter than a cell); refine the mesh"
         )
-    ends = np.abs(values[:, [0, -1]]) <= tip_tol * scale[simple, None]
-    touching = np.flatnonzero((changes == 0) & ends.any(axis=1))
-    if touching.size:
-        where = np.where(ends[touching, 0], 0, -1)
-        _refuse_on_boundary(data, simple[touching], X[touching, where], tip_tol)
-    kind[simple] = np.where(changes == 1, TIP, np.where(below[:, 0], CROSSED, NONE))
+    crack_side = below.any(axis=1) & (changes == 0)  # psi <= 0 all along
+    at_end = crack_side & ends.any(axis=1) & ~point  # the crack ends on the cell's boundary
+    if np.any(at_end & ends.all(axis=1)):
+        raise ValueError(
+            f"the crack ends twice in {describe_cells(simple[at_end & ends.all(axis=1)])}: "
+            "psi vanishes at both ends of phi = 0 (a crack of one cell); refine the mesh"
+        )
+    kind[simple] = np.where((changes == 1) | at_end, TIP, np.where(crack_side, CROSSED, NONE))
     tips = np.flatnonzero(changes == 1)
-    k = np.argmax(below[tips, 1:] != below[tips, :-1], axis=1)
-    v0, v1 = values[tips, k], values[tips, k + 1]
+    i, j = first[tips], second[tips]
+    v0, v1 = values[tips, i], values[tips, j]
     t = v0 / (v0 - v1)
-    start = (1 - t)[:, None] * X[tips, k] + t[:, None] * X[tips, k + 1]
-    rows = simple[tips]
-    tip = _newton_tip(data, phi[rows], psi[rows], start, rows)
-    _refuse_on_boundary(data, rows, tip, tip_tol)
-    return CrackCells(kind, rows, tip)
+    start = (1 - t)[:, None] * X[tips, i] + t[:, None] * X[tips, j]
+    tip = _newton_tip(data, phi[simple[tips]], psi[simple[tips]], start, simple[tips])
+    _refuse_outside(data, simple[tips], tip, tip_tol)
+    boundary = np.flatnonzero(at_end)
+    rows = np.concatenate([simple[tips], simple[boundary]])
+    tip = np.concatenate([tip, seg[boundary, np.where(ends[boundary, 0], 0, 1)]])
+    order = np.argsort(rows)
+    return CrackCells(kind, rows[order], tip[order])
+
+
+def _sign_changes(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per row of ``values`` ``(n, q)``: how often the sign changes between its nonzero
+    samples (exact zeros, a tip on the cell's boundary, are skipped), and the columns
+    ``(i, j)`` of the two nonzero samples the first change lies between; each ``(n,)``."""
+    n = values.shape[0]
+    count, i, j = (np.zeros(n, dtype=np.int64) for _ in range(3))
+    last = np.full(n, -1)  # the column of the last nonzero sample, -1: none yet
+    signs = np.sign(values)
+    for column in range(values.shape[1]):
+        here = signs[:, column] != 0
+        change = here & (last >= 0)
+        change &= signs[:, column] != signs[np.arange(n), np.maximum(last, 0)]
+        first = change & (count == 0)
+        i, j = np.where(first, last, i), np.where(first, column, j)
+        count += change
+        last = np.where(here, column, last)
+    return count, i, j
 
 
 def _values(data: CellData, values: np.ndarray, X: np.ndarray) -> np.ndarray:
     """Interpolant of ``values`` ``(n, ndofs)`` at points ``X`` ``(n, q, 2)`` of each row."""
     n, q = X.shape[:2]
     return interpolant(data, np.repeat(values, q, axis=0), X.reshape(-1, 2))[0].reshape(n, q)
-
-
-def _refuse_mesh_aligned(data: CellData, phi: np.ndarray, psi: np.ndarray) -> None:
-    """Refuse cells where ``phi`` vanishes along a whole edge on which ``psi < 0`` somewhere."""
-    zero = zero_edges(data, phi)
-    start = psi[:, data.loop]
-    crack = (start < 0) | (np.roll(start, -1, axis=1) < 0)
-    if data.degree == 2:
-        crack |= psi[:, data.loop_mid] < 0
-    bad = np.flatnonzero((zero & crack).any(axis=1))
-    if bad.size:
-        raise ValueError(
-            f"the crack runs along a mesh edge in {describe_cells(bad)} (phi vanishes on the "
-            "whole edge); shift or rotate the crack off the mesh lines"
-        )
 
 
 def _classify_special(
@@ -214,20 +231,12 @@ def _newton_tip(
     return X
 
 
-def _refuse_on_boundary(data: CellData, rows: np.ndarray, X: np.ndarray, tol: float) -> None:
-    """Refuse tips ``X`` ``(n, 2)`` within ``tol`` of a vertex or an edge of their cells."""
+def _refuse_outside(data: CellData, rows: np.ndarray, X: np.ndarray, tol: float) -> None:
+    """Refuse tips ``X`` ``(n, 2)`` farther than ``tol`` outside their cells."""
     if rows.size == 0:
         return
     norms = np.hypot(*data.face_normals.T)
     distance = (data.face_offsets - X @ data.face_normals.T) / norms  # (n, nfaces)
-    close = np.abs(distance) <= tol
-    for count, case in ((2, "a node"), (1, "an edge")):
-        bad = close.sum(axis=1) >= count
-        if bad.any():
-            raise ValueError(
-                f"the crack tip lies on {case} of {describe_cells(rows[bad])} (within "
-                f"tip_tol = {tol:g}); move the tip off the mesh lines (e.g. by 1e-3 h)"
-            )
     outside = (distance < -tol).any(axis=1)
     if outside.any():
         raise ValueError(

@@ -12,7 +12,8 @@ polygon of the cell is fanned around the tip: every sub-triangle has the tip as
 vertex 0, so the singular functions of the tip need one collapsed vertex per
 sub-triangle only (see :mod:`xfem_contact.quadrature.tip_rules`). An edge of a fan
 triangle along the crack or its extension carries that piece's mid-node; the
-others are straight. Zero-area triangles (the crack through a vertex) are dropped;
+others are straight. Zero-area triangles (the crack through a vertex, a tip on the
+cell's boundary: on a node, on an edge, at the end of the ``phi`` cut) are dropped;
 a fan that folds (a crack too curved for its cell) is refused.
 """
 
@@ -114,11 +115,11 @@ def cut_tip_cells(
     c_mp, c_pm = seg[:, 0], seg[:, 1]
     psi_mp = interpolant(data, psi, c_mp)[0]
     psi_pm = interpolant(data, psi, c_pm)[0]
-    entry_mp = psi_mp < 0
-    wrong = np.flatnonzero(entry_mp == (psi_pm < 0))
+    entry_mp = psi_mp < psi_pm  # the other end is the exit, or the tip itself
+    wrong = np.flatnonzero(np.minimum(psi_mp, psi_pm) >= 0)
     if wrong.size:
         raise ValueError(
-            f"psi has the same sign at both ends of phi = 0 in {describe_cells(wrong)}: "
+            f"psi is not negative at either end of phi = 0 in {describe_cells(wrong)}: "
             "not tip cells (see classify_crack)"
         )
     m_mp = _midnodes(data, phi, c_mp, tip, None, xtol)  # piece c_mp -> tip
@@ -191,6 +192,9 @@ def _fan_nodes(
             scale = np.abs(nodes).max(axis=(1, 2))
             flat = np.abs(nodes[:, [1, 4]] - nodes[:, [2, 5]]).max(axis=(1, 2))
             keep = flat > 4 * _EPS * scale  # zero area: P == Q and the same tip edges
+            # ... or a tip on the cell's boundary: on P or Q, or on the straight edge P Q
+            area = np.abs(_jacobian_bernstein(nodes)).max(axis=1)
+            keep &= area > 64 * _EPS * scale**2
             tris.append(nodes[keep])
             cells.append(rows[keep])
     tri, cell = np.concatenate(tris), np.concatenate(cells)

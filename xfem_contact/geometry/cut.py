@@ -11,7 +11,8 @@ points from side -1 to side +1. Exact zeros at vertices and near-tangent edges
 follow the rules of :mod:`xfem_contact.geometry.cut_topology` (a zero vertex is on side
 -1 for its cell's topology when the interface leaves it along an edge; dips of
 an edge polynomial within ``64 eps max|phi|`` of zero are tangency). Roots are
-placed to ``xtol`` (reference coordinates); interface mid-nodes within 8 ulp
+placed to ``xtol`` (reference coordinates), a crossing within ``xtol`` of a vertex
+on the vertex; interface mid-nodes within 8 ulp
 (relative to the chord) of the chord midpoint are snapped onto it.
 
 A *simple* cut crosses the cell boundary exactly twice and is represented by

@@ -4,7 +4,9 @@ Helper of :mod:`xfem_contact.geometry.cut` (pure numpy and Basix, no DOLFINx). A
 *simple* cut crosses the cell boundary exactly twice (``kind == 0`` and mixed
 vertex sides in :func:`xfem_contact.geometry.cut_topology.topology`) and is represented
 by one SEG3 ``(a, b, mid)``. Its ends are closed-form roots of the edge
-polynomials of the two crossed loop edges. The mid-node is the zero of the
+polynomials of the two crossed loop edges; an end within ``xtol`` of a vertex is
+that vertex, bitwise (a node on the zero line leaves no sliver beside it, whatever
+rounding its nodal value carries). The mid-node is the zero of the
 interpolant on the perpendicular bisector of the chord (bracketed Newton of
 :mod:`xfem_contact.geometry.roots`); for degree 1 it is the chord midpoint. Mid-nodes
 within 8 ulp (relative to the chord) of the chord midpoint are snapped onto it. With
@@ -106,14 +108,20 @@ def _edge_crossings(
     s = _crossing_parameter(a, b, m)
     P = data.loop_coords[jn]
     d = data.loop_coords[jp] - P
-    if exact is not None:
-        tol = xtol / np.hypot(d[:, 0], d[:, 1])
+    tol = xtol / np.hypot(d[:, 0], d[:, 1])
+    # A crossing within xtol of a vertex is the vertex, bitwise: no sliver beside it
+    at_start, at_end = s <= tol, s >= 1.0 - tol
+    free = np.flatnonzero(~(at_start | at_end))
+    if exact is not None and free.size:
 
         def f(idx: np.ndarray, t: np.ndarray) -> np.ndarray:
-            return call_exact(exact, idx, P[idx] + t[:, None] * d[idx])
+            return call_exact(exact, free[idx], P[free[idx]] + t[:, None] * d[free[idx]])
 
-        s = bracketed_root(f, s, np.zeros_like(s), np.ones_like(s), tol)
-    return P + s[:, None] * d
+        s[free] = bracketed_root(f, s[free], np.zeros(free.size), np.ones(free.size), tol[free])
+    X = P + s[:, None] * d
+    X[at_start] = P[at_start]
+    X[at_end] = data.loop_coords[jp][at_end]
+    return X
 
 
 def call_exact(exact: ExactLevelSet, rows: np.ndarray, X: np.ndarray) -> np.ndarray:

@@ -60,6 +60,14 @@ class RuleSet:
         """Number of rules (cut cells)."""
         return int(self.offsets.size - 1)
 
+    def sums(self, values: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Per rule, the sum of ``values`` ``(N,)`` over its points, shape ``(num_rules,)``
+        (0 for an empty rule, wherever it lies)."""
+        values = np.asarray(values, dtype=np.float64)
+        if values.shape != self.weights.shape:
+            raise ValueError(f"values must have shape {self.weights.shape}, got {values.shape}")
+        return np.bincount(self.point_rows, weights=values, minlength=self.num_rules)
+
     def select(self, keep: npt.NDArray[np.bool_]) -> RuleSet:
         """The same rules with those of the rows not in ``keep`` emptied.
 

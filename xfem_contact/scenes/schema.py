@@ -209,8 +209,8 @@ FIELDS = {
         "lbb": Field(Choice(LBB_OPTIONS), " | ".join(LBB_OPTIONS)),
         "tip_radius": Field(
             _POSITIVE,
-            "tip enrichment radius (m), at least the tip cells' size (default: "
-            "the nodes of the tip cells)",
+            "tip enrichment radius (m); below the tip cells' size, the tip cells' nodes "
+            "with a warning (default: the nodes of the tip cells)",
         ),
         "rings": Field(
             ring_list,
