@@ -67,6 +67,11 @@ def _square(half: float, n: int, cell: str, comm: MPI.Comm) -> dolfinx.mesh.Mesh
     )
 
 
+def _plate(mesh: dolfinx.mesh.Mesh | None, half: float, n: int, comm: MPI.Comm):
+    """``mesh`` if given, else the structured triangles of ``[-half, half]^2``, ``n`` a side."""
+    return _square(half, n, "triangle", comm) if mesh is None else mesh
+
+
 def _on_boundary(half: float) -> Callable[[np.ndarray], np.ndarray]:
     return lambda x: np.isclose(np.abs(x[0]), half) | np.isclose(np.abs(x[1]), half)
 
@@ -152,19 +157,22 @@ def griffith_case(
     N: int,
     degree: int,
     beta: float = 0.5 * math.pi,
-    tip_radius: float | None = 0.3,
+    tip_radius: float | str | None = 0.3,
     width: float = 2.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
+    mesh: dolfinx.mesh.Mesh | None = None,
 ) -> CrackCase:
     """A Griffith crack of half length ``a = 1`` m, inclined at ``beta`` (rad) to a
     remote tension of 1 Pa, in the square of half width ``width`` (m) meshed with
     ``h = a / N``; Westergaard's exact displacement on the boundary, so that the plate's
-    size adds no error. Tip enrichment radius ``tip_radius`` (m)."""
+    size adds no error. Tip enrichment radius ``tip_radius`` (m, or ``"auto"``, see
+    :class:`~xfem_contact.mechanics.problem.Problem`). ``mesh``: a mesh of that square
+    instead (e.g. unstructured; ``N`` is then unused)."""
     a, (d, normal) = 1.0, _frame()
     centre = OFFSET * a
     crack = GriffithCrack.uniaxial(a, 1.0, beta, center=tuple(centre), direction=tuple(d))
     cut = CutMesh(
-        _square(width, int(round(2 * width * N / a)), "triangle", comm),
+        _plate(mesh, width, int(round(2 * width * N / a)), comm),
         lambda x: (x[0] - centre[0]) * normal[0] + (x[1] - centre[1]) * normal[1],
         degree=degree,
         tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
@@ -184,10 +192,11 @@ def frictional_crack_case(
     degree: int,
     friction: float = 0.3,
     beta: float = 0.25 * math.pi,
-    tip_radius: float | None = 0.3,
+    tip_radius: float | str | None = 0.3,
     width: float = 2.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
     lbb: str = "none",
+    mesh: dolfinx.mesh.Mesh | None = None,
 ) -> CrackCase:
     """A closed crack of half length ``a = 1`` m inclined at ``beta`` to a remote
     compression of 1 Pa, Coulomb friction ``friction`` on its lips, in the square of half
@@ -195,7 +204,7 @@ def frictional_crack_case(
     ``|tau| > friction |sigma_n|``): the uniform stress plus Westergaard's mode II field of
     the crack loaded by the effective shear ``tau_eff = |tau| - friction |sigma_n|``;
     imposed on the boundary. ``K_I = 0``, ``K_II = sign(tau) tau_eff sqrt(pi a)``. ``lbb``:
-    the law's LBB treatment."""
+    the law's LBB treatment; ``mesh``: a mesh of the square instead (``N`` unused)."""
     a, (d, normal) = 1.0, _frame()
     centre = OFFSET * a
     S11, S22, S12 = GriffithCrack.uniaxial(a, -1.0, beta).remote
@@ -216,7 +225,7 @@ def frictional_crack_case(
         return uniform + sliding.displacement(x, MATERIAL.E, MATERIAL.nu, MATERIAL.plane)
 
     cut = CutMesh(
-        _square(width, int(round(2 * width * N / a)), "triangle", comm),
+        _plate(mesh, width, int(round(2 * width * N / a)), comm),
         lambda x: (x[0] - centre[0]) * normal[0] + (x[1] - centre[1]) * normal[1],
         degree=degree,
         tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
