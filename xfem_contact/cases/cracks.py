@@ -2,8 +2,9 @@
 crack and the closed inclined crack with Coulomb friction.
 
 Shared by the tests and the benchmarks. SI units; the material is E = 1 Pa, nu = 0.3,
-plane strain unless given. Every crack is straight, turned so that no mesh line follows
-it, and its tips lie inside cells (never on a node or an edge).
+plane strain unless given. Every crack is straight, turned so that no line of the
+structured meshes follows it, and its tips lie inside their cells (never on a node or an
+edge); the Griffith and frictional cases also take a mesh of their plate.
 """
 
 from __future__ import annotations

@@ -31,8 +31,8 @@ class InterfaceSpec:
 class CrackSpec:
     """A crack: its shape's parameters (``points``; ``centre``, ``radius``,
     ``angles_deg``; or ``phi``, ``psi`` expressions), the law of its lips, the tip
-    enrichment radius (m; None: the tip cells' nodes) and the rings of K (m; None:
-    the default, in tip cell sizes)."""
+    enrichment radius (m; None: the default, half the tip's crack length) and the rings
+    of K (m; None: the default, in units of the tip's crack length)."""
 
     shape: str
     params: dict
