@@ -1,6 +1,6 @@
 """Cracks against exact solutions: convergence, stress intensity factors, time and conditioning.
 
-Four studies (``--parts``, all by default), on the cases of ``xfem_contact.cases.cracks``:
+The studies (``--parts``, all by default), on the cases of ``xfem_contact.cases.cracks``:
 
 - ``williams``: the exact mixed-mode Williams field on [-1, 1]^2, relative energy error
   and its rate over four meshes, P1 and P2, triangles and quadrilaterals, geometric
@@ -13,6 +13,11 @@ Four studies (``--parts``, all by default), on the cases of ``xfem_contact.cases
   friction 0.3 on its lips: K_II error, |K_I| / |K_II|, slip error in L2 along the lips;
 - ``edge``: a single-edge crack in a strip under tension against Tada's geometry factor;
 - ``growth``: an inclined crack growing under tension, its path on two meshes;
+- ``defaults``: the Griffith crack with the default tip radius and rings (lengths of the
+  crack) against the former ones (the tip cells, rings in tip cell sizes), signed K_I
+  errors, plates of half width 2a and 4a;
+- ``p1_error``: where P1's error lies (squared energy error in annuli around a tip) next
+  to its K error;
 - ``conditioning``: the condition number of the scaled reduced stiffness (power and
   inverse iterations) against h at fixed r_e, and against r_e / h at fixed h: Jacobi
   scaling alone (``kappa_jacobi``) and the tip enrichment's change of unknowns the
@@ -160,6 +165,129 @@ def griffith(say, quick: bool) -> list[dict]:
                     f"{row['J_over_G'] - 1:.1e}; build + solve {solve:.1f} s, with K {whole:.1f} s"
                     + (f"; peer: {peer[0]:.1e} at {peer[1]} dofs" if peer else "")
                 )
+    return rows
+
+
+def defaults(say, quick: bool) -> list[dict]:
+    """The Griffith crack with the defaults (tip radius ``"auto"`` = a / 2, the rings of
+    the scenes in units of a) against the former ones (the tip cells' nodes, rings 2..5
+    and 3..7 tip cell sizes), signed K_I errors per tip and ring, plates of half width 2a
+    and 4a."""
+    from xfem_contact.mechanics.fracture import tip_cell_size
+    from xfem_contact.scenes.crack_builder import default_rings
+
+    rows = []
+    runs = [(2.0, 1, [4, 8, 16, 32]), (2.0, 2, [8, 16]), (4.0, 1, [4, 8, 16])]
+    for width, degree, Ns in runs:
+        for N in Ns[:2] if quick else Ns:
+            for name, radius in (("auto", "auto"), ("mesh (former)", None)):
+                start = time.perf_counter()
+                case = griffith_case(N, degree, tip_radius=radius, width=width)
+                case.problem.solve()
+                if radius is None:
+                    mesh, tips = case.problem.mesh, case.problem.cut.crack.tips
+                    h = max(tip_cell_size(mesh, tip) for tip in tips)
+                    rings = [(2 * h, 5 * h), (3 * h, 7 * h)]
+                else:
+                    rings = default_rings(case.problem)
+                try:
+                    results = stress_intensity(case, rings)
+                except ValueError as error:  # a former ring reaching the boundary
+                    say(f"defaults {name}, half width {width:g}a, P{degree} h = a/{N}: {error}")
+                    continue
+                K_I = case.K[0][0]
+                errors = [[(r.K_I - K_I) / K_I for r in tip] for tip in results]
+                row = dict(
+                    case="defaults",
+                    defaults=name,
+                    width=width,
+                    degree=degree,
+                    h=f"a/{N}",
+                    dofs=case.problem.space.dof_counts().total,
+                    tip_radius=case.problem.space.tip_radius,
+                    rings=[[round(a, 4), round(b, 4)] for a, b in rings],
+                    K_I_errors=[[float(f"{e:.3e}") for e in tip] for tip in errors],
+                    time=time.perf_counter() - start,
+                )
+                rows.append(row)
+                say(
+                    f"defaults {name}, half width {width:g}a, P{degree} h = a/{N}: "
+                    f"{row['dofs']} dofs, K_I errors per tip and ring {row['K_I_errors']} "
+                    f"({row['time']:.1f} s)"
+                )
+    return rows
+
+
+def energy_error_annuli(case, bins: list[float]) -> list[tuple[float, float]]:
+    """Per annulus ``bins[k] <= r < bins[k + 1]`` (m) around tip 0 of a solved
+    :func:`griffith_case` (``beta = pi / 2``): the squared energy-norm error against
+    Westergaard's field and the exact energy (both sides). Collective."""
+    import dolfinx.fem
+    import ufl
+
+    from xfem_contact.mechanics.fracture import UFL, GriffithCrack
+
+    problem = case.problem
+    crack = problem.cut.crack
+    tip, d = crack.tips[0], crack.directions[0]
+    centre = 0.5 * (crack.tips[0] + crack.tips[1])
+    exact = GriffithCrack.uniaxial(
+        1.0, 1.0, 0.5 * math.pi, center=tuple(centre), direction=tuple(d)
+    )
+    x = ufl.SpatialCoordinate(problem.mesh)
+    u = problem.space.split(problem.w)
+    r = ufl.sqrt((x[0] - tip[0]) ** 2 + (x[1] - tip[1]) ** 2)
+    E, nu = MATERIAL.E, MATERIAL.nu
+
+    def strain(S):  # the plane strain compliance
+        return (1 + nu) / E * (S - nu * ufl.tr(S) * ufl.Identity(2))
+
+    def total(expr) -> float:
+        return MPI.COMM_WORLD.allreduce(dolfinx.fem.assemble_scalar(form(expr)), op=MPI.SUM)
+
+    out = []
+    for lo, hi in zip(bins[:-1], bins[1:], strict=True):
+        inside = ufl.conditional(ufl.And(ufl.ge(r, lo), ufl.lt(r, hi)), 1.0, 0.0)
+        err, whole = 0.0, 0.0
+        for i, side in enumerate((-1, 1)):
+            S = exact.stress(x, UFL, side=side)
+            e = MATERIAL.stress(u[i]) - S
+            err += total(ufl.inner(e, strain(e)) * inside * problem.cut.dx(side))
+            whole += total(ufl.inner(S, strain(S)) * inside * problem.cut.dx(side))
+        out.append((err, whole))
+    return out
+
+
+def p1_error(say, quick: bool) -> list[dict]:
+    """Where P1's error lies: the squared energy-norm error of the Griffith crack (plate
+    2a, r_e = 0.3a) in annuli around tip 0 (share of the whole), the relative energy
+    error squared and the K_I error (ring 0.2a..0.6a), at a/16 and a/32; P2 at a/8 for
+    comparison."""
+    bins = [0.0, 0.1, 0.3, 0.45, 0.6, 1.0, 1.5, 100.0]
+    rows = []
+    for degree, N in [(1, 16)] if quick else [(1, 16), (1, 32), (2, 8)]:
+        case = griffith_case(N, degree, tip_radius=0.3)
+        case.problem.solve()
+        ring = stress_intensity(case, [(0.2, 0.6)])[0][0]
+        annuli = energy_error_annuli(case, bins)
+        err = sum(e for e, _ in annuli)
+        row = dict(
+            case="p1_error",
+            degree=degree,
+            h=f"a/{N}",
+            K_I_error=(ring.K_I - case.K[0][0]) / case.K[0][0],
+            energy_error_squared=err / sum(w for _, w in annuli),
+            shares={
+                f"{lo:g}..{hi:g}a": round(e / err, 3)
+                for lo, hi, (e, _) in zip(bins[:-1], bins[1:], annuli, strict=True)
+            },
+        )
+        rows.append(row)
+        say(
+            f"P{degree} h = a/{N}: K_I error {row['K_I_error']:+.2e}, relative energy error "
+            f"squared {row['energy_error_squared']:.2e}, its shares by distance to tip 0 "
+            f"{row['shares']}"
+        )
     return rows
 
 
@@ -383,6 +511,8 @@ PARTS = {
     "friction": friction,
     "conditioning": conditioning,
     "growth": growth,
+    "defaults": defaults,
+    "p1_error": p1_error,
 }
 
 

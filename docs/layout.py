@@ -3,8 +3,9 @@
 The sub-packages are the steps of the data flow, lowest first (:data:`LAYERS`); each
 may import only the ones before it. ``tests/test_layout.py`` checks that by parsing the
 sources (nothing is imported), together with the module sizes (:data:`LONG_MODULE_LINES`,
-:data:`LONG_MODULES`) and :data:`MAX_ROOT_MODULES`. This script writes the table of modules (package | module |
-what it is: the summary of each module's docstring) between the markers
+:data:`LONG_MODULES`) and :data:`MAX_ROOT_MODULES`. This script writes the table of
+modules (package | module | what it is: the summary of each module's docstring) between
+the markers
 ``<!-- layout:start -->`` and ``<!-- layout:end -->`` of ``docs/architecture.md``::
 
     python docs/layout.py          # rewrite the tables

@@ -3,7 +3,8 @@ crack and the closed inclined crack with Coulomb friction.
 
 Shared by the tests and the benchmarks. SI units; the material is E = 1 Pa, nu = 0.3,
 plane strain unless given. Every crack is straight; by default turned so that no mesh
-line follows it, its tips inside cells (never on a node or an edge).
+line follows it, its tips inside cells (never on a node or an edge); the Griffith and
+frictional cases also take a mesh of their plate.
 """
 
 from __future__ import annotations
@@ -65,6 +66,12 @@ def _square(half: float, n: int, cell: str, comm: MPI.Comm) -> dolfinx.mesh.Mesh
     return dolfinx.mesh.create_rectangle(
         comm, corners, [n, n], CELLS[cell], partitioner=ghosted_partitioner()
     )
+
+
+def _plate(mesh: dolfinx.mesh.Mesh | None, half: float, n: int, cell: str, comm: MPI.Comm):
+    """``mesh`` if given, else the structured ``cell`` mesh of ``[-half, half]^2``, ``n``
+    cells a side."""
+    return _square(half, n, cell, comm) if mesh is None else mesh
 
 
 def _on_boundary(half: float) -> Callable[[np.ndarray], np.ndarray]:
@@ -165,25 +172,28 @@ def griffith_case(
     N: int,
     degree: int,
     beta: float = 0.5 * math.pi,
-    tip_radius: float | None = 0.3,
+    tip_radius: float | str | None = 0.3,
     width: float = 2.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
     angle: float = ANGLE,
     offset: tuple[float, float] = tuple(OFFSET),
     cell: str = "triangle",
+    mesh: dolfinx.mesh.Mesh | None = None,
 ) -> CrackCase:
     """A Griffith crack of half length ``a = 1`` m, inclined at ``beta`` (rad) to a
     remote tension of 1 Pa, in the square of half width ``width`` (m) meshed with
     ``h = a / N`` (``cell``: triangles or quadrilaterals); Westergaard's exact
     displacement on the boundary, so that the plate's size adds no error. Tip enrichment
-    radius ``tip_radius`` (m). The crack runs at ``angle`` (rad) from the x axis through
-    ``offset`` (m): by default off every mesh line (``angle = 0``, ``offset = (0, 0)``:
-    along a row of cell edges, tips on nodes)."""
+    radius ``tip_radius`` (m, or ``"auto"``, see
+    :class:`~xfem_contact.mechanics.problem.Problem`). The crack runs at ``angle`` (rad)
+    from the x axis through ``offset`` (m): by default off every mesh line (``angle = 0``,
+    ``offset = (0, 0)``: along a row of cell edges, tips on nodes). ``mesh``: a mesh of
+    that square instead (e.g. unstructured; ``N`` and ``cell`` are then unused)."""
     a, (d, normal) = 1.0, _frame(angle)
     centre = np.asarray(offset, dtype=float) * a
     crack = GriffithCrack.uniaxial(a, 1.0, beta, center=tuple(centre), direction=tuple(d))
     cut = CutMesh(
-        _square(width, int(round(2 * width * N / a)), cell, comm),
+        _plate(mesh, width, int(round(2 * width * N / a)), cell, comm),
         lambda x: (x[0] - centre[0]) * normal[0] + (x[1] - centre[1]) * normal[1],
         degree=degree,
         tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
@@ -203,12 +213,13 @@ def frictional_crack_case(
     degree: int,
     friction: float = 0.3,
     beta: float = 0.25 * math.pi,
-    tip_radius: float | None = 0.3,
+    tip_radius: float | str | None = 0.3,
     width: float = 2.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
     lbb: str = "none",
     angle: float = ANGLE,
     offset: tuple[float, float] = tuple(OFFSET),
+    mesh: dolfinx.mesh.Mesh | None = None,
 ) -> CrackCase:
     """A closed crack of half length ``a = 1`` m inclined at ``beta`` to a remote
     compression of 1 Pa, Coulomb friction ``friction`` on its lips, in the square of half
@@ -216,7 +227,8 @@ def frictional_crack_case(
     ``|tau| > friction |sigma_n|``): the uniform stress plus Westergaard's mode II field of
     the crack loaded by the effective shear ``tau_eff = |tau| - friction |sigma_n|``;
     imposed on the boundary. ``K_I = 0``, ``K_II = sign(tau) tau_eff sqrt(pi a)``. ``lbb``:
-    the law's LBB treatment; ``angle``, ``offset``: as for :func:`griffith_case`."""
+    the law's LBB treatment; ``angle``, ``offset``, ``mesh``: as for
+    :func:`griffith_case`."""
     a, (d, normal) = 1.0, _frame(angle)
     centre = np.asarray(offset, dtype=float) * a
     S11, S22, S12 = GriffithCrack.uniaxial(a, -1.0, beta).remote
@@ -237,7 +249,7 @@ def frictional_crack_case(
         return uniform + sliding.displacement(x, MATERIAL.E, MATERIAL.nu, MATERIAL.plane)
 
     cut = CutMesh(
-        _square(width, int(round(2 * width * N / a)), "triangle", comm),
+        _plate(mesh, width, int(round(2 * width * N / a)), "triangle", comm),
         lambda x: (x[0] - centre[0]) * normal[0] + (x[1] - centre[1]) * normal[1],
         degree=degree,
         tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,

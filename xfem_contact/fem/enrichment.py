@@ -26,6 +26,7 @@ from mpi4py import MPI
 from xfem_contact.fem.branch import UFL, branch_values, null_pins
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.subspaces import collapse
+from xfem_contact.fem.tip_scale import default_tip_radius
 from xfem_contact.geometry.crack import CROSSED, TIP
 
 _logger = logging.getLogger(__name__)
@@ -64,9 +65,11 @@ class EnrichedSpace:
             active on the cut cells of its interface only (``None``: all).
         tip_radius: For a cut by a crack (``cut.crack``): the tip enrichment's radius
             (m): the vertices within it of a tip carry the four branch functions
-            (geometric enrichment, with the ramp below); ``None``: the tip cells' nodes.
-            A radius below the tip cells' diameter takes the ramp 1 on the tip cells'
-            vertices instead, with a logged warning.
+            (geometric enrichment, with the ramp below); ``"auto"``: a fixed fraction
+            of the tips' crack length (:func:`~xfem_contact.fem.tip_scale.default_tip_radius`,
+            None without a crack); ``None``: the tip cells' nodes. A radius below the tip
+            cells' diameter takes the ramp 1 on the tip cells' vertices instead, with a
+            logged warning.
 
     A crack's multipliers live on the vertices of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillated, K_I of a closed crack 0.23 instead
@@ -92,7 +95,7 @@ class EnrichedSpace:
         multiplier: int = 0,
         min_support_fraction: float = 0.0,
         multipliers: Sequence[tuple[int, str | None]] | None = None,
-        tip_radius: float | None = None,
+        tip_radius: float | str | None = None,
     ):
         if degree not in (1, 2):
             raise ValueError(f"Displacement degree must be 1 or 2, got {degree}")
@@ -120,6 +123,12 @@ class EnrichedSpace:
         self.has_multiplier = bool(multipliers)
         #: The field of the branch dofs (None without a crack)
         self.branch_field: int | None = None
+        if isinstance(tip_radius, str):
+            if tip_radius != "auto":
+                raise ValueError(
+                    f"tip_radius must be a length (m), 'auto' or None, got {tip_radius!r}"
+                )
+            tip_radius = None if cut.crack is None else default_tip_radius(cut)
         if cut.crack is not None:
             elements.append(basix.ufl.element("Lagrange", cell, 1, shape=(4 * gdim,)))
             self.branch_field = len(elements) - 1

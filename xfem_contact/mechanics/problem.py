@@ -57,7 +57,9 @@ class Problem:
             element of :mod:`xfem_contact.mechanics.sliding`).
         slave, pairing: See :class:`~xfem_contact.mechanics.laws.sliding.SlidingFrictionless`
             (``kinematics="large"`` only): the slave side, when pairs are searched.
-        tip_radius: A crack's tip enrichment radius (m), see :class:`EnrichedSpace`.
+        tip_radius: A crack's tip enrichment radius (m), ``"auto"`` (default: a fixed
+            fraction of the tips' crack length, not of the mesh) or None (the tip cells'
+            nodes), see :class:`EnrichedSpace`.
 
     Collective.
     """
@@ -74,7 +76,7 @@ class Problem:
         kinematics: str = DEFAULT.kinematics,
         slave: int = DEFAULT.slave,
         pairing: str = DEFAULT.pairing,
-        tip_radius: float | None = None,
+        tip_radius: float | str | None = "auto",
     ):
         if kinematics not in KINEMATICS:
             raise ValueError(f"Unknown kinematics {kinematics!r}; valid: {KINEMATICS}")

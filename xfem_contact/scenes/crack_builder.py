@@ -19,6 +19,7 @@ import numpy as np
 from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.tip_scale import tip_lengths
 from xfem_contact.geometry.crack_paths import CrackPath, arc, polyline
 from xfem_contact.mechanics.composition import crack_law
 from xfem_contact.mechanics.fracture import tip_cell_size
@@ -119,7 +120,8 @@ def crack_cut(scene: Scene, mesh: dolfinx.mesh.Mesh, interfaces: dict | None = N
         message = re.sub(r"^(levelset|tangent)(\[[^]]*\])?: ", "", " ".join(str(error).split()))
         raise SceneError(crack_key(scene, str(error)), message) from None
     # no ghost penalty: its derivatives of the branch functions make the forms very costly
-    options = {"tip_radius": scene.cracks[0].tip_radius, "ghost_penalty": 0.0}
+    tip_radius = scene.cracks[0].tip_radius
+    options = {"tip_radius": "auto" if tip_radius is None else tip_radius, "ghost_penalty": 0.0}
     materials = body if not scene.interfaces else {-1: inside, 1: body}
     return cut, laws, materials, options
 
@@ -164,29 +166,31 @@ def _boundary_distance(mesh: dolfinx.mesh.Mesh, point: np.ndarray) -> float:
 
 
 def default_rings(problem) -> list[tuple[float, float]]:
-    """The rings of K (m) for every tip: :data:`CRACK_RINGS` in units of the largest tip
-    cell size ``h``, ``r_sup`` kept within 90 % of the distance from every tip to the
-    boundary and to the other tips; a ring left narrower than ``h / 2`` is dropped.
-    Collective.
+    """The rings of K (m) for every tip: :data:`CRACK_RINGS` in units of the shortest
+    tip's crack length (:func:`~xfem_contact.fem.tip_scale.tip_lengths`, not of the
+    mesh), ``r_inf`` at least the largest tip cell size ``h``, ``r_sup`` kept within
+    90 % of the distance from every tip to the boundary and to the other tips; a ring
+    left narrower than ``h / 2`` is dropped. Collective.
 
     Raises:
         SceneError: a tip too close to the boundary or another tip for any ring.
     """
     mesh, tips = problem.mesh, problem.cut.crack.tips
     h = max(tip_cell_size(mesh, tip) for tip in tips)
+    length = float(tip_lengths(problem.cut).min())
     room = min(_boundary_distance(mesh, np.asarray(tip)) for tip in tips)
     if len(tips) > 1:
         gaps = np.linalg.norm(tips[:, None] - tips[None], axis=2)
         room = min(room, float(gaps[~np.eye(len(tips), dtype=bool)].min()))
     if problem.cut.cracks is not None:  # and to the other cracks
         room = min(room, problem.cut.cracks.gap)
-    rings = [(a * h, min(b * h, 0.9 * room)) for a, b in CRACK_RINGS]
+    rings = [(max(a * length, h), min(b * length, 0.9 * room)) for a, b in CRACK_RINGS]
     rings = [(r_inf, r_sup) for r_inf, r_sup in rings if r_sup - r_inf >= 0.5 * h]
     if not rings:
         raise SceneError(
             "cracks[0].rings",
             f"a tip lies {room:.4g} m from the boundary or another tip, too close for the "
-            f"default rings from {CRACK_RINGS[0][0]:g} tip cell sizes ({h:.4g} m): refine "
-            "the mesh or give rings = [[r_inf, r_sup], ...] (m)",
+            f"default rings from {CRACK_RINGS[0][0]:g} crack lengths ({length:.4g} m) or the "
+            f"tip cells ({h:.4g} m): refine the mesh or give rings = [[r_inf, r_sup], ...] (m)",
         )
     return rings

@@ -31,9 +31,9 @@ class InterfaceSpec:
 class CrackSpec:
     """A crack: its shape's parameters (``points``; ``centre``, ``radius``,
     ``angles_deg``; or ``phi``, ``psi`` expressions), the law of its lips, the tip
-    enrichment radius (m; None: the tip cells' nodes), the rings of K (m; None:
-    the default, in tip cell sizes) and the reference ``(K_I, K_II)`` (Pa m^1/2) of
-    every tip with its source (None: no reference)."""
+    enrichment radius (m; None: the default, half the tip's crack length), the rings of
+    K (m; None: the default, in units of the tip's crack length) and the reference
+    ``(K_I, K_II)`` (Pa m^1/2) of every tip with its source (None: no reference)."""
 
     shape: str
     params: dict

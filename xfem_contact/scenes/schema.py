@@ -79,8 +79,9 @@ CRACK_SHAPE_KEYS = {
     "arc": (("centre", "radius", "angles_deg"), ()),
     "expression": (("phi", "psi"), ()),
 }
-#: Default rings of the stress intensity factors, in units of the tip cell size
-CRACK_RINGS = ((2.0, 5.0), (3.0, 7.0))
+#: Default rings of the stress intensity factors, in units of the tip's crack length
+#: (:func:`~xfem_contact.fem.tip_scale.tip_lengths`: ``a`` for a crack of length ``2a``)
+CRACK_RINGS = ((0.2, 0.6), (0.3, 0.8))
 #: The keys of each load type besides ``type``: (required, optional)
 LOAD_KEYS = {
     "pressure": (("part", "value"), ("side", "history")),
@@ -210,12 +211,14 @@ FIELDS = {
         "tip_radius": Field(
             _POSITIVE,
             "tip enrichment radius (m); below the tip cells' size, the tip cells' nodes "
-            "with a warning (default: the nodes of the tip cells)",
+            "with a warning (default: half the tip's crack length, at least the tip "
+            "cells' size)",
         ),
         "rings": Field(
             ring_list,
             "[[r_inf, r_sup], ...] (m) of the K integrals (default: "
-            f"{[list(r) for r in CRACK_RINGS]} tip cell sizes, r_sup kept off the boundary)",
+            f"{[list(r) for r in CRACK_RINGS]} tip's crack lengths, r_sup kept off the "
+            "boundary)",
         ),
         "material": Field(Text(), "material of the cracked body (default: the first)"),
         "reference_K": Field(
