@@ -89,10 +89,15 @@ def test_williams_field_p2(enrichment):
         assert error > 2.5e-2  # 3.5e-2, three times the geometric enrichment's
         return
     assert error < 1.2e-2  # 1.07e-2 measured; 4e-2 with the cut cells' default degree 6
-    (ring,) = TipIntegrals(case.problem, [(0.2, 0.6)]).evaluate()[0]
+    integrals = TipIntegrals(case.problem, [(0.2, 0.6)])
+    (ring,) = integrals.evaluate()[0]
     assert ring.K_I == pytest.approx(1.0, abs=1.5e-4)
     assert ring.K_II == pytest.approx(0.5, abs=1.5e-4)
     assert ring.J == pytest.approx(ring.G, rel=2e-4)
+    # each side owns its moduli: one side changed, K (one material) is refused
+    case.problem.materials[-1].E = 2.0 * case.problem.materials[1].E
+    with pytest.raises(ValueError, match="one material around the tips"):
+        integrals.evaluate()
 
 
 @pytest.mark.serial

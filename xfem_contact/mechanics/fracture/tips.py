@@ -101,5 +101,18 @@ class TipIntegrals:
 
     def evaluate(self) -> list[list[RingResult]]:
         """Per tip, per ring: K_I, K_II (Pa m^1/2), J and G (J/m^2) of the current
-        solution. Collective; the same on every process."""
+        solution. Collective; the same on every process.
+
+        Raises:
+            ValueError: the two sides' materials differ (each side owns its moduli: the
+                interaction integral here is that of one homogeneous material).
+        """
+        sides = self.problem.bulk.materials
+        if (sides[-1].E, sides[-1].nu) != (sides[1].E, sides[1].nu):
+            raise ValueError(
+                "K, J and G need one material around the tips, but the crack's sides "
+                f"differ: side -1 E = {sides[-1].E:.6g} Pa, nu = {sides[-1].nu:.6g}; side "
+                f"+1 E = {sides[1].E:.6g} Pa, nu = {sides[1].nu:.6g}. Set the same E and "
+                "nu on problem.materials[-1] and problem.materials[1]"
+            )
         return [integral.evaluate() for integral in self.integrals]
