@@ -85,7 +85,7 @@ def test_scene_selects_the_preset():
     assert load_scene(base(law="sticking")).petsc_options.get("pc_type") is None
     with pytest.raises(SceneError, match=r"solver.linear.*direct"):
         load_scene(base(law="sticking") | {"solver": {"linear": "multigrid"}})
-    with pytest.raises(ValueError, match="Unknown linear solver 'cg'"):
+    with pytest.raises(ValueError, match="Unknown solver preset 'cg'"):
         preset("cg")
     assert set(LINEAR_PRESETS) == {"direct", "iterative"}
 

@@ -28,7 +28,7 @@ from xfem_contact.mechanics.sliding.lips import CurvePoint
 from xfem_contact.mechanics.sliding.projection import closest_points
 from xfem_contact.mechanics.sliding.segments import split
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton
-from xfem_contact.solvers.options import REUSED_LU_OPTIONS, preset
+from xfem_contact.solvers.options import preset
 
 
 class ArcLip:
@@ -474,7 +474,7 @@ def test_a_reused_factorisation_that_fails_is_refactored_not_fatal():
     fails at the second iterate, Newton goes on, the next iterate refactors and the
     step converges to the solution of LU at every iterate."""
     solutions = []
-    for options in ({"ksp_type": "preonly"}, {**REUSED_LU_OPTIONS, "ksp_max_it": 3}):
+    for options in ({"ksp_type": "preonly"}, {**preset("reused_lu"), "ksp_max_it": 3}):
         problem = rotating_annulus_problem(6, 2, 1.0)
         problem.loads.set_time(0.5)
         report = problem.solve(options)

@@ -30,7 +30,7 @@ from xfem_contact.cases import paper
 from xfem_contact.cases.body_fitted import INCLUSION_GEO, annulus_geo, mesh_geo
 from xfem_contact.mechanics.bulk import cell_size
 from xfem_contact.mechanics.materials import Material
-from xfem_contact.solvers.options import remove_options, unique_prefix
+from xfem_contact.solvers.options import preset, remove_options, unique_prefix
 
 #: Nitsche's penalty: gamma = NITSCHE * degree^2 (dimensionless)
 NITSCHE = 10.0
@@ -148,11 +148,7 @@ class TwoBodies:
             self._load_forms(),
             bcs=self.bcs,
             petsc_options_prefix=prefix,
-            petsc_options={
-                "ksp_type": "preonly",
-                "pc_type": "lu",
-                "pc_factor_mat_solver_type": "mumps",
-            },
+            petsc_options=preset("fitted"),
             entity_maps=self.entity_maps,
             kind="mpi",
         )

@@ -25,7 +25,7 @@ from xfem_contact.fem.enrichment import DofCounts
 from xfem_contact.fem.forms import form
 from xfem_contact.mechanics.loads import Loads, PlainFields
 from xfem_contact.mechanics.materials import Material, Moduli
-from xfem_contact.solvers.options import remove_options, unique_prefix
+from xfem_contact.solvers.options import preset, remove_options, unique_prefix
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 
 
@@ -131,7 +131,7 @@ class PlainElasticityProblem:
             bcs=self.loads.bcs,
             u=self.w,
             petsc_options_prefix=prefix,
-            petsc_options={"ksp_type": "preonly", "pc_type": "lu", **(petsc_options or {})},
+            petsc_options={**preset("plain"), **(petsc_options or {})},
         )
         try:
             problem.solve()

@@ -30,11 +30,10 @@ from xfem_contact.mechanics.loads import Loads, SideFields
 from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
-from xfem_contact.solvers.linear import added_options, solve_restricted, tip_transform
+from xfem_contact.solvers.linear import solve_restricted, tip_transform
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton, weak_method
-from xfem_contact.solvers.options import merged_options
+from xfem_contact.solvers.options import Facts, problem_options, splits_fields
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
-from xfem_contact.solvers.symmetry import symmetric_options
 
 
 class Problem:
@@ -197,14 +196,13 @@ class Problem:
 
     def solver_options(self, petsc_options: dict | None = None) -> dict:
         """The PETSc options (without prefix) :meth:`solve` uses: ``petsc_options``
-        over the defaults, the LDL^T of a symmetric problem included. Not collective."""
+        over the defaults and the presets that apply to this problem (the LDL^T of a
+        symmetric one, a crack's, large sliding's; see
+        :func:`~xfem_contact.solvers.options.problem_options`). Not collective."""
         solver = "linear" if self.linear else "newton"
-        return merged_options(solver, self._options(petsc_options))
-
-    def _options(self, petsc_options: dict | None) -> dict:
-        """``petsc_options`` over LDL^T when symmetric and a crack's or large sliding's."""
-        options = symmetric_options(petsc_options, self.symmetric)
-        return {**added_options(self.space, options, bool(self.couplings)), **options}
+        crack_tip = self.space.branch_field is not None
+        facts = Facts(dict(petsc_options or {}), self.symmetric, crack_tip, bool(self.couplings))
+        return problem_options(solver, facts)
 
     def law(self, name: str | None = None) -> InterfaceLaw:
         """The law of interface ``name`` (of the only interface for ``None``)."""
@@ -291,7 +289,7 @@ class Problem:
         if self._checked_loads != self.loads.revision:  # again only when the loads changed
             check_support(self, log)
             self._checked_loads = self.loads.revision
-        petsc_options = self._options(petsc_options)
+        petsc_options = self.solver_options(petsc_options)
         if self.linear:
             a, L = form(self.bilinear_form()), form(self.loads.linear_form())
             start, residuals = time.perf_counter(), []
@@ -316,7 +314,7 @@ class Problem:
             self._newton.destroy()  # loads or solver options changed since it was built
             self._newton = None
         if self._newton is None:
-            split = (petsc_options or {}).get("pc_type") in ("fieldsplit", "python")
+            split = splits_fields(petsc_options)
             self._newton = RestrictedNewton(
                 self.residual(self.w),
                 self.w,

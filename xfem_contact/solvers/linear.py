@@ -19,18 +19,8 @@ from petsc4py import PETSc
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.restriction import restriction_matrix
 from xfem_contact.solvers.assembly import ReducedMatrix
-from xfem_contact.solvers.block_scaling import (
-    crack_options,
-    refined,
-    scaled,
-    tip_transform,
-)
-from xfem_contact.solvers.options import (
-    applied_options,
-    merged_options,
-    reused_lu,
-    unique_prefix,
-)
+from xfem_contact.solvers.block_scaling import refined, scaled, tip_transform
+from xfem_contact.solvers.options import applied_options, merged_options, unique_prefix
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.symmetry import mark_symmetric
@@ -180,10 +170,3 @@ def solve_restricted(
         for obj in {id(o): o for o in owned}.values():
             obj.destroy()
 
-
-def added_options(space: EnrichedSpace, options: dict, couplings: bool) -> dict:
-    """The options a problem's solver adds under its ``options``: a crack's
-    (:func:`~xfem_contact.solvers.block_scaling.crack_options`) and, with ``couplings``
-    (large sliding), the reused LU (:func:`~xfem_contact.solvers.options.reused_lu`).
-    Not collective."""
-    return {**crack_options(space, options, couplings), **reused_lu(options, couplings)}

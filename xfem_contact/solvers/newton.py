@@ -51,10 +51,10 @@ class RestrictedNewton:
     the current ``w`` (projected on the range of ``R D``) and checks the final residual
     against the tolerances. With ``pc_type = "cholesky"`` every Jacobian is checked to
     be symmetric first (:func:`~xfem_contact.solvers.symmetry.mark_symmetric`). A
-    Krylov method over a factorisation (``pc_type`` lu or cholesky, e.g.
-    :data:`~xfem_contact.solvers.options.REUSED_LU_OPTIONS`) keeps the factorisation of
-    an earlier iterate of the same solve: it refactors at the first iterate, when the
-    pattern grows, and after a linear solve that failed or took more than
+    Krylov method over a factorisation (``pc_type`` lu or cholesky, e.g. the preset
+    ``reused_lu`` of :data:`~xfem_contact.solvers.options.PRESETS`) keeps the
+    factorisation of an earlier iterate of the same solve: it refactors at the first
+    iterate, when the pattern grows, and after a linear solve that failed or took more than
     :data:`~xfem_contact.solvers.options.REFACTOR_AFTER` iterations; such a failed
     linear solve does not end the Newton solve (its step is taken as it is, the final
     residual check stands).
@@ -74,7 +74,7 @@ class RestrictedNewton:
             dict shown in the log.
         log: Called with each log line (e.g. ``print``); ``None`` for silence.
         splits: For a ``fieldsplit`` preconditioner, or the band multigrid of the
-            ``"iterative"`` preset of :data:`~xfem_contact.solvers.options.LINEAR_PRESETS`
+            ``"iterative"`` preset of :data:`~xfem_contact.solvers.options.PRESETS`
             (which reads ``"u"`` and ``"band"``): split name to the
             local dofs of ``W`` it holds: shape ``(n,)``, the reduced unknowns touching
             them; or ``(n, bs)``, blocks of dofs that are reduced unknowns themselves
