@@ -74,7 +74,7 @@ def main():
 
     say(f"paper case 2: {args.n}x{args.n} {args.cell}, degree {args.degree}, law {args.law}")
     t0 = time.perf_counter()
-    options = {"lbb": args.lbb}
+    options = {"lbb": args.lbb, "petsc_options": preset(args.solver)}
     if args.law == "coulomb":
         options["friction"] = args.friction
     problem = inclusion_problem(args.n, args.degree, args.law, args.cell, **options)
@@ -84,7 +84,7 @@ def main():
     dofs = problem.space.dof_counts()  # collective
     say(f"  {cut.num_cut_cells_global} cut cells; dofs {dofs._asdict()}")
 
-    report = problem.solve(preset(args.solver), log=say)
+    report = problem.solve(log=say)
     setup = problem.solver_timings
     timings["forms"] = setup["forms"]
     timings["sparsity"] = setup["sparsity"]
@@ -128,7 +128,7 @@ def main():
             "tangential_traction_rel_L2_error": errors.tangential,
             "newton_iterations": report.iterations,
             "solver": args.solver,
-            "factorisation": problem.solver_options(preset(args.solver))["pc_type"],
+            "factorisation": problem.solver_options()["pc_type"],
             "krylov_iterations": report.linear_iterations,
             "newton_residuals": report.residuals,
             "contact_status": report.status[-1],

@@ -221,7 +221,8 @@ def test_rigid_rotation_by_a_right_angle_carries_no_stress():
     for t in (0.5, 1.0):
         problem.loads.set_time(t)
         # no load: the rotation's residual is round-off (4e-9), not to be reduced 1e10 times
-        problem.solve({"snes_atol": 1e-7})
+        problem.petsc_options = {"snes_atol": 1e-7}
+        problem.solve()
         problem.accept_step()
     lam = problem.interface_state()["lambda_n"]
     scale = 1e6  # the load scale of case 3 (Pa)
@@ -371,9 +372,11 @@ def test_a_failing_step_reports_its_history_and_keeps_the_accepted_state():
     accepted = problem.w.x.array.copy()
     problem.loads.set_time(1.0)
     with pytest.raises(NewtonFailure, match="iterate  1") as failure:
-        problem.solve({"snes_max_it": 1})
+        problem.petsc_options = {"snes_max_it": 1}
+        problem.solve()
     assert failure.value.report.iterations == 1
     assert np.array_equal(problem.w.x.array, accepted)
+    problem.petsc_options = {}
     problem.loads.set_time(0.5)
     assert problem.solve().iterations <= 10
 
@@ -443,10 +446,11 @@ def test_newton_reuses_a_factorisation_and_takes_the_exact_steps(monkeypatch):
     for name, options in (("exact", {"ksp_type": "preonly"}), ("reused", None)):
         problem = rotating_annulus_problem(6, 2, 1.0)
         assert (problem.solver_options(options)["ksp_type"] == "gmres") == (options is None)
+        problem.petsc_options = options
         reports = []
         for k in (1, 2):
             problem.loads.set_time(k / 2)
-            reports.append(problem.solve(options))
+            reports.append(problem.solve())
             problem.accept_step()
         runs[name] = (reports, problem.w.x.array.copy())
     (exact, w_exact), (reused, w_reused) = runs["exact"], runs["reused"]
@@ -477,7 +481,8 @@ def test_a_reused_factorisation_that_fails_is_refactored_not_fatal():
     for options in ({"ksp_type": "preonly"}, {**preset("reused_lu"), "ksp_max_it": 3}):
         problem = rotating_annulus_problem(6, 2, 1.0)
         problem.loads.set_time(0.5)
-        report = problem.solve(options)
+        problem.petsc_options = options
+        report = problem.solve()
         solutions.append(problem.w.x.array.copy())
     assert max(report.linear_iterations) == 3 and report.linear_iterations.count(1) >= 2
     assert np.abs(solutions[1] - solutions[0]).max() < 1e-9 * np.abs(solutions[0]).max()

@@ -45,7 +45,8 @@ def test_loads_added_after_a_solve_are_used():
 def test_solver_options_given_after_a_solve_are_used():
     problem = inclusion_problem(8, 1, "sticking")
     problem.solve()
-    problem.solve(petsc_options={"snes_rtol": 1e-6, "snes_atol": 1e-9})
+    problem.petsc_options = {"snes_rtol": 1e-6, "snes_atol": 1e-9}
+    problem.solve()
     rtol, atol, _, _ = problem.newton.snes.getTolerances()
     assert (rtol, atol) == (1e-6, 1e-9)
 
@@ -63,7 +64,8 @@ def test_failure_keeps_the_state_before_the_solve():
     problem.loads.add_pressure(sides, -0.5)  # a harder load, several Newton steps
     before = problem.w.x.array.copy()
     with pytest.raises(NewtonFailure, match="restored") as failure:
-        problem.solve(petsc_options={"snes_max_it": 1})
+        problem.petsc_options = {"snes_max_it": 1}
+        problem.solve()
     assert failure.value.report.iterations == 1
     assert np.array_equal(problem.w.x.array, before)
     assert problem.last_report is failure.value.report
@@ -91,12 +93,14 @@ def test_a_linear_solve_fails_as_newton_does(make):
     before = problem.w.x.array.copy()
     problem.loads.set_time(2.0)
     with pytest.raises(LinearSolveFailure, match="KSP converged reason -3") as failure:
-        problem.solve(petsc_options=ONE_CG_STEP)
+        problem.petsc_options = ONE_CG_STEP
+        problem.solve()
     assert isinstance(failure.value, SolveError)
     assert failure.value.report.reason < 0
     assert problem.last_report is failure.value.report
     assert np.array_equal(problem.w.x.array, before)
     assert our_options() == []
+    problem.petsc_options = {}
     problem.solve()  # and the problem solves again
     assert problem.last_report.converged
 
@@ -114,15 +118,18 @@ def test_ksponly_cannot_pass_as_converged():
     """One linear step of a problem that needs several does not meet the tolerances."""
     problem = inclusion_problem(10, 2, "coulomb", loading="pull", friction=1.0)
     with pytest.raises(NewtonFailure, match="final residual"):
-        problem.solve(petsc_options={"snes_type": "ksponly"})
+        problem.petsc_options = {"snes_type": "ksponly"}
+        problem.solve()
 
 
 def test_no_option_outlives_its_solve():
     problem = inclusion_problem(8, 1, "sticking", lbb="stabilized")
-    problem.solve(petsc_options={"snes_linesearch_type": "bt"})
+    problem.petsc_options = {"snes_linesearch_type": "bt"}
+    problem.solve()
     assert our_options() == []
     bonded = inclusion_problem(8, 1, "bonded")
-    bonded.solve(petsc_options={"ksp_type": "preonly"})
+    bonded.petsc_options = {"ksp_type": "preonly"}
+    bonded.solve()
     assert our_options() == []
     # DOLFINx's LinearProblem writes its own options: plain elasticity and the
     # body-fitted baselines remove them after the solve
@@ -132,3 +139,66 @@ def test_no_option_outlives_its_solve():
     fitted_inclusion(0.2, 1)
     nitsche_inclusion(0.2, 1)
     assert our_options() == []
+
+
+def test_options_given_at_construction_reach_petsc_under_the_prefix():
+    options = {"snes_rtol": 1e-7, "snes_max_it": 17, "ksp_type": "gmres"}
+    problem = inclusion_problem(
+        8, 1, "sticking", petsc_options=options, petsc_options_prefix="mine_"
+    )
+    problem.solve()
+    snes = problem.newton.snes
+    assert snes.getOptionsPrefix() == "mine_"
+    assert snes.getKSP().getOptionsPrefix() == "mine_"
+    rtol, _, _, max_it = snes.getTolerances()
+    assert (rtol, max_it) == (1e-7, 17)
+    assert snes.getKSP().getType() == "gmres"
+    assert problem.solver_options()["snes_max_it"] == 17
+    # a new value is an explicit change: the next solve rebuilds the solver with it
+    problem.petsc_options = {"snes_max_it": 9}
+    problem.solve()
+    assert problem.newton.snes is not snes
+    assert problem.newton.snes.getTolerances()[3] == 9
+    assert [k for k in PETSc.Options().getAll() if k.startswith("mine_")] == []
+    # the plain problem too (its KSP)
+    plain = PlainElasticityProblem(
+        dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 2, 2),
+        1,
+        Material(1e3, 0.3),
+        petsc_options=ONE_CG_STEP,
+        petsc_options_prefix="plain_mine_",
+    )
+    plain.loads.add_displacement(lambda x: np.isclose(x[1], 0.0), 0.0)
+    plain.loads.add_traction(lambda x: np.isclose(x[1], 1.0), (0.0, -10.0))
+    with pytest.raises(LinearSolveFailure, match="reason -3"):  # one CG step: the options
+        plain.solve()
+
+
+def test_problems_without_a_prefix_get_different_ones():
+    first, second = inclusion_problem(4, 1, "sticking"), inclusion_problem(4, 1, "sticking")
+    assert first.petsc_options_prefix != second.petsc_options_prefix
+    assert first.petsc_options_prefix.startswith("xfem_problem_")
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 2, 2)
+    plains = [PlainElasticityProblem(mesh, 1, Material(1e3, 0.3)) for _ in range(2)]
+    assert plains[0].petsc_options_prefix != plains[1].petsc_options_prefix
+
+
+def test_an_empty_prefix_is_refused():
+    with pytest.raises(ValueError, match="petsc_options_prefix must be a non-empty string, got ''"):
+        inclusion_problem(4, 1, "sticking", petsc_options_prefix="")
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 2, 2)
+    with pytest.raises(ValueError, match="petsc_options_prefix must be a non-empty string"):
+        PlainElasticityProblem(mesh, 1, Material(1e3, 0.3), petsc_options_prefix="")
+
+
+def test_options_at_solve_are_deprecated_and_used_for_that_solve():
+    problem = inclusion_problem(8, 1, "sticking")
+    with pytest.warns(DeprecationWarning, match=r"Problem\(\.\.\., petsc_options=\.\.\.\)"):
+        problem.solve({"snes_max_it": 13})
+    assert problem.newton.snes.getTolerances()[3] == 13
+    assert problem.petsc_options == {}
+    problem.solve()  # the problem's own options again
+    assert problem.newton.snes.getTolerances()[3] == 30
+    plain = plain_problem()
+    with pytest.warns(DeprecationWarning, match=r"PlainElasticityProblem\(\.\.\., petsc_"):
+        plain.solve({"ksp_type": "preonly"})

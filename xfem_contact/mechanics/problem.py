@@ -10,6 +10,7 @@ solve; contact laws: generalized Newton (SNES), on the active dofs of the restri
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable, Mapping
 
 import dolfinx.fem
@@ -32,7 +33,12 @@ from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
 from xfem_contact.solvers.linear import solve_restricted, tip_transform
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton, weak_method
-from xfem_contact.solvers.options import Facts, problem_options, splits_fields
+from xfem_contact.solvers.options import (
+    Facts,
+    checked_prefix,
+    problem_options,
+    splits_fields,
+)
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 
 
@@ -57,6 +63,12 @@ class Problem:
         slave, pairing: See :class:`~xfem_contact.mechanics.laws.sliding.SlidingFrictionless`
             (``kinematics="large"`` only): the slave side, when pairs are searched.
         tip_radius: A crack's tip enrichment radius (m), see :class:`EnrichedSpace`.
+        petsc_options: PETSc options (names without prefix) of the solver, over the
+            defaults and presets of :mod:`xfem_contact.solvers.options` (see
+            :meth:`solver_options`); change them later with :attr:`petsc_options`.
+        petsc_options_prefix: The options prefix of the solver's PETSc objects (the SNES
+            or KSP, its PC). ``None``: a prefix unique in the process
+            (``"xfem_problem_3_"``); an empty one is refused. The same on every process.
 
     Collective.
     """
@@ -74,9 +86,14 @@ class Problem:
         slave: int = DEFAULT.slave,
         pairing: str = DEFAULT.pairing,
         tip_radius: float | None = None,
+        petsc_options: dict | None = None,
+        petsc_options_prefix: str | None = None,
     ):
         if kinematics not in KINEMATICS:
             raise ValueError(f"Unknown kinematics {kinematics!r}; valid: {KINEMATICS}")
+        #: The options prefix of the solver's PETSc objects
+        self.petsc_options_prefix = checked_prefix(petsc_options_prefix, "xfem_problem_")
+        self._petsc_options = dict(petsc_options or {})
         self.cut, self.mesh = cut, cut.mesh
         self.kinematics = kinematics
         self.laws = interface_laws(cut, law)
@@ -112,7 +129,8 @@ class Problem:
         self.w_old = dolfinx.fem.Function(self.space.W, name="w_old")
         self._law_materials = side_materials.laws
         self._newton: RestrictedNewton | None = None
-        self._newton_key = None
+        self._newton_loads: int | None = None
+        self._options_changed = False
         self._last_report: SolveReport | None = None
         #: Pseudo-time of the rotations that the bodies of ``w`` have turned by
         self._rotated_at = 0.0
@@ -194,14 +212,29 @@ class Problem:
         small = self.kinematics == "small" and not self.couplings
         return small and all(law.symmetric for law in self.laws.values())
 
+    @property
+    def petsc_options(self) -> dict:
+        """The PETSc options the user gave (names without prefix; a copy). Setting them
+        rebuilds the Newton solver at the next solve. Not collective, but set them
+        alike on every process."""
+        return dict(self._petsc_options)
+
+    @petsc_options.setter
+    def petsc_options(self, options: dict | None) -> None:
+        options = dict(options or {})
+        self._options_changed |= options != self._petsc_options
+        self._petsc_options = options
+
     def solver_options(self, petsc_options: dict | None = None) -> dict:
         """The PETSc options (without prefix) :meth:`solve` uses: ``petsc_options``
-        over the defaults and the presets that apply to this problem (the LDL^T of a
-        symmetric one, a crack's, large sliding's; see
+        (default: :attr:`petsc_options`) over the defaults and the presets that apply to
+        this problem (the LDL^T of a symmetric one, a crack's, large sliding's; see
         :func:`~xfem_contact.solvers.options.problem_options`). Not collective."""
         solver = "linear" if self.linear else "newton"
         crack_tip = self.space.branch_field is not None
-        facts = Facts(dict(petsc_options or {}), self.symmetric, crack_tip, bool(self.couplings))
+        if petsc_options is None:
+            petsc_options = self._petsc_options
+        facts = Facts(dict(petsc_options), self.symmetric, crack_tip, bool(self.couplings))
         return problem_options(solver, facts)
 
     def law(self, name: str | None = None) -> InterfaceLaw:
@@ -270,15 +303,36 @@ class Problem:
         Linear problems: one KSP solve. With a contact law: generalized Newton
         (SNES) from ``self.w``, a ``log`` line per iterate. Either way returns a
         :class:`~xfem_contact.solvers.report.SolveReport` (the solution ``w``, its
-        fields, iterations, residual history, reason). The Newton
-        solver is kept between solves and rebuilt when loads, Dirichlet conditions
-        or ``petsc_options`` changed since.
+        fields, iterations, residual history, reason). The Newton solver is kept between
+        solves and rebuilt when the loads, the Dirichlet conditions or
+        :attr:`petsc_options` were changed since.
+
+        Args:
+            petsc_options: Deprecated (give them at construction, or set
+                :attr:`petsc_options`): options for this solve only.
 
         Raises:
             NewtonFailure: with the iteration history, if SNES does not converge;
                 ``self.w`` then holds the state from before this solve.
             ValueError: the cut was updated after the problem was built.
         """
+        if petsc_options is None:
+            return self._solve(log)
+        warnings.warn(
+            "Problem.solve(petsc_options=...) is deprecated and will be removed in the next "
+            "release: give the options at construction, Problem(..., petsc_options=...), "
+            "or set problem.petsc_options",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        kept, self.petsc_options = self._petsc_options, petsc_options
+        try:
+            return self._solve(log)
+        finally:
+            self._petsc_options = kept
+            self._options_changed = kept != petsc_options
+
+    def _solve(self, log: Callable[[str], None] | None) -> SolveReport:
         if self.cut.revision != self._cut_revision:
             raise ValueError(
                 "The cut changed (cut.update) after this problem was built: its enriched "
@@ -289,13 +343,19 @@ class Problem:
         if self._checked_loads != self.loads.revision:  # again only when the loads changed
             check_support(self, log)
             self._checked_loads = self.loads.revision
-        petsc_options = self.solver_options(petsc_options)
+        petsc_options = self.solver_options()
         if self.linear:
             a, L = form(self.bilinear_form()), form(self.loads.linear_form())
             start, residuals = time.perf_counter(), []
             try:
                 w, reason = solve_restricted(
-                    a, L, self.loads.bcs, self.space, petsc_options, residuals=residuals
+                    a,
+                    L,
+                    self.loads.bcs,
+                    self.space,
+                    petsc_options,
+                    self.petsc_options_prefix,
+                    residuals=residuals,
                 )
             except LinearSolveFailure as failure:  # self.w is untouched
                 self._last_report = failure.report
@@ -309,8 +369,8 @@ class Problem:
                 space=self.space,
             )
             return self._last_report
-        key = (self.loads.revision, repr(sorted((petsc_options or {}).items())))
-        if self._newton is not None and key != self._newton_key:
+        changed = self._options_changed or self._newton_loads != self.loads.revision
+        if self._newton is not None and changed:
             self._newton.destroy()  # loads or solver options changed since it was built
             self._newton = None
         if self._newton is None:
@@ -321,6 +381,7 @@ class Problem:
                 self.loads.bcs,
                 self.restriction(),
                 petsc_options,
+                self.petsc_options_prefix,
                 status=weak_method(self.interface_status),
                 log=log,
                 splits=field_splits(self.space) if split else None,
@@ -330,7 +391,7 @@ class Problem:
                 field_space=self.space.field_space,
                 transform=tip_transform(self.space, off=split or bool(self.couplings)),
             )
-            self._newton_key = key
+            self._newton_loads, self._options_changed = self.loads.revision, False
         self._newton.log = log
         accepted = self.w.x.array.copy()
         t = self.loads.time
@@ -360,7 +421,7 @@ class Problem:
     def newton(self) -> RestrictedNewton | None:
         """The Newton solver of the contact solves (its ``snes``, the reduced Jacobian
         ``J_r``, ``options``), kept between solves; None before the first or after the
-        loads, the solver options or the cut changed."""
+        cut changed (it is rebuilt at the next solve after the loads or the options)."""
         return self._newton
 
     @property

@@ -125,7 +125,9 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
     mesh = meshed.mesh
     material = next(iter(scene.materials.values()))
     if not (scene.interfaces or scene.cracks):
-        problem = PlainElasticityProblem(mesh, scene.degree, material)
+        problem = PlainElasticityProblem(
+            mesh, scene.degree, material, petsc_options=scene.petsc_options
+        )
         effects = {
             "interface": None,
             "interfaces": [],
@@ -160,7 +162,9 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             options = {"kinematics": first.kinematics, "slave": first.slave}
             options["pairing"] = first.pairing
         try:
-            problem = Problem(cut, scene.degree, materials, laws, **options)
+            problem = Problem(
+                cut, scene.degree, materials, laws, petsc_options=scene.petsc_options, **options
+            )
         except ValueError as error:
             if not scene.cracks:
                 raise

@@ -79,18 +79,17 @@ def _stress_fields(problem, fields: list) -> StressFields:
 
 
 def solve_step(
-    problem, petsc_options: dict | None = None, log: Callable[[str], None] | None = None
+    problem, log: Callable[[str], None] | None = None
 ) -> tuple[dolfinx.fem.Function, int, dict]:
     """Solve a problem at its current time and accept the step: (solution, iterations,
     status).
 
     Contact problems run Newton from the previous step (a ``log`` line per
-    iterate); linear ones solve once. ``petsc_options`` override the solver's
-    defaults. Raises
+    iterate); linear ones solve once, with the problem's options. Raises
     :class:`~xfem_contact.solvers.newton.NewtonFailure` with the iteration
     history when Newton fails.
     """
-    report = problem.solve(petsc_options=petsc_options, log=log)
+    report = problem.solve(log=log)
     problem.accept_step()
     return problem.w, report.iterations or 1, report.status[-1] if report.status else {}
 
@@ -153,9 +152,7 @@ def run(
         for k, t in enumerate(bar, start=1):
             problem.loads.set_time(t)
             try:
-                solution, its, status = solve_step(
-                    problem, scene.petsc_options or None, say if log else None
-                )
+                solution, its, status = solve_step(problem, say if log else None)
             except SolveError as failure:
                 newton = isinstance(failure, NewtonFailure)
                 solver = "Newton failed (SNES" if newton else "the linear solve failed (KSP"

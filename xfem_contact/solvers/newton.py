@@ -29,8 +29,8 @@ from xfem_contact.solvers.jacobian import JacobianForms
 from xfem_contact.solvers.options import (
     REFACTOR_AFTER,
     applied_options,
+    checked_prefix,
     merged_options,
-    unique_prefix,
 )
 from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
@@ -45,7 +45,7 @@ class RestrictedNewton:
     ``R^T J R`` (:class:`~xfem_contact.solvers.assembly.ReducedMatrix`), assembles the
     Jacobian once for the scaling ``D`` of :mod:`xfem_contact.solvers.scaling` (the
     first iterate reuses it when it sits at the same state), and creates the SNES
-    under a unique options prefix, removing its options from the PETSc database
+    under its options prefix, removing its options from the PETSc database
     afterwards). SNES iterates on the scaled unknowns ``y`` with ``w = R D y``, so the
     residual norms it reports are those of ``D R^T F``. Each :meth:`solve` starts from
     the current ``w`` (projected on the range of ``R D``) and checks the final residual
@@ -69,7 +69,8 @@ class RestrictedNewton:
             the solver keeps its own scaled copy ``R D`` (:attr:`R`).
         petsc_options: PETSc options (without prefix) overriding the ``"newton"``
             defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
-        petsc_options_prefix: Prefix of the SNES options in the PETSc options database.
+        petsc_options_prefix: Options prefix of the SNES (and its KSP and PC); ``None``:
+            a unique one.
         status: Called with ``w`` at every iterate, on every process; returns a
             dict shown in the log.
         log: Called with each log line (e.g. ``print``); ``None`` for silence.
@@ -111,7 +112,7 @@ class RestrictedNewton:
         bcs: list,
         R: PETSc.Mat,
         petsc_options: dict | None = None,
-        petsc_options_prefix: str = "xfem_newton_",
+        petsc_options_prefix: str | None = None,
         status: Callable[[dolfinx.fem.Function], dict] | None = None,
         log: Callable[[str], None] | None = None,
         splits: dict[str, np.ndarray] | None = None,
@@ -180,7 +181,7 @@ class RestrictedNewton:
         self.snes = PETSc.SNES().create(R.getComm())
         # Options live in the PETSc database only while PETSc may read them (here and
         # during each solve, when the factorisation reads e.g. mat_mumps_* options)
-        self._prefix = unique_prefix(petsc_options_prefix)
+        self._prefix = checked_prefix(petsc_options_prefix, "xfem_newton_")
         self.snes.setOptionsPrefix(self._prefix)
         with applied_options(self._prefix, self.options):
             self.snes.setFromOptions()

@@ -362,6 +362,24 @@ def unique_prefix(base: str) -> str:
     return f"{base.rstrip('_')}_{next(_prefixes)}_"
 
 
+def checked_prefix(prefix: str | None, base: str) -> str:
+    """A solver's options prefix: ``prefix`` as given, or for ``None`` a unique one made
+    from ``base`` (:func:`unique_prefix`). Not collective.
+
+    Raises:
+        ValueError: ``prefix`` is empty (DOLFINx's problems refuse it too: the options
+            of every solver would mix in the database).
+    """
+    if prefix is None:
+        return unique_prefix(base)
+    if not isinstance(prefix, str) or not prefix:
+        raise ValueError(
+            f"petsc_options_prefix must be a non-empty string, got {prefix!r}; give e.g. "
+            "'mine_', or None for a unique one"
+        )
+    return prefix
+
+
 @contextlib.contextmanager
 def applied_options(prefix: str, options: dict[str, OptionValue]):
     """Write ``options`` under ``prefix`` into the PETSc options database for the
