@@ -34,6 +34,7 @@ from mpi4py import MPI
 from xfem_contact.cases.paper import INCLUSION_CENTRE, inclusion_errors, inclusion_problem
 from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
 from xfem_contact.io.plots import Series, line_plot
+from xfem_contact.solvers.log_lines import lines_to
 from xfem_contact.solvers.options import LINEAR_PRESETS, preset
 
 # %% [markdown]
@@ -84,7 +85,8 @@ def main():
     dofs = problem.space.dof_counts()  # collective
     say(f"  {cut.num_cut_cells_global} cut cells; dofs {dofs._asdict()}")
 
-    report = problem.solve(log=say)
+    with lines_to(say):  # the solver's log: a line per Newton iterate
+        report = problem.solve()
     setup = problem.solver_timings
     timings["forms"] = setup["forms"]
     timings["sparsity"] = setup["sparsity"]

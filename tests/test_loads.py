@@ -203,7 +203,7 @@ def test_a_scene_without_interfaces_takes_every_load_type():
         "body force",
     ]
     assert np.isclose(problem.loads.items[2].value, np.pi / 180)
-    summary = run(scene, log=None)
+    summary = run(scene)
     assert summary["load_steps"] == 1 and problem.loads.end_time == 2.0
 
 
@@ -219,7 +219,7 @@ def test_scene_load_paths_and_stages():
     first, second = (problem.loads.items[k] for k in (1, 2))
     problem.loads.set_time(1.0)
     assert (first.factor.value, second.factor.value) == (1.0, 0.0)
-    summary = run(scene, log=None)
+    summary = run(scene)
     assert summary["load_steps"] == 2
 
 

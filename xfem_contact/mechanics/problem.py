@@ -32,6 +32,7 @@ from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
 from xfem_contact.solvers.linear import solve_restricted, tip_transform
+from xfem_contact.solvers.log_lines import lines_to
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton, weak_method
 from xfem_contact.solvers.options import (
     Facts,
@@ -301,7 +302,8 @@ class Problem:
         """Solve on the active dofs; ``self.w`` holds the result. Collective.
 
         Linear problems: one KSP solve. With a contact law: generalized Newton
-        (SNES) from ``self.w``, a ``log`` line per iterate. Either way returns a
+        (SNES) from ``self.w``, a log record per iterate (INFO, logger
+        ``xfem_contact.solvers.newton``). Either way returns a
         :class:`~xfem_contact.solvers.report.SolveReport` (the solution ``w``, its
         fields, iterations, residual history, reason). The Newton solver is kept between
         solves and rebuilt when the loads, the Dirichlet conditions or
@@ -310,14 +312,25 @@ class Problem:
         Args:
             petsc_options: Deprecated (give them at construction, or set
                 :attr:`petsc_options`): options for this solve only.
+            log: Deprecated (install a handler on the ``xfem_contact`` logger, e.g.
+                :func:`~xfem_contact.solvers.log_lines.lines_to`): called with each line.
 
         Raises:
             NewtonFailure: with the iteration history, if SNES does not converge;
                 ``self.w`` then holds the state from before this solve.
             ValueError: the cut was updated after the problem was built.
         """
+        if log is not None:
+            warnings.warn(
+                "Problem.solve(log=...) is deprecated and will be removed in the next release: "
+                "the solver logs on logging.getLogger('xfem_contact'); show its lines with a "
+                "handler, e.g. with xfem_contact.solvers.log_lines.lines_to(print): ...",
+                DeprecationWarning,
+                stacklevel=2,
+            )
         if petsc_options is None:
-            return self._solve(log)
+            with lines_to(log):
+                return self._solve()
         warnings.warn(
             "Problem.solve(petsc_options=...) is deprecated and will be removed in the next "
             "release: give the options at construction, Problem(..., petsc_options=...), "
@@ -327,12 +340,13 @@ class Problem:
         )
         kept, self.petsc_options = self._petsc_options, petsc_options
         try:
-            return self._solve(log)
+            with lines_to(log):
+                return self._solve()
         finally:
             self._petsc_options = kept
             self._options_changed = kept != petsc_options
 
-    def _solve(self, log: Callable[[str], None] | None) -> SolveReport:
+    def _solve(self) -> SolveReport:
         if self.cut.revision != self._cut_revision:
             raise ValueError(
                 "The cut changed (cut.update) after this problem was built: its enriched "
@@ -341,7 +355,7 @@ class Problem:
                 "problem.update_interface(levelset)"
             )
         if self._checked_loads != self.loads.revision:  # again only when the loads changed
-            check_support(self, log)
+            check_support(self)
             self._checked_loads = self.loads.revision
         petsc_options = self.solver_options()
         if self.linear:
@@ -383,7 +397,6 @@ class Problem:
                 petsc_options,
                 self.petsc_options_prefix,
                 status=weak_method(self.interface_status),
-                log=log,
                 splits=field_splits(self.space) if split else None,
                 near_nullspace=rigid_modes(self.space) if split else None,
                 interpolation=vertex_interpolation(self.space) if split else None,
@@ -392,7 +405,6 @@ class Problem:
                 transform=tip_transform(self.space, off=split or bool(self.couplings)),
             )
             self._newton_loads, self._options_changed = self.loads.revision, False
-        self._newton.log = log
         accepted = self.w.x.array.copy()
         t = self.loads.time
         if self.kinematics == "large":  # turn rotated bodies rigidly first (predictor)

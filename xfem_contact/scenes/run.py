@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
+import logging
 import pathlib
 import time
-from collections.abc import Callable
 
 import dolfinx.io
 import dolfinx.mesh
@@ -17,7 +17,7 @@ from xfem_contact.fem import forms
 from xfem_contact.io.crack_data import EnrichedDisplacements
 from xfem_contact.io.interface_data import sample_status
 from xfem_contact.io.output import write_json
-from xfem_contact.io.progress import note, progress
+from xfem_contact.io.progress import progress
 from xfem_contact.mechanics.loads import load_steps
 from xfem_contact.mechanics.reactions import balance
 from xfem_contact.mechanics.stress import StressFields
@@ -31,6 +31,8 @@ from xfem_contact.scenes.builder import (  # noqa: F401  (re-exported)
 from xfem_contact.scenes.crack_outputs import CrackOutputs
 from xfem_contact.scenes.scene import Scene
 from xfem_contact.solvers.report import NewtonFailure, SolveError
+
+logger = logging.getLogger(__name__)
 
 
 class Result:
@@ -78,18 +80,16 @@ def _stress_fields(problem, fields: list) -> StressFields:
     return StressFields(sides, problem.kinematics)
 
 
-def solve_step(
-    problem, log: Callable[[str], None] | None = None
-) -> tuple[dolfinx.fem.Function, int, dict]:
+def solve_step(problem) -> tuple[dolfinx.fem.Function, int, dict]:
     """Solve a problem at its current time and accept the step: (solution, iterations,
     status).
 
-    Contact problems run Newton from the previous step (a ``log`` line per
+    Contact problems run Newton from the previous step (a log record per
     iterate); linear ones solve once, with the problem's options. Raises
     :class:`~xfem_contact.solvers.newton.NewtonFailure` with the iteration
     history when Newton fails.
     """
-    report = problem.solve(log=log)
+    report = problem.solve()
     problem.accept_step()
     return problem.w, report.iterations or 1, report.status[-1] if report.status else {}
 
@@ -97,15 +97,16 @@ def solve_step(
 def run(
     scene: Scene,
     out: str | pathlib.Path | None = None,
-    log: Callable[[str], None] | None = print,
     comm: MPI.Comm = MPI.COMM_WORLD,
     progress_bar: bool = True,
 ) -> dict:
     """Build, solve and summarise a scene. Collective.
 
     The pseudo-time runs to ``scene.end_time`` (default: the loads' last time, at
-    least 1) in ``scene.load_steps`` equal steps, each load following its path (a line
-    per step and per Newton iterate goes to ``log``; ``None`` for silence), with a progress bar over
+    least 1) in ``scene.load_steps`` equal steps, each load following its path (an INFO
+    record per step on this module's logger on rank 0, per Newton iterate on the
+    solver's: shown where a handler is installed, see
+    :func:`~xfem_contact.solvers.log_lines.lines_to`), with a progress bar over
     the steps when there are several and ``progress_bar`` is true
     (:func:`xfem_contact.io.progress.progress`). With ``out``, the
     fields of every step go to VTX files (``displacement.bp``, ``multiplier.bp``,
@@ -127,9 +128,7 @@ def run(
         its lips and K at the last step (``cracks``, see
         :class:`~xfem_contact.scenes.crack_outputs.CrackOutputs`).
     """
-    if log is print:  # printed lines go above the progress bar, not through it
-        log = note
-    say = log if (log and comm.rank == 0) else (lambda *a: None)
+    say = logger.info if comm.rank == 0 else (lambda *a: None)
     out = None if out is None else pathlib.Path(out)
     if out is not None and comm.rank == 0:  # a summary.json is a finished run's
         (out / "summary.json").unlink(missing_ok=True)
@@ -152,7 +151,7 @@ def run(
         for k, t in enumerate(bar, start=1):
             problem.loads.set_time(t)
             try:
-                solution, its, status = solve_step(problem, say if log else None)
+                solution, its, status = solve_step(problem)
             except SolveError as failure:
                 newton = isinstance(failure, NewtonFailure)
                 solver = "Newton failed (SNES" if newton else "the linear solve failed (KSP"
@@ -259,7 +258,7 @@ def run(
         if scene.outputs["png"]:
             from xfem_contact.io.pictures import render_folder
 
-            render_folder(out, log=say)
+            render_folder(out)
     say(
         f"done in {summary['timings']['total']:.2f} s: dofs {summary['dofs']}, "
         f"iterations {summary['iterations_per_step']}"

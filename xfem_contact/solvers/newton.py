@@ -4,13 +4,14 @@ Residual and Jacobian are assembled with Dirichlet conditions (as
 :class:`dolfinx.fem.petsc.NonlinearProblem` does) and reduced: ``F_r = R^T F(R y)``,
 ``J_r = R^T J R`` (straight into the reduced numbering,
 :mod:`xfem_contact.solvers.assembly`), the same restriction as the linear solves of
-:mod:`xfem_contact.solvers.linear`. Every iterate is logged
-(residual norm and, through a callback, e.g. the contact status); failure raises
+:mod:`xfem_contact.solvers.linear`. Every iterate is logged (INFO on this module's
+logger: residual norm and, through a callback, e.g. the contact status); failure raises
 with the whole history. Default options: :mod:`xfem_contact.solvers.options`.
 """
 
 from __future__ import annotations
 
+import logging
 import time
 import weakref
 from collections.abc import Callable
@@ -36,6 +37,8 @@ from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.split_sets import split_sets
 from xfem_contact.solvers.symmetry import mark_symmetric
+
+logger = logging.getLogger(__name__)
 
 
 class RestrictedNewton:
@@ -73,7 +76,6 @@ class RestrictedNewton:
             a unique one.
         status: Called with ``w`` at every iterate, on every process; returns a
             dict shown in the log.
-        log: Called with each log line (e.g. ``print``); ``None`` for silence.
         splits: For a ``fieldsplit`` preconditioner, or the band multigrid of the
             ``"iterative"`` preset of :data:`~xfem_contact.solvers.options.PRESETS`
             (which reads ``"u"`` and ``"band"``): split name to the
@@ -114,7 +116,6 @@ class RestrictedNewton:
         petsc_options: dict | None = None,
         petsc_options_prefix: str | None = None,
         status: Callable[[dolfinx.fem.Function], dict] | None = None,
-        log: Callable[[str], None] | None = None,
         splits: dict[str, np.ndarray] | None = None,
         near_nullspace: list[dolfinx.fem.Function] | None = None,
         couplings: list | None = None,
@@ -138,7 +139,7 @@ class RestrictedNewton:
         self.b = dolfinx.fem.petsc.create_vector(self.F[0].function_spaces[0])
         self.y = R.createVecRight()
         self.F_r = R.createVecRight()
-        self.status, self.log = status, log
+        self.status = status
         start = time.perf_counter()
         self.jacobian = ReducedMatrix(
             self.J,
@@ -283,11 +284,11 @@ class RestrictedNewton:
         status = self.status(self.w) if self.status else {}
         self.report.status.append(status)
         self.report.status_time += time.perf_counter() - start
-        if self.log:
+        if logger.isEnabledFor(logging.INFO):
             krylov = ""
             if it > 0 and snes.getKSP().getType() != PETSc.KSP.Type.PREONLY:
                 krylov = f"  ({self.report.linear_iterations[-1]} Krylov iterations)"
-            self.log(
+            logger.info(
                 f"  Newton {it:2d}: |F| = {norm:.3e}  "
                 + "  ".join(f"{k} {v}" for k, v in status.items())
                 + krylov
