@@ -44,7 +44,7 @@ def case(n: int, solver: str, path: str) -> None:
         iterations.append(report.iterations)
         krylov.append(report.linear_iterations)
     solve = time.perf_counter() - start
-    samples = problem.interface_samples()  # collective, as the two below
+    samples = problem.interface_samples(problem.w)  # collective, as the two below
     errors, dofs = pressure_errors(problem), problem.space.dof_counts().total
     if MPI.COMM_WORLD.rank == 0:
         data = {"dofs": dofs, "solve": solve, "newton": iterations}

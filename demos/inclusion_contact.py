@@ -96,7 +96,7 @@ def main():
     timings["status"] = report.status_time
     t0 = time.perf_counter()
     errors = inclusion_errors(problem, problem.w)
-    samples = problem.interface_samples()  # collective
+    samples = problem.interface_samples(problem.w)  # collective
     timings["post_processing"] = time.perf_counter() - t0
     say(
         f"  Newton iterations {report.iterations}; contact pressure rel. L2 error "

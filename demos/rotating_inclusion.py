@@ -125,7 +125,7 @@ def solve(args, degree: int, say, comm) -> tuple[dict, dict]:
         )
     timings["solve"] = time.perf_counter() - t0
     errors = pressure_errors(problem)
-    samples = problem.interface_samples()
+    samples = problem.interface_samples(problem.w)
     complete = len(history) == len(steps)
     say(
         f"degree {degree}: lambda_n rel. L2 error {errors['error']:.3e} (against the "

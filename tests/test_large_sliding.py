@@ -164,7 +164,7 @@ def _jacobian_error(problem, eps, seed=0):
     comm = problem.mesh.comm
     num = comm.allreduce(float(np.sum((fd - Jdy.getArray()) ** 2)), op=MPI.SUM)
     den = comm.allreduce(float(np.sum(Jdy.getArray() ** 2)), op=MPI.SUM)
-    state = problem.interface_state()
+    state = problem.interface_state(problem.w)
     contact = comm.allreduce(int(np.sum(state["P_n"] < 0)), op=MPI.SUM)
     newton.destroy()
     return np.sqrt(num / den), contact
@@ -224,7 +224,7 @@ def test_rigid_rotation_by_a_right_angle_carries_no_stress():
         problem.petsc_options = {"snes_atol": 1e-7}
         problem.solve()
         problem.accept_step()
-    lam = problem.interface_state()["lambda_n"]
+    lam = problem.interface_state(problem.w)["lambda_n"]
     scale = 1e6  # the load scale of case 3 (Pa)
     assert np.abs(lam).max(initial=0.0) < 1e-10 * scale
     u = problem.space.field(problem.w, 0)
@@ -270,7 +270,7 @@ def test_objectivity_a_right_angle_gives_the_unturned_pressures():
     _solve(still, 1)
     turned = rotating_annulus_problem(10, 2, np.pi / 2)
     _solve(turned, 4)
-    a, b = (p.interface_state()["lambda_n"] for p in (turned, still))
+    a, b = (p.interface_state(p.w)["lambda_n"] for p in (turned, still))
     assert np.abs(a - b).max() < 1e-8 * abs(ANNULUS_CONTACT_PRESSURE)
 
 
@@ -352,7 +352,7 @@ def test_coulomb_in_large_sliding_slides_on_the_cone():
     problem = rotating_annulus_problem(8, 2, 0.3, law="coulomb", friction=0.3, outer="tangential")
     reports = _solve(problem, 2)
     assert all(r.iterations <= 10 for r in reports)
-    state = problem.interface_state()
+    state = problem.interface_state(problem.w)
     counts = problem.interface_status(problem.w)
     assert counts["slip"] == counts["contact"] > 0
     P_n, P_t = state["P_n"], state["P_t"]
@@ -428,7 +428,7 @@ def test_a_turn_by_one_radian_gives_the_unturned_pressures(segments):
     turned = rotating_annulus_problem(10, 2, 1.0, segments=segments)
     reports = _solve(turned, 4)
     assert all(r.iterations <= 6 for r in reports)
-    a, b = (p.interface_state()["lambda_n"] for p in (turned, still))
+    a, b = (p.interface_state(p.w)["lambda_n"] for p in (turned, still))
     difference = np.abs(a - b).max() / abs(ANNULUS_CONTACT_PRESSURE)
     if segments:
         assert difference < 1e-8, difference

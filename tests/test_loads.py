@@ -174,7 +174,7 @@ def test_coulomb_inclusion_depends_on_the_load_path():
         scale = np.linalg.norm(applied[:2])
         assert scale > 0.5
         assert np.all(np.abs(resultant + applied) <= 1e-8 * scale), (path, resultant, applied)
-        state = problem.interface_state()
+        state = problem.interface_state(problem.w)
         cone = np.abs(state["P_t"]) - mu * np.maximum(-state["P_n"], 0.0)
         assert np.all(cone <= 1e-10 * np.abs(state["P_n"]).max())
         violations, kinds = contact_conditions(state, mu, largest_cell(problem), problem.mesh.comm)

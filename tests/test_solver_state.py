@@ -2,6 +2,8 @@
 a failed solve keeps the last good state, Newton starts from ``w``, success means the
 tolerances hold, and no PETSc option of ours outlives its solve."""
 
+import inspect
+
 import xfem_contact  # noqa: F401
 
 # isort: split
@@ -20,7 +22,7 @@ ONE_CG_STEP = {"ksp_type": "cg", "pc_type": "none", "ksp_max_it": 1, "ksp_rtol":
 
 
 def multipliers(problem) -> np.ndarray:
-    return np.asarray(problem.interface_samples()["lambda_n"])
+    return np.asarray(problem.interface_samples(problem.w)["lambda_n"])
 
 
 def our_options() -> list[str]:
@@ -202,3 +204,20 @@ def test_options_at_solve_are_deprecated_and_used_for_that_solve():
     plain = plain_problem()
     with pytest.warns(DeprecationWarning, match=r"PlainElasticityProblem\(\.\.\., petsc_"):
         plain.solve({"ksp_type": "preonly"})
+
+
+def test_the_interface_methods_share_one_signature():
+    """``(w, name=None)`` each: the state is explicit, the interface optional."""
+    problem = inclusion_problem(6, 1, "sticking")
+    problem.solve()
+    methods = (problem.interface_state, problem.interface_status, problem.interface_samples)
+    for method in methods:
+        assert list(inspect.signature(method).parameters) == ["w", "name"], method.__name__
+    (name,) = problem.laws
+    assert problem.interface_status(problem.w, name) == problem.interface_status(problem.w)
+    samples = problem.interface_samples(problem.w, name)
+    state = problem.interface_state(problem.w, name)
+    assert len(samples["lambda_n"]) == MPI.COMM_WORLD.allreduce(len(state["lambda_n"]))
+    zero = problem.w.copy()
+    zero.x.array[:] = 0.0
+    assert np.all(problem.interface_state(zero)["lambda_n"] == 0.0)

@@ -185,7 +185,7 @@ def pressure_errors(problem: Problem, reference: float | None = None) -> dict[st
     (Pa). Collective."""
     reference = svk_annulus_pressure() if reference is None else reference
     coupling = next(iter(problem.couplings.values()))
-    lam = problem.interface_state()["lambda_n"]
+    lam = problem.interface_state(problem.w)["lambda_n"]
     w = coupling.weights
     comm = problem.mesh.comm
 

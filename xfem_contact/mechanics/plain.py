@@ -183,6 +183,6 @@ class PlainElasticityProblem:
     def accept_step(self) -> None:
         """Nothing to accept: no interface law has a history."""
 
-    def interface_status(self, w: dolfinx.fem.Function) -> dict:
+    def interface_status(self, w: dolfinx.fem.Function, name: str | None = None) -> dict:
         """No interface: ``{}``."""
         return {}

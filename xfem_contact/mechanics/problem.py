@@ -463,21 +463,25 @@ class Problem:
 
     # -- interface state -------------------------------------------------------------
     def interface_state(
-        self, w: dolfinx.fem.Function | None = None, name: str | None = None
+        self, w: dolfinx.fem.Function, name: str | None = None
     ) -> dict[str, np.ndarray]:
-        """The law's state at this process's rule points of interface ``name``
-        (see the law's ``state``), for ``w`` (default: the solution)."""
+        """The law's state at this process's rule points of interface ``name`` (the only
+        one for ``None``) for the state ``w`` (e.g. :attr:`w`; see the law's ``state``)."""
         name = self._name(name)
-        return self.laws[name].state(self.contexts[name], self.w if w is None else w)
+        return self.laws[name].state(self.contexts[name], w)
 
-    def interface_status(self, w: dolfinx.fem.Function) -> dict:
-        """Global counts of interface rule points by status (contact / stick / slip),
-        prefixed by the interface name when there are several. Collective."""
-        return status_counts(self.laws, self.contexts, w)
+    def interface_status(self, w: dolfinx.fem.Function, name: str | None = None) -> dict:
+        """Global counts of interface rule points by status (contact / stick / slip) for
+        the state ``w``: of interface ``name``, or for ``None`` of all, prefixed by the
+        interface name when there are several. Collective."""
+        laws = self.laws if name is None else {self._name(name): self.law(name)}
+        return status_counts(laws, self.contexts, w)
 
-    def interface_samples(self, name: str | None = None) -> dict[str, list[float]]:
-        """The state of the solution at the rule points of all processes, for plots
-        and summaries (see :func:`~xfem_contact.mechanics.contexts.samples`).
-        Collective."""
+    def interface_samples(
+        self, w: dolfinx.fem.Function, name: str | None = None
+    ) -> dict[str, list[float]]:
+        """The state ``w`` (e.g. :attr:`w`) at the rule points of all processes of
+        interface ``name`` (the only one for ``None``), for plots and summaries (see
+        :func:`~xfem_contact.mechanics.contexts.samples`). Collective."""
         name = self._name(name)
-        return samples(self.laws[name], self.contexts[name], self.w)
+        return samples(self.laws[name], self.contexts[name], w)

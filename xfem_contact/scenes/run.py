@@ -220,7 +220,7 @@ def run(
     if pairing:
         summary["pairing"] = pairing
     if problem.laws:
-        samples = {name: problem.interface_samples(name) for name in problem.laws}
+        samples = {name: problem.interface_samples(problem.w, name) for name in problem.laws}
         for name, sampled in samples.items():  # 0 open, 1 stick, 2 slip
             sampled["status"] = sample_status(problem, name)
         summary["interfaces"] = {
