@@ -1,6 +1,7 @@
 """The package logs through ``logging`` (a logger per module) and never prints; programs
 show the lines with a handler (:func:`xfem_contact.solvers.log_lines.lines_to`)."""
 
+import datetime
 import logging
 
 import pytest
@@ -47,3 +48,25 @@ def test_the_log_callback_of_solve_is_deprecated_and_still_called():
     with pytest.warns(DeprecationWarning, match=r"solve\(log=\.\.\.\) is deprecated"):
         report = problem.solve(log=lines.append)
     assert len(lines) == report.iterations + 1
+
+
+def test_phase_timings_are_dolfinx_timers():
+    """The solve's wall times are those of DOLFINx's timers, in its table of timings."""
+    from dolfinx.common import timing
+
+    def recorded(name):
+        try:
+            return timing(f"xfem_contact: {name}")
+        except RuntimeError:  # not timed yet in this process
+            return 0, datetime.timedelta(0)
+
+    before = {name: recorded(name) for name in ("Newton solve", "Newton set-up: forms")}
+    problem = inclusion_problem(6, 1, "sticking")
+    report = problem.solve()
+    calls, total = recorded("Newton solve")
+    assert calls == before["Newton solve"][0] + 1
+    added = (total - before["Newton solve"][1]).total_seconds()
+    assert report.total_time == pytest.approx(added, abs=2e-6)
+    calls, total = recorded("Newton set-up: forms")
+    added = (total - before["Newton set-up: forms"][1]).total_seconds()
+    assert problem.solver_timings["forms"] == pytest.approx(added, abs=2e-6)

@@ -12,7 +12,6 @@ linear solve; no level set, no cut, no enrichment, no multiplier. Its loads are 
 
 from __future__ import annotations
 
-import time
 import warnings
 
 import dolfinx.fem
@@ -28,6 +27,7 @@ from xfem_contact.mechanics.loads import Loads, PlainFields
 from xfem_contact.mechanics.materials import Material, Moduli
 from xfem_contact.solvers.options import applied_options, checked_prefix, preset
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
+from xfem_contact.solvers.timers import phase, seconds
 
 
 class PlainSpace:
@@ -150,7 +150,7 @@ class PlainElasticityProblem:
                 DeprecationWarning,
                 stacklevel=2,
             )
-        start = time.perf_counter()
+        timer = phase("plain linear solve")
         accepted = self.w.x.array.copy()
         options = {**preset("plain"), **self.petsc_options, **(petsc_options or {})}
         # the options in the database while PETSc reads them (MUMPS's at the solve)
@@ -169,7 +169,7 @@ class PlainElasticityProblem:
             finally:
                 del problem  # its KSP, matrix and vectors (LinearProblem.__del__)
         self.last_report = SolveReport(
-            reason=reason, total_time=time.perf_counter() - start, w=self.w, space=self.space
+            reason=reason, total_time=seconds(timer), w=self.w, space=self.space
         )
         if reason < 0:
             self.w.x.array[:] = accepted

@@ -9,7 +9,6 @@ solve; contact laws: generalized Newton (SNES), on the active dofs of the restri
 
 from __future__ import annotations
 
-import time
 import warnings
 from collections.abc import Callable, Mapping
 
@@ -41,6 +40,7 @@ from xfem_contact.solvers.options import (
     splits_fields,
 )
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
+from xfem_contact.solvers.timers import phase, seconds
 
 
 class Problem:
@@ -360,7 +360,7 @@ class Problem:
         petsc_options = self.solver_options()
         if self.linear:
             a, L = form(self.bilinear_form()), form(self.loads.linear_form())
-            start, residuals = time.perf_counter(), []
+            timer, residuals = phase("linear solve"), []
             try:
                 w, reason = solve_restricted(
                     a,
@@ -378,7 +378,7 @@ class Problem:
             self._last_report = SolveReport(
                 residuals,
                 reason=reason,
-                total_time=time.perf_counter() - start,
+                total_time=seconds(timer),
                 w=self.w,
                 space=self.space,
             )

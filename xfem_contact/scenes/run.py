@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import logging
 import pathlib
-import time
 
 import dolfinx.io
 import dolfinx.mesh
@@ -31,6 +30,7 @@ from xfem_contact.scenes.builder import (  # noqa: F401  (re-exported)
 from xfem_contact.scenes.crack_outputs import CrackOutputs
 from xfem_contact.scenes.scene import Scene
 from xfem_contact.solvers.report import NewtonFailure, SolveError
+from xfem_contact.solvers.timers import phase, seconds
 
 logger = logging.getLogger(__name__)
 
@@ -133,9 +133,9 @@ def run(
     if out is not None and comm.rank == 0:  # a summary.json is a finished run's
         (out / "summary.json").unlink(missing_ok=True)
     compiled_before = forms.compiled_forms()
-    start = time.perf_counter()
+    total, timer = phase("scene run"), phase("scene build")
     problem, effects = build(scene, comm)
-    build_time = time.perf_counter() - start
+    build_time = seconds(timer)
     say(f"scene {scene.name}: effects {effects}")
     cracks = CrackOutputs(problem, scene) if scene.cracks else None
     result = Result(problem)
@@ -145,7 +145,7 @@ def run(
     steps, iterations, residuals, status = load_steps(scene.load_steps, end_time), [], [], {}
     pairing, records, tips = [], [], None
     forces_time = output_time = 0.0
-    solve_start = time.perf_counter()
+    solving = phase("scene load steps")
     try:
         bar = progress(steps, f"{scene.name}: load steps", progress_bar and len(steps) > 1, comm)
         for k, t in enumerate(bar, start=1):
@@ -179,21 +179,21 @@ def run(
                 }
             result.update(solution)
             record = {"step": k, "time": float(t), "iterations": its, "status": status}
-            forces_start = time.perf_counter()  # reactions, interface resultants (N/m)
+            timer = phase("scene forces")  # reactions, interface resultants (N/m)
             record["forces"] = balance(problem, problem.w)
-            forces_time += time.perf_counter() - forces_start
+            forces_time += seconds(timer)
             if problem.laws:
                 record["interfaces"] = status_counts(problem)
             if cracks is not None:
                 tips = cracks.tips()
                 record["cracks"] = cracks.per_crack(tips)
             records.append(record)
-            output_start = time.perf_counter()
+            timer = phase("scene output")
             for writer in series:
                 writer.write(float(t))
             if grids is not None:
                 grids.write(float(t))
-            output_time += time.perf_counter() - output_start
+            output_time += seconds(timer)
             say(
                 f"load step {k}/{len(steps)} (time {t:.4g}): {its} iteration(s)"
                 + "".join(f", {key} {value}" for key, value in status.items())
@@ -201,7 +201,7 @@ def run(
     finally:
         for writer in series:
             writer.close()
-    solve_time = time.perf_counter() - solve_start - forces_time - output_time
+    solve_time = seconds(solving) - forces_time - output_time
     summary = {
         "scene": scene.name,
         "effects": effects,
@@ -247,10 +247,10 @@ def run(
         "forces": forces_time,
     }
     if out is not None:
-        output_start = time.perf_counter()
+        timer = phase("scene output")
         grids.write_last()
-        timings["output"] = output_time + time.perf_counter() - output_start
-    summary["timings"] = timings | {"total": time.perf_counter() - start}
+        timings["output"] = output_time + seconds(timer)
+    summary["timings"] = timings | {"total": seconds(total)}
     if out is not None:
         comm.barrier()  # every rank's files are on disk before rank 0 renders them
     if out is not None and comm.rank == 0:

@@ -12,7 +12,6 @@ with the whole history. Default options: :mod:`xfem_contact.solvers.options`.
 from __future__ import annotations
 
 import logging
-import time
 import weakref
 from collections.abc import Callable
 
@@ -37,6 +36,7 @@ from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.split_sets import split_sets
 from xfem_contact.solvers.symmetry import mark_symmetric
+from xfem_contact.solvers.timers import phase, seconds
 
 logger = logging.getLogger(__name__)
 
@@ -125,22 +125,22 @@ class RestrictedNewton:
     ):
         self.w, self.bcs, self.R = w, bcs, R
         self.couplings = list(couplings or [])
-        start = time.perf_counter()
+        timer = phase("Newton set-up: selection")
         chosen = selection(R, w.function_space)
-        selecting = time.perf_counter() - start
-        start = time.perf_counter()
+        selecting = seconds(timer)
+        timer = phase("Newton set-up: forms")
         self.F = form_parts(residual)  # the residual: standard and runtime integrals apart
         #: The Jacobian's forms (the uncut cells' field blocks apart when possible)
         self.jacobian_forms = JacobianForms(residual, w, None if chosen is None else field_space)
         self.J = self.jacobian_forms.rest
         #: Wall time (s) of the set-up steps: forms (JIT included on a cold cache),
         #: sparsity, first Jacobian, scaling
-        self.timings = {"forms": time.perf_counter() - start}
+        self.timings = {"forms": seconds(timer)}
         self.b = dolfinx.fem.petsc.create_vector(self.F[0].function_spaces[0])
         self.y = R.createVecRight()
         self.F_r = R.createVecRight()
         self.status = status
-        start = time.perf_counter()
+        timer = phase("Newton set-up: sparsity")
         self.jacobian = ReducedMatrix(
             self.J,
             bcs,
@@ -149,7 +149,7 @@ class RestrictedNewton:
             field_blocks=self.jacobian_forms.blocks,
             chosen=chosen,
         )
-        self.timings["sparsity"] = time.perf_counter() - start + selecting
+        self.timings["sparsity"] = seconds(timer) + selecting
         if self.couplings and not self.jacobian.direct:
             raise ValueError(
                 "Couplings assembled outside UFL (large sliding) need a restriction that "
@@ -159,14 +159,14 @@ class RestrictedNewton:
             coupling.bind(self.jacobian.selection.columns, bcs)
         # Solve for y_s with x = R D y_s, D the scaling of the first Jacobian (well
         # scaled saddle points: see xfem_contact.solvers.scaling); J_r = D R^T J R D
-        start = time.perf_counter()
+        timer = phase("Newton set-up: first Jacobian")
         self.J_r = self.jacobian.assemble()
-        self.timings["jacobian"] = time.perf_counter() - start
-        start = time.perf_counter()
+        self.timings["jacobian"] = seconds(timer)
+        timer = phase("Newton set-up: scaling")
         self.D = saddle_point_scaling(self.J_r)
         Z = None if transform is None else transform(R, self.J_r)
         self.J_r.diagonalScale(self.D, self.D)
-        self.timings["scaling"] = time.perf_counter() - start
+        self.timings["scaling"] = seconds(timer)
         #: The PETSc options (without prefix) of this solver's SNES, KSP and PC
         self.options = merged_options("newton", petsc_options)
         self._symmetric = self.options.get("pc_type") == "cholesky"
@@ -222,7 +222,7 @@ class RestrictedNewton:
         self.w.x.scatter_forward()
 
     def _residual(self, snes, y, F_r):
-        start = time.perf_counter()
+        timer = phase("Newton assembly")
         self._update(y)
         x = self.w.x.petsc_vec
         with self.b.localForm() as local:
@@ -235,10 +235,10 @@ class RestrictedNewton:
             coupling.add_residual(self.w, self.b)
         dolfinx.fem.petsc.set_bc(self.b, self.bcs, x, -1.0)
         self.R.multTranspose(self.b, F_r)
-        self.report.assembly_time += time.perf_counter() - start
+        self.report.assembly_time += seconds(timer)
 
     def _jacobian(self, snes, y, J_r, P_r):
-        start = time.perf_counter()
+        timer = phase("Newton assembly")
         self._update(y)
         x, at, self._assembled_at = self.w.x.array, self._assembled_at, None
         if at is None or not _same_state(x, at, self.R.getComm().tompi4py()):
@@ -254,7 +254,7 @@ class RestrictedNewton:
                 J_r.copy(P_r, _DIFFERENT if grown else _SAME)
                 if self._symmetric:
                     mark_symmetric(P_r)
-        self.report.assembly_time += time.perf_counter() - start
+        self.report.assembly_time += seconds(timer)
 
     def _refactor(self, snes) -> bool:
         """Whether the preconditioner takes the Jacobian of this iterate: at the first
@@ -277,13 +277,13 @@ class RestrictedNewton:
             self.snes.getKSP().getPC().reset()
 
     def _monitor(self, snes, it, norm):
-        start = time.perf_counter()
+        timer = phase("Newton interface status")
         if it > 0:
             self.report.linear_iterations.append(snes.getKSP().getIterationNumber())
         self.report.residuals.append(float(norm))
         status = self.status(self.w) if self.status else {}
         self.report.status.append(status)
-        self.report.status_time += time.perf_counter() - start
+        self.report.status_time += seconds(timer)
         if logger.isEnabledFor(logging.INFO):
             krylov = ""
             if it > 0 and snes.getKSP().getType() != PETSc.KSP.Type.PREONLY:
@@ -325,7 +325,7 @@ class RestrictedNewton:
             NewtonFailure: SNES did not converge (reason <= 0); it holds the history.
         """
         self.report = NewtonReport()
-        start = time.perf_counter()
+        timer = phase("Newton solve")
         self._start_from_w()
         self.jacobian.keep_constant_blocks()  # the uncut cells' linear bulk: once a solve
         for coupling in self.couplings:
@@ -337,7 +337,7 @@ class RestrictedNewton:
                 if isinstance(error.__cause__, ValueError):  # Jacobian for LDL^T) is clearer
                     raise error.__cause__ from None
                 raise
-        self.report.total_time = time.perf_counter() - start
+        self.report.total_time = seconds(timer)
         self._update(self.y)
         self.report.reason = self.snes.getConvergedReason()
         if self.report.reason <= 0:
