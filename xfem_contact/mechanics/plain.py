@@ -21,13 +21,13 @@ import numpy as np
 import numpy.typing as npt
 import ufl
 
+from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.enrichment import DofCounts
 from xfem_contact.fem.forms import form
 from xfem_contact.mechanics.loads import Loads, PlainFields
 from xfem_contact.mechanics.materials import Material, Moduli
 from xfem_contact.solvers.options import applied_options, checked_prefix, preset
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
-from xfem_contact.solvers.timers import phase, seconds
 
 
 class PlainSpace:

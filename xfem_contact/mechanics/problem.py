@@ -16,6 +16,7 @@ import dolfinx.fem
 import numpy as np
 import ufl
 
+from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.forms import form
@@ -40,7 +41,6 @@ from xfem_contact.solvers.options import (
     splits_fields,
 )
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
-from xfem_contact.solvers.timers import phase, seconds
 
 
 class Problem:

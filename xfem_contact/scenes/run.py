@@ -11,6 +11,7 @@ import dolfinx.mesh
 import numpy as np
 from mpi4py import MPI
 
+from xfem_contact._timers import phase, seconds
 from xfem_contact._version import versions
 from xfem_contact.fem import forms
 from xfem_contact.io.crack_data import EnrichedDisplacements
@@ -30,7 +31,6 @@ from xfem_contact.scenes.builder import (  # noqa: F401  (re-exported)
 from xfem_contact.scenes.crack_outputs import CrackOutputs
 from xfem_contact.scenes.scene import Scene
 from xfem_contact.solvers.report import NewtonFailure, SolveError
-from xfem_contact.solvers.timers import phase, seconds
 
 logger = logging.getLogger(__name__)
 

@@ -22,6 +22,7 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.forms import form_parts
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
 from xfem_contact.solvers.block_scaling import TipFactor
@@ -36,7 +37,6 @@ from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.split_sets import split_sets
 from xfem_contact.solvers.symmetry import mark_symmetric
-from xfem_contact.solvers.timers import phase, seconds
 
 logger = logging.getLogger(__name__)
 
