@@ -221,3 +221,20 @@ def test_the_interface_methods_share_one_signature():
     zero = problem.w.copy()
     zero.x.array[:] = 0.0
     assert np.all(problem.interface_state(zero)["lambda_n"] == 0.0)
+
+
+def test_a_scene_problem_takes_the_scene_options_and_a_prefix():
+    from test_scenes import base
+
+    from xfem_contact.scenes.builder import build
+    from xfem_contact.scenes.scene import load_scene
+
+    scene = load_scene(base(law="sticking") | {"solver": {"max_iterations": 12}})
+    problem, _ = build(scene, petsc_options_prefix="scene_")
+    assert problem.petsc_options_prefix == "scene_"
+    assert problem.petsc_options == scene.petsc_options
+    assert problem.solver_options()["snes_max_it"] == 12
+    problem.loads.set_time(1.0)
+    problem.solve()
+    assert problem.newton.snes.getOptionsPrefix() == "scene_"
+    assert problem.newton.snes.getTolerances()[3] == 12

@@ -344,7 +344,7 @@ class Problem:
                 return self._solve()
         finally:
             self._petsc_options = kept
-            self._options_changed = kept != petsc_options
+            self._options_changed |= kept != petsc_options
 
     def _solve(self) -> SolveReport:
         if self.cut.revision != self._cut_revision:

@@ -120,15 +120,17 @@ def interface_levelsets(scene: Scene) -> dict[str, Callable]:
     return {spec.name: levelset(spec) for spec in scene.interfaces}
 
 
-def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
-    """Create the mesh and the problem of a scene (collective). Returns (problem, effects)."""
+def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD, petsc_options_prefix: str | None = None):
+    """Create the mesh and the problem of a scene (collective). Returns (problem, effects).
+
+    The problem takes the scene's PETSc options (``[solver]``) and ``petsc_options_prefix``
+    (``None``: a unique one, see :class:`~xfem_contact.mechanics.problem.Problem`)."""
+    solver = {"petsc_options": scene.petsc_options, "petsc_options_prefix": petsc_options_prefix}
     meshed = create_mesh(scene, comm)
     mesh = meshed.mesh
     material = next(iter(scene.materials.values()))
     if not (scene.interfaces or scene.cracks):
-        problem = PlainElasticityProblem(
-            mesh, scene.degree, material, petsc_options=scene.petsc_options
-        )
+        problem = PlainElasticityProblem(mesh, scene.degree, material, **solver)
         effects = {
             "interface": None,
             "interfaces": [],
@@ -163,9 +165,7 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             options = {"kinematics": first.kinematics, "slave": first.slave}
             options["pairing"] = first.pairing
         try:
-            problem = Problem(
-                cut, scene.degree, materials, laws, petsc_options=scene.petsc_options, **options
-            )
+            problem = Problem(cut, scene.degree, materials, laws, **solver, **options)
         except ValueError as error:
             if not scene.cracks:
                 raise
