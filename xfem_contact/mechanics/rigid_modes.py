@@ -132,7 +132,7 @@ def check_support(problem) -> None:
         raise ValueError("Free rigid modes: " + " | ".join(errors))
     for body in free:
         message = f"{body.message()} if the loads carry a torque"
-        warnings.warn(message, RigidModeWarning, stacklevel=3)
+        warnings.warn(message, RigidModeWarning, stacklevel=4)  # the caller of solve()
         if problem.mesh.comm.rank == 0:
             logger.warning(message)
 
