@@ -163,9 +163,9 @@ def case2(N, degree, cell, lbb, solver):
     from xfem_contact.solvers.options import preset
 
     start = time.perf_counter()
-    problem = inclusion_problem(N, degree, "sticking", cell, lbb=lbb)
+    problem = inclusion_problem(N, degree, "sticking", cell, lbb=lbb, petsc_options=preset(solver))
     build = time.perf_counter() - start
-    report = problem.solve(preset(solver))
+    report = problem.solve()
     return _contact_row(
         problem, report, build, start, inclusion_errors(problem, problem.w).pressure
     )

@@ -299,7 +299,7 @@ def friction(say, quick: bool) -> list[dict]:
             case = frictional_crack_case(N, degree, friction=0.3, tip_radius=0.3)
             report = case.problem.solve()
             results = stress_intensity(case, [(0.2, 0.6), (0.3, 0.8)])
-            samples = case.problem.interface_samples()
+            samples = case.problem.interface_samples(case.problem.w)
             centre, d = np.array([0.0123, 0.0271]), np.array([math.cos(0.3), math.sin(0.3)])
             s = (np.asarray(samples["x"]) - centre[0]) * d[0]
             s += (np.asarray(samples["y"]) - centre[1]) * d[1]

@@ -41,9 +41,9 @@ def case(n: int, solver: str, tiny: bool) -> dict:
     from xfem_contact.solvers.options import preset
 
     radius = INCLUSION_RADIUS + (1e-7 / n if tiny else 0.0)
-    problem = inclusion_problem(n, 2, "sticking", radius=radius)
+    problem = inclusion_problem(n, 2, "sticking", radius=radius, petsc_options=preset(solver))
     start = time.perf_counter()
-    report = problem.solve(preset(solver))
+    report = problem.solve()
     wall = time.perf_counter() - start
     return {
         "n": n,

@@ -35,16 +35,16 @@ def case(n: int, solver: str, path: str) -> None:
     from xfem_contact.cases.rotation import pressure_errors, rotating_annulus_problem
     from xfem_contact.solvers.options import preset
 
-    problem = rotating_annulus_problem(n, 2, 1.0)
+    problem = rotating_annulus_problem(n, 2, 1.0, petsc_options=preset(solver))
     start, iterations, krylov = time.perf_counter(), [], []
     for k in range(1, 5):
         problem.loads.set_time(k / 4)
-        report = problem.solve(preset(solver))
+        report = problem.solve()
         problem.accept_step()
         iterations.append(report.iterations)
         krylov.append(report.linear_iterations)
     solve = time.perf_counter() - start
-    samples = problem.interface_samples()  # collective, as the two below
+    samples = problem.interface_samples(problem.w)  # collective, as the two below
     errors, dofs = pressure_errors(problem), problem.space.dof_counts().total
     if MPI.COMM_WORLD.rank == 0:
         data = {"dofs": dofs, "solve": solve, "newton": iterations}

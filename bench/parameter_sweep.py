@@ -55,7 +55,7 @@ def main() -> None:
         problem.w_old.x.array[:] = 0.0
         report, sweep = timed(problem.solve)
         swept_compiles = forms.compiled_forms() - before
-        lambda_n = np.array(problem.interface_samples()["lambda_n"])
+        lambda_n = np.array(problem.interface_samples(problem.w)["lambda_n"])
         fresh, rebuild = timed(lambda mu=mu: inclusion_problem(args.n, 2, "coulomb", friction=mu))
         fresh_report, fresh_solve = timed(fresh.solve)
         difference = (

@@ -34,6 +34,7 @@ from mpi4py import MPI
 from xfem_contact.cases.paper import INCLUSION_CENTRE, inclusion_errors, inclusion_problem
 from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
 from xfem_contact.io.plots import Series, line_plot
+from xfem_contact.solvers.log_lines import lines_to
 from xfem_contact.solvers.options import LINEAR_PRESETS, preset
 
 # %% [markdown]
@@ -108,7 +109,7 @@ def main():
 
     say(f"paper case 2: {args.n}x{args.n} {args.cell}, degree {args.degree}, law {args.law}")
     t0 = time.perf_counter()
-    options = {"lbb": args.lbb}
+    options = {"lbb": args.lbb, "petsc_options": preset(args.solver)}
     if args.law == "coulomb":
         options["friction"] = args.friction
     problem = inclusion_problem(args.n, args.degree, args.law, args.cell, **options)
@@ -118,7 +119,8 @@ def main():
     dofs = problem.space.dof_counts()  # collective
     say(f"  {cut.num_cut_cells_global} cut cells; dofs {dofs._asdict()}")
 
-    report = problem.solve(preset(args.solver), log=say)
+    with lines_to(say):  # the solver's log: a line per Newton iterate
+        report = problem.solve()
     setup = problem.solver_timings
     timings["forms"] = setup["forms"]
     timings["sparsity"] = setup["sparsity"]
@@ -128,7 +130,7 @@ def main():
     timings["status"] = report.status_time
     t0 = time.perf_counter()
     errors = inclusion_errors(problem, problem.w)
-    samples = problem.interface_samples()  # collective
+    samples = problem.interface_samples(problem.w)  # collective
     timings["post_processing"] = time.perf_counter() - t0
     say(
         f"  Newton iterations {report.iterations}; contact pressure rel. L2 error "
@@ -162,7 +164,7 @@ def main():
             "tangential_traction_rel_L2_error": errors.tangential,
             "newton_iterations": report.iterations,
             "solver": args.solver,
-            "factorisation": problem.solver_options(preset(args.solver))["pc_type"],
+            "factorisation": problem.solver_options()["pc_type"],
             "krylov_iterations": report.linear_iterations,
             "newton_residuals": report.residuals,
             "contact_status": report.status[-1],

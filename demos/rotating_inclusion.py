@@ -46,6 +46,7 @@ from xfem_contact.io.progress import progress
 from xfem_contact.mechanics.laws import SLIDING_LAWS
 from xfem_contact.mechanics.loads import load_steps
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
+from xfem_contact.solvers.log_lines import lines_to
 from xfem_contact.solvers.newton import NewtonFailure
 
 # %% [markdown]
@@ -142,7 +143,8 @@ def solve(args, degree: int, say, comm) -> tuple[dict, dict]:
     for k, t in enumerate(bar, start=1):
         problem.loads.set_time(t)
         try:
-            report = problem.solve(log=say)
+            with lines_to(say):  # the solver's log: a line per Newton iterate
+                report = problem.solve()
         except NewtonFailure as failure:  # the last accepted state is kept in problem.w
             say(f"load step {k} (angle {t * args.alpha:.4f} rad) failed:\n{failure}")
             break
@@ -165,7 +167,7 @@ def solve(args, degree: int, say, comm) -> tuple[dict, dict]:
         )
     timings["solve"] = time.perf_counter() - t0
     errors = pressure_errors(problem)
-    samples = problem.interface_samples()
+    samples = problem.interface_samples(problem.w)
     complete = len(history) == len(steps)
     say(
         f"degree {degree}: lambda_n rel. L2 error {errors['error']:.3e} (against the "

@@ -175,20 +175,17 @@ def scene_reference() -> str:
 
 
 def solver_options() -> str:
-    from xfem_contact.solvers.options import (
-        LINEAR_PRESETS,
-        REFACTOR_AFTER,
-        REUSED_LU_OPTIONS,
-        SOLVER_OPTIONS,
-    )
+    from xfem_contact.solvers.options import PRESETS, REFACTOR_AFTER, SOLVER_OPTIONS
 
     lines = [
         "# Solver options",
         "",
-        "Generated from `xfem_contact.solvers.options.SOLVER_OPTIONS`. Every solver runs",
-        "under a unique PETSc options prefix (`xfem_newton_3_`, ...), so options given to",
-        "one solve never leak into another; pass them without prefix, e.g.",
-        '`problem.solve({"snes_rtol": 1e-12})`, or in a scene\'s `[solver.petsc]` table.',
+        "Generated from `xfem_contact.solvers.options.SOLVER_OPTIONS` and `PRESETS`. A problem",
+        "takes its PETSc options (without prefix) and options prefix at construction, as",
+        'DOLFINx\'s problems do: `Problem(..., petsc_options={"snes_rtol": 1e-12},',
+        'petsc_options_prefix="mine_")`, or a scene\'s `[solver.petsc]` table. Without a',
+        "prefix each problem makes a unique one (`xfem_problem_3_`, ...), so the options of",
+        "one problem never leak into another; an empty prefix is refused.",
         "",
         "| option | type | default | solvers | meaning |",
         "|---|---|---|---|---|",
@@ -201,18 +198,22 @@ def solver_options() -> str:
             + (f" (one of {option.allowed})" if option.allowed else "")
             + " |"
         )
-    lines += ["", "## Linear solver presets (`[solver] linear`)", ""]
-    for name, options in LINEAR_PRESETS.items():
-        shown = ", ".join(f"`{k}={v}`" for k, v in options.items()) or "MUMPS LU (the defaults)"
-        lines.append(f"- `{name}`: {shown}")
-    reused = ", ".join(f"`{k}={v}`" for k, v in REUSED_LU_OPTIONS.items())
     lines += [
         "",
-        "Large sliding with the `direct` preset and no `ksp_type` given adds "
-        f"{reused}: GMRES on the LU of the solve's first iterate, refactored when GMRES "
-        f"needs more than {REFACTOR_AFTER} iterations (`REFACTOR_AFTER`). In Newton, any Krylov "
-        "method over `pc_type = lu` or `cholesky` reuses its factorisation so.",
+        "## Presets",
+        "",
+        "Every other set of options the solvers use, with what selects it. The rows a",
+        "problem adds itself go under the user's options; the sub-solvers' rows are written",
+        "under their own prefix unless the options database has them already. A Krylov",
+        "method over `pc_type = lu` or `cholesky` in Newton keeps its factorisation while it",
+        f"converges within {REFACTOR_AFTER} iterations (`REFACTOR_AFTER`).",
+        "",
+        "| preset | selected by | options | meaning |",
+        "|---|---|---|---|",
     ]
+    for name, row in PRESETS.items():
+        shown = ", ".join(f"`{row.prefix}{k}={v}`" for k, v in row.options.items()) or "-"
+        lines.append(f"| `{name}` | {_cell(row.selected_by)} | {shown} | {_cell(row.help)} |")
     return "\n".join(lines) + "\n"
 
 

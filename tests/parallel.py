@@ -17,7 +17,7 @@ def gathered_fields(problem) -> dict[str, np.ndarray]:
     ``u_minus``, ``u_plus`` at the displacement dofs (m, shape ``(n, 2)``).
     """
     comm = problem.mesh.comm
-    samples = problem.interface_samples()
+    samples = problem.interface_samples(problem.w)
     order = _by_position(np.c_[samples["x"], samples["y"]])
     fields = {k: np.asarray(samples[k])[order] for k in ("lambda_n", "lambda_t")}
     for field, name in ((0, "u_minus"), (1, "u_plus")):

@@ -256,7 +256,8 @@ def test_inclusion_equilibrium(law):
 def test_newton_failure_reports_history():
     problem = inclusion_problem(10, 2, "coulomb", loading="pull", friction=1.0)
     with pytest.raises(NewtonFailure, match="iterate"):
-        problem.solve(petsc_options={"snes_max_it": 1})
+        problem.petsc_options = {"snes_max_it": 1}
+        problem.solve()
 
 
 def test_bad_contact_input_raises():

@@ -63,7 +63,7 @@ def test_stiffness_contrast_keeps_the_multiplier_smooth(contrast):
     pressure oscillated (misfit 0.7 and 1.8, part of the interface opened)."""
     materials = {-1: Material(contrast * INCLUSION_E, 0.0), 1: Material(INCLUSION_E, 0.0)}
     problem, report = solve(0.2, materials=materials, loading="hydrostatic")
-    samples = problem.interface_samples()
+    samples = problem.interface_samples(problem.w)
     theta = np.arctan2(np.array(samples["y"]) - 0.5, np.array(samples["x"]) - 0.5)
     lam, P_n = np.array(samples["lambda_n"]), np.array(samples["P_n"])
     # least-squares fit by Fourier modes 0..8: the smooth part of the pressure

@@ -151,7 +151,7 @@ def frictional():
 def test_closed_crack_with_coulomb_friction(frictional):
     case, report = frictional
     assert report.converged
-    samples = case.problem.interface_samples()
+    samples = case.problem.interface_samples(case.problem.w)
     centre, d = np.array([0.0123, 0.0271]), np.array([math.cos(0.3), math.sin(0.3)])
     s = (np.asarray(samples["x"]) - centre[0]) * d[0] + (np.asarray(samples["y"]) - centre[1]) * d[
         1

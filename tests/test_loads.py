@@ -176,7 +176,7 @@ def test_coulomb_inclusion_depends_on_the_load_path():
         scale = np.linalg.norm(applied[:2])
         assert scale > 0.5
         assert np.all(np.abs(resultant + applied) <= 1e-8 * scale), (path, resultant, applied)
-        state = problem.interface_state()
+        state = problem.interface_state(problem.w)
         cone = np.abs(state["P_t"]) - mu * np.maximum(-state["P_n"], 0.0)
         assert np.all(cone <= 1e-10 * np.abs(state["P_n"]).max())
         violations, kinds = contact_conditions(state, mu, largest_cell(problem), problem.mesh.comm)
@@ -205,7 +205,7 @@ def test_a_scene_without_interfaces_takes_every_load_type():
         "body force",
     ]
     assert np.isclose(problem.loads.items[2].value, np.pi / 180)
-    summary = run(scene, log=None)
+    summary = run(scene)
     assert summary["load_steps"] == 1 and problem.loads.end_time == 2.0
 
 
@@ -221,7 +221,7 @@ def test_scene_load_paths_and_stages():
     first, second = (problem.loads.items[k] for k in (1, 2))
     problem.loads.set_time(1.0)
     assert (first.factor.value, second.factor.value) == (1.0, 0.0)
-    summary = run(scene, log=None)
+    summary = run(scene)
     assert summary["load_steps"] == 2
 
 

@@ -52,7 +52,7 @@ def test_a_moved_coulomb_interface_keeps_its_history_and_the_cone():
     start from there), converges warm and stays inside the cone."""
     moved, warm, _, cold = moved_and_fresh("coulomb", friction=0.3)
     assert warm.converged and cold.converged
-    state = moved.interface_state()
+    state = moved.interface_state(moved.w)
     bound = 0.3 * np.abs(state["P_n"])
     assert np.all(np.abs(state["P_t"]) <= bound + 1e-10 * np.abs(state["P_n"]).max())
     assert np.abs(moved.w_old.x.array[~moved.space.active]).max(initial=0.0) == 0.0

@@ -140,7 +140,7 @@ def coulomb_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("coulomb")
     data = plate("coulomb", cells=10, friction=0.3)
     data["solver"] = {"load_steps": 2}
-    summary = run(load_scene(data), out, log=None, progress_bar=False)
+    summary = run(load_scene(data), out, progress_bar=False)
     return out, summary
 
 
@@ -243,7 +243,7 @@ def test_plain_scene_series_holds_the_mesh_nodes(tmp_path, cell, per_square):
     data = plate(None, cells=4)
     data["mesh"]["cell"] = cell
     data["solver"] = {"load_steps": 2}
-    summary = run(load_scene(data), tmp_path, log=None, progress_bar=False)
+    summary = run(load_scene(data), tmp_path, progress_bar=False)
     assert [r["forces"]["balance_relative"] < BALANCE for r in summary["steps"]] == [True] * 2
     reader = pyvista.get_reader(tmp_path / "result.pvd")
     assert reader.time_values == [0.5, 1.0]
@@ -285,10 +285,10 @@ def test_parallel_series_has_pvtu_pieces_and_equals_serial(tmp_path_factory):
     folder = pathlib.Path(comm.bcast(str(folder), root=0))
     data = plate("coulomb", cells=8, friction=0.3)
     data["solver"] = {"load_steps": 2}
-    summary = run(load_scene(data), folder / "parallel", log=None, progress_bar=False)
+    summary = run(load_scene(data), folder / "parallel", progress_bar=False)
     assert len(summary["steps"]) == 2
     if comm.rank == 0:
-        run(load_scene(data), folder / "serial", log=None, progress_bar=False, comm=MPI.COMM_SELF)
+        run(load_scene(data), folder / "serial", progress_bar=False, comm=MPI.COMM_SELF)
     comm.barrier()
     steps = folder / "parallel" / "result_steps"
     if comm.size > 1:

@@ -220,7 +220,7 @@ def test_show_renders_a_run_folder(tmp_path, capsys):
     ]
     scene = load_scene(data)
     out = tmp_path / "run"
-    run(scene, out, log=None)  # writes the PNGs itself ([outputs] png = true)
+    run(scene, out)  # writes the PNGs itself ([outputs] png = true)
     for name in ("subcells.vtu", "interface.vtu"):
         assert (out / name).exists()
     for name in ("result.png", "cut.png", "pressure.png"):

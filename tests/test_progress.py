@@ -7,9 +7,10 @@ import pytest
 from test_scenes import base
 
 from xfem_contact.io import progress as progress_module
-from xfem_contact.io.progress import progress
+from xfem_contact.io.progress import note, progress
 from xfem_contact.scenes.run import run
 from xfem_contact.scenes.scene import load_scene
+from xfem_contact.solvers.log_lines import lines_to
 
 
 @pytest.fixture(scope="module")
@@ -22,7 +23,8 @@ def scene():
 @pytest.mark.parametrize("enabled", [True, False])
 def test_load_steps_bar_on_a_terminal_only(scene, capsys, monkeypatch, enabled, terminal):
     monkeypatch.setattr(progress_module, "on_terminal", lambda: terminal)
-    summary = run(scene, log=print, progress_bar=enabled)
+    with lines_to(note):  # as the command line shows them
+        summary = run(scene, progress_bar=enabled)
     assert summary["load_steps"] == 3
     captured = capsys.readouterr()
     assert ("t: load steps" in captured.err) == (enabled and terminal)  # the bar, on stderr

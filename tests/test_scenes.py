@@ -17,6 +17,7 @@ from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.scenes import cli
 from xfem_contact.scenes.run import build, levelset, run
 from xfem_contact.scenes.scene import bundled_scenes, load_scene
+from xfem_contact.solvers.log_lines import lines_to
 from xfem_contact.solvers.newton import NewtonFailure
 
 
@@ -400,7 +401,7 @@ def test_bundled_rotating_inclusion_turns_a_right_angle():
     """The bundled case-3 scene: 4 load steps of pi/8, every slave point paired and
     changing master cell each step, the pressure uniform to round-off."""
     scene = load_scene(bundled_scenes()["case3_rotating_inclusion"])
-    summary = run(scene, log=None, progress_bar=False)
+    summary = run(scene, progress_bar=False)
     assert summary["effects"]["kinematics"] == "large" and summary["effects"]["pairing"]
     assert len(summary["pairing"]) == 4
     counts = [step["interface0"] for step in summary["pairing"]]
@@ -612,7 +613,7 @@ def test_write_json_is_atomic(tmp_path):
 
 
 def test_run_contact_scene_reports_newton():
-    summary = run(load_scene(bundled_scenes()["hydrostatic_frictionless"]), out=None, log=None)
+    summary = run(load_scene(bundled_scenes()["hydrostatic_frictionless"]), out=None)
     assert summary["effects"]["solver"].startswith("SNES")
     assert summary["iterations"] <= 10
     assert summary["contact_status"]["contact"] > 0
@@ -648,8 +649,8 @@ def test_load_factor_scales_every_load_of_a_linear_problem():
 @pytest.mark.parametrize("law", ["frictionless", "sticking"])
 def test_load_steps_end_at_the_one_step_solution(law):
     """Frictionless and sticking contact are path independent: 3 steps = 1 step."""
-    one = run(load_scene(pressed_inclusion(law)), log=None)
-    three = run(load_scene(pressed_inclusion(law, load_steps=3)), log=None)
+    one = run(load_scene(pressed_inclusion(law)))
+    three = run(load_scene(pressed_inclusion(law, load_steps=3)))
     assert three["load_steps"] == 3 and len(three["iterations_per_step"]) == 3
     a, b = (np.array(s["interface_samples"]["lambda_n"]) for s in (one, three))
     assert np.abs(a).max() > 0
@@ -658,7 +659,8 @@ def test_load_steps_end_at_the_one_step_solution(law):
 
 def test_coulomb_steps_respect_the_cone_and_print_a_line_per_step():
     lines = []
-    summary = run(load_scene(pressed_inclusion("coulomb", load_steps=2)), log=lines.append)
+    with lines_to(lines.append):
+        summary = run(load_scene(pressed_inclusion("coulomb", load_steps=2)))
     s = {k: np.array(v) for k, v in summary["interface_samples"].items()}
     # the raw multipliers (P_t is clamped into the cone by construction): within the
     # cone up to h times the pressure scale (h = 1/6, the base scene's cells)
@@ -672,7 +674,7 @@ def test_coulomb_steps_respect_the_cone_and_print_a_line_per_step():
 def test_newton_failure_is_reported_with_its_history():
     data = pressed_inclusion("coulomb", max_iterations=1, load_steps=2)
     with pytest.raises(NewtonFailure, match="load step 1/2") as failure:
-        run(load_scene(data), log=None)
+        run(load_scene(data))
     assert "iterate  0" in str(failure.value) and "iterate  1" in str(failure.value)
     assert len(failure.value.report.residuals) == 2
 
@@ -736,7 +738,7 @@ def test_two_inclusions_under_hydrostatic_pressure():
     total = length(problem.cut)
     assert abs(total - sum(length(c) for c in alone)) < 1e-13
     assert abs(total - 2 * 2 * np.pi * 0.12) < 1e-3 * total
-    summary = run(scene, log=None)
+    summary = run(scene)
     assert "interface_samples" not in summary  # one set of samples per interface instead
     for name, side in (("inc0", -1), ("inc1", 1)):
         s = {k: np.array(v) for k, v in summary["interfaces"][name]["samples"].items()}
@@ -788,13 +790,13 @@ def test_two_laws_in_one_plate_equal_each_law_alone():
     """Each interface keeps its own law, multiplier field, measure and samples: with both
     inclusions of the plate's material the stress stays uniform, so the two-law scene
     gives each interface the multipliers of that law's one-inclusion scene."""
-    both = run(load_scene(two_laws()), log=None)
+    both = run(load_scene(two_laws()))
     assert both["effects"]["laws"]["bonded"]["law"] == "bonded"
     assert both["effects"]["laws"]["coulomb"]["friction"] == 1.0
     assert both["fields"] == ["u_minus", "u_plus", "multiplier_bonded", "multiplier_coulomb"]
     assert both["effects"]["solver"].startswith("SNES")
     for name in ("bonded", "coulomb"):
-        alone = run(load_scene(two_laws((name,))), log=None)
+        alone = run(load_scene(two_laws((name,))))
         a, b = (s["interfaces"][name]["samples"] for s in (both, alone))
         order_a, order_b = (np.lexsort(np.round([s["x"], s["y"]], 10)) for s in (a, b))
         scale = np.abs(b["lambda_n"]).max()  # the traction scale (2 Pa)
@@ -856,8 +858,8 @@ SCENES = bundled_scenes()["plate_with_hole_inclusion"].parent
 def test_gmsh_scene_runs_with_named_parts():
     """A .geo with physical curves: loads on named parts; same on 1 and 2 ranks."""
     scene = load_scene(gmsh_scene(), folder=SCENES)
-    summary = run(scene, log=None)
-    alone = run(scene, log=None, comm=MPI.COMM_SELF)
+    summary = run(scene)
+    alone = run(scene, comm=MPI.COMM_SELF)
     a, b = (np.array(s["interface_samples"]["lambda_n"]) for s in (summary, alone))
     order_a = np.lexsort([summary["interface_samples"][k] for k in ("x", "y")])
     order_b = np.lexsort([alone["interface_samples"][k] for k in ("x", "y")])

@@ -24,7 +24,8 @@ def _solved(law, pc_type, **options):
     problem = inclusion_problem(12, 2, law, "quadrilateral", **options)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # frictionless: the free spin of the inclusion
-        problem.solve({} if pc_type is None else {"pc_type": pc_type})
+        problem.petsc_options = {} if pc_type is None else {"pc_type": pc_type}
+        problem.solve()
     return problem
 
 
@@ -47,7 +48,8 @@ def test_coulomb_keeps_lu_and_its_jacobian_fails_the_guard():
     problem = inclusion_problem(12, 2, "coulomb", "quadrilateral", friction=0.3)
     assert not problem.symmetric
     with pytest.raises(ValueError, match="needs a symmetric Jacobian"):
-        problem.solve({"pc_type": "cholesky"})
+        problem.petsc_options = {"pc_type": "cholesky"}
+        problem.solve()
     newton = RestrictedNewton(
         problem.residual(problem.w),
         problem.w,

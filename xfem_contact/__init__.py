@@ -6,6 +6,8 @@ the start-up hook installed with this package does before any ``import dolfinx``
 (see ``xfem_contact/_bootstrap.py``), and which is done here too.
 """
 
+import logging
+
 from xfem_contact._bootstrap import load_dolfinx_solver
 
 load_dolfinx_solver()  # the PyPI wheel: MPI first; conda/apt DOLFINx: nothing to do
@@ -13,6 +15,7 @@ load_dolfinx_solver()  # the PyPI wheel: MPI first; conda/apt DOLFINx: nothing t
 from xfem_contact._version import package_version, versions  # noqa: E402
 
 __version__ = package_version()
+logging.getLogger(__name__).addHandler(logging.NullHandler())  # shown only where asked
 
 from xfem_contact.fem.cutmesh import CutMesh  # noqa: E402
 from xfem_contact.fem.forms import form  # noqa: E402

@@ -117,7 +117,7 @@ def test_two_interfaces_a_cell_apart(gap_cells):
     report = problem.solve()
     assert report.iterations <= 30
     for name, (cx, cy) in centres.items():
-        samples = problem.interface_samples(name)
+        samples = problem.interface_samples(problem.w, name)
         theta = np.arctan2(np.array(samples["y"]) - cy, np.array(samples["x"]) - cx)
         exact = -1.5 + 0.5 * np.cos(2 * theta)
         assert np.abs(np.array(samples["lambda_n"]) - exact).max() < 1e-2

@@ -31,7 +31,7 @@ def solved(law, loading="pull", **options):
 @pytest.mark.parametrize("friction", FRICTIONS)
 def test_any_friction_converges_inside_the_cone(friction):
     problem, report = solved("coulomb", friction=friction)
-    state = problem.interface_state()
+    state = problem.interface_state(problem.w)
     counts = problem.interface_status(problem.w)
     print(f"mu {friction:g}: Newton {report.iterations}, {counts}")
     assert report.iterations <= 30
@@ -54,8 +54,8 @@ def test_friction_limits_are_the_frictionless_and_sticking_solutions(friction, l
     there too.)"""
     coulomb, _ = solved("coulomb", "paper", friction=friction)
     other, _ = solved(limit, "paper")
-    a = coulomb.interface_state()["lambda_n"]
-    b = other.interface_state()["lambda_n"]
+    a = coulomb.interface_state(coulomb.w)["lambda_n"]
+    b = other.interface_state(other.w)["lambda_n"]
     scale = MPI.COMM_WORLD.allreduce(np.abs(b).max(initial=0.0), op=MPI.MAX)
     difference = MPI.COMM_WORLD.allreduce(np.abs(a - b).max(initial=0.0), op=MPI.MAX)
     assert difference < tolerance * scale

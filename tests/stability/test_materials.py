@@ -27,7 +27,7 @@ def fourier_misfit(problem, modes: int = 9) -> float:
     """Largest deviation of lambda_n from its least-squares fit by ``modes`` Fourier
     modes of the angle, over the mean |lambda_n| (the smooth part is what the square's
     boundary adds to the uniform infinite-plate pressure)."""
-    samples = problem.interface_samples()
+    samples = problem.interface_samples(problem.w)
     theta = np.arctan2(np.array(samples["y"]) - 0.5, np.array(samples["x"]) - 0.5)
     lam = np.array(samples["lambda_n"])
     k = np.arange(modes)
@@ -43,7 +43,7 @@ def test_stiffness_contrast_keeps_the_interface_closed_and_smooth(contrast):
     problem = inclusion_problem(16, 2, "sticking", loading="hydrostatic", materials=materials)
     report = problem.solve()
     counts = problem.interface_status(problem.w)
-    state = problem.interface_state()
+    state = problem.interface_state(problem.w)
     print(f"contrast {contrast:g}: Newton {report.iterations}, {counts}")
     assert report.iterations <= 30
     assert counts["contact"] == problem.mesh.comm.allreduce(state["P_n"].size)

@@ -25,7 +25,7 @@ def turned(steps: int):
         report = problem.solve()
         assert report.iterations <= 30
         problem.accept_step()
-    return problem.interface_state()["lambda_n"]
+    return problem.interface_state(problem.w)["lambda_n"]
 
 
 @pytest.mark.mpi

@@ -17,20 +17,20 @@ of DOLFINx 0.11. SI units (m, Pa).
 
 from __future__ import annotations
 
-import time
-
 import dolfinx.fem
 import dolfinx.fem.petsc
 import dolfinx.mesh
 import numpy as np
 import ufl
+from dolfinx.common import Timer
 from mpi4py import MPI
 
+from xfem_contact._timers import phase, seconds
 from xfem_contact.cases import paper
 from xfem_contact.cases.body_fitted import INCLUSION_GEO, annulus_geo, mesh_geo
 from xfem_contact.mechanics.bulk import cell_size
 from xfem_contact.mechanics.materials import Material
-from xfem_contact.solvers.options import remove_options, unique_prefix
+from xfem_contact.solvers.options import preset, remove_options, unique_prefix
 
 #: Nitsche's penalty: gamma = NITSCHE * degree^2 (dimensionless)
 NITSCHE = 10.0
@@ -148,11 +148,7 @@ class TwoBodies:
             self._load_forms(),
             bcs=self.bcs,
             petsc_options_prefix=prefix,
-            petsc_options={
-                "ksp_type": "preonly",
-                "pc_type": "lu",
-                "pc_factor_mat_solver_type": "mumps",
-            },
+            petsc_options=preset("fitted"),
             entity_maps=self.entity_maps,
             kind="mpi",
         )
@@ -178,14 +174,14 @@ class TwoBodies:
         return sum(V.dofmap.index_map.size_global * V.dofmap.bs for V in self.V)
 
 
-def _run(gm, bodies: TwoBodies, exact, timings: dict, start: float) -> dict:
-    timings["build"] = time.perf_counter() - start
-    start = time.perf_counter()
+def _run(gm, bodies: TwoBodies, exact, timings: dict, timer: Timer) -> dict:
+    timings["build"] = seconds(timer)
+    timer = phase("fitted Nitsche solve")
     w = bodies.solve()
-    timings["solve"] = time.perf_counter() - start
-    start = time.perf_counter()
+    timings["solve"] = seconds(timer)
+    timer = phase("fitted Nitsche post")
     error = bodies.pressure_error(w, exact)
-    timings["post"] = time.perf_counter() - start
+    timings["post"] = seconds(timer)
     return {"error": error, "dofs": bodies.dofs(), "timings": timings}
 
 
@@ -196,10 +192,10 @@ def nitsche_inclusion(
     size ``h``, m): pressure error against ``-3/2 + cos(2 theta)/2`` Pa, dofs and wall
     times (s) of meshing, building, solving and post-processing. Collective."""
     cx, cy = paper.INCLUSION_CENTRE
-    start = time.perf_counter()
+    timer = phase("fitted Nitsche mesh")
     gm = mesh_geo(INCLUSION_GEO.format(h=h, cx=cx, cy=cy, r=radius), degree, "triangle", comm)
-    timings = {"mesh": time.perf_counter() - start}
-    start = time.perf_counter()
+    timings = {"mesh": seconds(timer)}
+    timer = phase("fitted Nitsche build")
     bodies = TwoBodies(gm, degree, Material(paper.INCLUSION_E, 0.0))
     sxx, syy = paper.LOADINGS["paper"]
     bodies.add_pressure(1, lambda x: np.isclose(x[0], 0.0) | np.isclose(x[0], 1.0), -sxx)
@@ -208,17 +204,17 @@ def nitsche_inclusion(
         bodies.fix(1, lambda x, p=point: np.isclose(x[0], p[0]) & np.isclose(x[1], p[1]), component)
     x = ufl.SpatialCoordinate(gm.mesh)("+")
     exact = -1.5 + 0.5 * ufl.cos(2 * ufl.atan2(x[1] - cy, x[0] - cx))
-    return _run(gm, bodies, exact, timings, start)
+    return _run(gm, bodies, exact, timings, timer)
 
 
 def nitsche_annulus(h: float, degree: int, comm: MPI.Comm = MPI.COMM_WORLD) -> dict:
     """Paper case 3 at alpha = 0, the inner and outer rings as two meshes with a
     frictionless (normal) Nitsche tie: pressure error against -1825/1636 MPa, as
     :func:`nitsche_inclusion`."""
-    start = time.perf_counter()
+    timer = phase("fitted Nitsche mesh")
     gm = mesh_geo(annulus_geo(h), degree, "triangle", comm)
-    timings = {"mesh": time.perf_counter() - start}
-    start = time.perf_counter()
+    timings = {"mesh": seconds(timer)}
+    timer = phase("fitted Nitsche build")
     bodies = TwoBodies(gm, degree, Material(paper.ANNULUS_E, 0.0), normal_only=True)
     r_in, _, r_out = paper.ANNULUS_RADII
     tol = 1e-6 * r_out
@@ -227,4 +223,4 @@ def nitsche_annulus(h: float, degree: int, comm: MPI.Comm = MPI.COMM_WORLD) -> d
         2, lambda x: np.abs(np.hypot(x[0], x[1]) - r_out) < tol, paper.ANNULUS_PRESSURE
     )
     bodies.fix(2, lambda x: np.isclose(x[0], r_out) & np.isclose(x[1], 0.0), 1)
-    return _run(gm, bodies, paper.ANNULUS_CONTACT_PRESSURE, timings, start)
+    return _run(gm, bodies, paper.ANNULUS_CONTACT_PRESSURE, timings, timer)

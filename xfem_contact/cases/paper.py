@@ -97,7 +97,7 @@ def pressure_total_variation(problem: ContactProblem, centre=INCLUSION_CENTRE) -
     """Total variation (Pa) of ``lambda_n`` around a closed interface, the interface
     points ordered by polar angle about ``centre``; an oscillating multiplier has a
     total variation far above that of the exact pressure. Collective."""
-    samples = problem.interface_samples()
+    samples = problem.interface_samples(problem.w)
     theta = np.arctan2(np.array(samples["y"]) - centre[1], np.array(samples["x"]) - centre[0])
     values = np.array(samples["lambda_n"])[np.argsort(theta)]
     return float(np.abs(np.diff(np.r_[values, values[:1]])).sum())

@@ -148,6 +148,7 @@ def rotating_annulus_problem(
     if outer not in OUTER_SUPPORTS:
         raise ValueError(f"Unknown outer support {outer!r}; valid: {OUTER_SUPPORTS}")
     problem_keys = ("pairing", "slave", "ghost_penalty", "min_support_fraction")
+    problem_keys += ("petsc_options", "petsc_options_prefix")
     problem_options = {k: options.pop(k) for k in problem_keys if k in options}
     r_in, r_gamma, r_out = ANNULUS_RADII
     n_angular = 4 * n_radial if n_angular is None else n_angular
@@ -184,7 +185,7 @@ def pressure_errors(problem: Problem, reference: float | None = None) -> dict[st
     (Pa). Collective."""
     reference = svk_annulus_pressure() if reference is None else reference
     coupling = next(iter(problem.couplings.values()))
-    lam = problem.interface_state()["lambda_n"]
+    lam = problem.interface_state(problem.w)["lambda_n"]
     w = coupling.weights
     comm = problem.mesh.comm
 

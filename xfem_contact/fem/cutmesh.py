@@ -5,7 +5,6 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import itertools
-import time
 from collections.abc import Mapping
 
 import dolfinx.fem
@@ -15,6 +14,7 @@ import numpy.typing as npt
 import ufl
 from mpi4py import MPI
 
+from xfem_contact._timers import phase, seconds
 from xfem_contact.fem import cut_boundary
 from xfem_contact.fem.crack_cut import Crack, crack_rules
 from xfem_contact.fem.interface_cells import cell_interfaces, trace_nullity, without_slivers
@@ -120,7 +120,7 @@ class CutMesh:
         mesh = self.mesh
         tdim = mesh.topology.dim
         cell_name = mesh.topology.cell_name()
-        start = time.perf_counter()
+        timer = phase("cut")
         known = getattr(self, "interface_names", None)
         #: The cracks (names, union level sets, zones) of a cut by cracks, else None
         self.cracks: CrackUnion | None = None
@@ -154,7 +154,7 @@ class CutMesh:
         )
         self.geometry = geometry
         self.cut_cells = cut_cells
-        cut_time = time.perf_counter() - start
+        cut_time, timer = seconds(timer), phase("cut rules")
         q = self.quadrature_degree
         rules = {
             _SIDE_MINUS: quadrature.side_rules(geometry, -1, q, ncut),
@@ -187,7 +187,7 @@ class CutMesh:
         self.num_cut_cells_global = mesh.comm.allreduce(ncut, op=MPI.SUM)
         #: Wall time (s) of the last update: level set + classification +
         #: sub-triangulation ("cut"), and per-cell rules ("quadrature")
-        self.timings = {"cut": cut_time, "quadrature": time.perf_counter() - start - cut_time}
+        self.timings = {"cut": cut_time, "quadrature": seconds(timer)}
 
     def _crack_rules(self, rules: dict, tangent, maps: CellMaps) -> dict:
         """The rules of the crack ``phi = 0, psi < 0`` from those of the cut by ``phi``;

@@ -87,10 +87,11 @@ def interface_point_data(problem) -> dict[str, np.ndarray]:
 
 def sample_status(problem, name: str) -> list[int]:
     """The status codes (0 open, 1 stick, 2 slip) at the rule points of interface
-    ``name`` of all processes, in the order of ``problem.interface_samples(name)``.
+    ``name`` of all processes, in the order of
+    ``problem.interface_samples(problem.w, name)``.
     Collective."""
     law = problem.laws[name]
-    state = problem.interface_state(name=name)
+    state = problem.interface_state(problem.w, name)
     npoints = problem.contexts[name].rules.points.shape[0]
     local = law.point_status(state, npoints)
     return np.concatenate(problem.mesh.comm.allgather(local)).tolist()

@@ -8,8 +8,9 @@ and write PNG files; the drawing helpers they share are in :mod:`xfem_contact.io
 from __future__ import annotations
 
 import json
+import logging
 import pathlib
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 import numpy as np
 import pyvista
@@ -29,6 +30,8 @@ from xfem_contact.io.render import (
     quiet_vtk,
 )
 from xfem_contact.io.vtk_grids import deformed_lips_grid, interface_grid, merge_grids, subcell_grid
+
+logger = logging.getLogger(__name__)
 
 __all__ = [
     "auto_scale",
@@ -251,7 +254,7 @@ def colour_range(values: np.ndarray, tiny: float = 1e-12) -> tuple[np.ndarray, t
 
 
 def render_folder(
-    folder: str | pathlib.Path, log: Callable[[str], None] | None = None
+    folder: str | pathlib.Path,
 ) -> list[pathlib.Path]:
     """Render the results of a scene run folder to PNG (serial; reads the files).
 
@@ -263,7 +266,8 @@ def render_folder(
     with each point's stick / slip status); one plot per interface when there are
     several (``pressure_NAME.png``, ``traction_NAME.png``); for a crack ``lips.png``
     (opening, slip and multipliers along its lips). A picture whose data is
-    missing is skipped with a ``log`` line.
+    missing is skipped with an INFO record on this module's logger, as is each file
+    written.
 
     Raises:
         FileNotFoundError: if the folder holds no ``result*.vtu``.
@@ -275,7 +279,7 @@ def render_folder(
         plot_traction,
     )
 
-    say = log or (lambda line: None)
+    say = logger.info
     folder = pathlib.Path(folder)
     results = sorted(folder.glob("result*.vtu"))
     if not results:

@@ -12,7 +12,7 @@ linear solve; no level set, no cut, no enrichment, no multiplier. Its loads are 
 
 from __future__ import annotations
 
-import time
+import warnings
 
 import dolfinx.fem
 import dolfinx.fem.petsc
@@ -21,11 +21,12 @@ import numpy as np
 import numpy.typing as npt
 import ufl
 
+from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.enrichment import DofCounts
 from xfem_contact.fem.forms import form
 from xfem_contact.mechanics.loads import Loads, PlainFields
 from xfem_contact.mechanics.materials import Material, Moduli
-from xfem_contact.solvers.options import remove_options, unique_prefix
+from xfem_contact.solvers.options import applied_options, checked_prefix, preset
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 
 
@@ -85,6 +86,11 @@ class PlainElasticityProblem:
         mesh: The mesh.
         degree: Displacement degree (Lagrange).
         material: The material (its moduli become Constants: ``problem.material.E``).
+        petsc_options: PETSc options (names without prefix) of the KSP, over the preset
+            ``plain`` of :data:`~xfem_contact.solvers.options.PRESETS` (PETSc's LU);
+            settable later as :attr:`petsc_options`.
+        petsc_options_prefix: The KSP's options prefix; ``None``: a prefix unique in the
+            process (``"xfem_plain_3_"``); an empty one is refused.
 
     Collective.
     """
@@ -92,7 +98,19 @@ class PlainElasticityProblem:
     #: One linear solve; no interface, no law, small kinematics
     linear, symmetric, kinematics, cut = True, True, "small", None
 
-    def __init__(self, mesh: dolfinx.mesh.Mesh, degree: int, material: Material):
+    def __init__(
+        self,
+        mesh: dolfinx.mesh.Mesh,
+        degree: int,
+        material: Material,
+        *,
+        petsc_options: dict | None = None,
+        petsc_options_prefix: str | None = None,
+    ):
+        #: The options prefix of the KSP
+        self.petsc_options_prefix = checked_prefix(petsc_options_prefix, "xfem_plain_")
+        #: The PETSc options the user gave (names without prefix)
+        self.petsc_options = dict(petsc_options or {})
         self.mesh = mesh
         self.material = Moduli(material, mesh)
         self.V = dolfinx.fem.functionspace(mesh, ("Lagrange", degree, (mesh.geometry.dim,)))
@@ -114,33 +132,44 @@ class PlainElasticityProblem:
         return a if springs is None else a + springs
 
     def solve(self, petsc_options: dict | None = None, log=None) -> SolveReport:
-        """One linear solve (PETSc LU unless ``petsc_options`` say otherwise); ``w``
-        holds the result and :attr:`last_report` the report. ``log`` is unused (no
-        iterates). Collective.
+        """One linear solve (PETSc LU unless :attr:`petsc_options` say otherwise); ``w``
+        holds the result and :attr:`last_report` the report. ``petsc_options``:
+        deprecated (give them at construction), options for this solve only. ``log`` is
+        unused (no iterates). Collective.
 
         Raises:
             LinearSolveFailure: the KSP diverged; ``w`` then holds the state from before
                 this solve and :attr:`last_report` the failed solve's report.
         """
-        start = time.perf_counter()
+        if petsc_options is not None:
+            warnings.warn(
+                "PlainElasticityProblem.solve(petsc_options=...) is deprecated and will be "
+                "removed in the next release: give the options at construction, "
+                "PlainElasticityProblem(..., petsc_options=...), or set "
+                "problem.petsc_options",
+                DeprecationWarning,
+                stacklevel=2,
+            )
+        timer = phase("plain linear solve")
         accepted = self.w.x.array.copy()
-        prefix = unique_prefix("xfem_plain_")
-        problem = dolfinx.fem.petsc.LinearProblem(
-            form(self.bilinear_form()),
-            form(self.loads.linear_form()),
-            bcs=self.loads.bcs,
-            u=self.w,
-            petsc_options_prefix=prefix,
-            petsc_options={"ksp_type": "preonly", "pc_type": "lu", **(petsc_options or {})},
-        )
-        try:
-            problem.solve()
-            reason = problem.solver.getConvergedReason()
-        finally:
-            remove_options(prefix)  # nothing of ours outlives the solve
-            del problem  # its KSP, matrix and vectors (LinearProblem.__del__)
+        options = {**preset("plain"), **self.petsc_options, **(petsc_options or {})}
+        # the options in the database while PETSc reads them (MUMPS's at the solve)
+        with applied_options(self.petsc_options_prefix, options):
+            problem = dolfinx.fem.petsc.LinearProblem(
+                form(self.bilinear_form()),
+                form(self.loads.linear_form()),
+                bcs=self.loads.bcs,
+                u=self.w,
+                petsc_options_prefix=self.petsc_options_prefix,
+            )
+            try:
+                problem.solver.setFromOptions()
+                problem.solve()
+                reason = problem.solver.getConvergedReason()
+            finally:
+                del problem  # its KSP, matrix and vectors (LinearProblem.__del__)
         self.last_report = SolveReport(
-            reason=reason, total_time=time.perf_counter() - start, w=self.w, space=self.space
+            reason=reason, total_time=seconds(timer), w=self.w, space=self.space
         )
         if reason < 0:
             self.w.x.array[:] = accepted
@@ -154,6 +183,6 @@ class PlainElasticityProblem:
     def accept_step(self) -> None:
         """Nothing to accept: no interface law has a history."""
 
-    def interface_status(self, w: dolfinx.fem.Function) -> dict:
+    def interface_status(self, w: dolfinx.fem.Function, name: str | None = None) -> dict:
         """No interface: ``{}``."""
         return {}

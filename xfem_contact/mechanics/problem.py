@@ -9,13 +9,14 @@ solve; contact laws: generalized Newton (SNES), on the active dofs of the restri
 
 from __future__ import annotations
 
-import time
+import warnings
 from collections.abc import Callable, Mapping
 
 import dolfinx.fem
 import numpy as np
 import ufl
 
+from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.forms import form
@@ -30,11 +31,16 @@ from xfem_contact.mechanics.loads import Loads, SideFields
 from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
-from xfem_contact.solvers.linear import added_options, solve_restricted, tip_transform
+from xfem_contact.solvers.linear import solve_restricted, tip_transform
+from xfem_contact.solvers.log_lines import lines_to
 from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton, weak_method
-from xfem_contact.solvers.options import merged_options
+from xfem_contact.solvers.options import (
+    Facts,
+    checked_prefix,
+    problem_options,
+    splits_fields,
+)
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
-from xfem_contact.solvers.symmetry import symmetric_options
 
 
 class Problem:
@@ -60,6 +66,12 @@ class Problem:
         tip_radius: A crack's tip enrichment radius (m), ``"auto"`` (default: a fixed
             fraction of the tips' crack length, not of the mesh) or None (the tip cells'
             nodes), see :class:`EnrichedSpace`.
+        petsc_options: PETSc options (names without prefix) of the solver, over the
+            defaults and presets of :mod:`xfem_contact.solvers.options` (see
+            :meth:`solver_options`); change them later with :attr:`petsc_options`.
+        petsc_options_prefix: The options prefix of the solver's PETSc objects (the SNES
+            or KSP, its PC). ``None``: a prefix unique in the process
+            (``"xfem_problem_3_"``); an empty one is refused. The same on every process.
 
     Collective.
     """
@@ -77,9 +89,14 @@ class Problem:
         slave: int = DEFAULT.slave,
         pairing: str = DEFAULT.pairing,
         tip_radius: float | str | None = "auto",
+        petsc_options: dict | None = None,
+        petsc_options_prefix: str | None = None,
     ):
         if kinematics not in KINEMATICS:
             raise ValueError(f"Unknown kinematics {kinematics!r}; valid: {KINEMATICS}")
+        #: The options prefix of the solver's PETSc objects
+        self.petsc_options_prefix = checked_prefix(petsc_options_prefix, "xfem_problem_")
+        self._petsc_options = dict(petsc_options or {})
         self.cut, self.mesh = cut, cut.mesh
         self.kinematics = kinematics
         self.laws = interface_laws(cut, law)
@@ -115,7 +132,8 @@ class Problem:
         self.w_old = dolfinx.fem.Function(self.space.W, name="w_old")
         self._law_materials = side_materials.laws
         self._newton: RestrictedNewton | None = None
-        self._newton_key = None
+        self._newton_loads: int | None = None
+        self._options_changed = False
         self._last_report: SolveReport | None = None
         #: Pseudo-time of the rotations that the bodies of ``w`` have turned by
         self._rotated_at = 0.0
@@ -197,16 +215,30 @@ class Problem:
         small = self.kinematics == "small" and not self.couplings
         return small and all(law.symmetric for law in self.laws.values())
 
+    @property
+    def petsc_options(self) -> dict:
+        """The PETSc options the user gave (names without prefix; a copy). Setting them
+        rebuilds the Newton solver at the next solve. Not collective, but set them
+        alike on every process."""
+        return dict(self._petsc_options)
+
+    @petsc_options.setter
+    def petsc_options(self, options: dict | None) -> None:
+        options = dict(options or {})
+        self._options_changed |= options != self._petsc_options
+        self._petsc_options = options
+
     def solver_options(self, petsc_options: dict | None = None) -> dict:
         """The PETSc options (without prefix) :meth:`solve` uses: ``petsc_options``
-        over the defaults, the LDL^T of a symmetric problem included. Not collective."""
+        (default: :attr:`petsc_options`) over the defaults and the presets that apply to
+        this problem (the LDL^T of a symmetric one, a crack's, large sliding's; see
+        :func:`~xfem_contact.solvers.options.problem_options`). Not collective."""
         solver = "linear" if self.linear else "newton"
-        return merged_options(solver, self._options(petsc_options))
-
-    def _options(self, petsc_options: dict | None) -> dict:
-        """``petsc_options`` over LDL^T when symmetric and a crack's or large sliding's."""
-        options = symmetric_options(petsc_options, self.symmetric)
-        return {**added_options(self.space, options, bool(self.couplings)), **options}
+        crack_tip = self.space.branch_field is not None
+        if petsc_options is None:
+            petsc_options = self._petsc_options
+        facts = Facts(dict(petsc_options), self.symmetric, crack_tip, bool(self.couplings))
+        return problem_options(solver, facts)
 
     def law(self, name: str | None = None) -> InterfaceLaw:
         """The law of interface ``name`` (of the only interface for ``None``)."""
@@ -272,17 +304,51 @@ class Problem:
         """Solve on the active dofs; ``self.w`` holds the result. Collective.
 
         Linear problems: one KSP solve. With a contact law: generalized Newton
-        (SNES) from ``self.w``, a ``log`` line per iterate. Either way returns a
+        (SNES) from ``self.w``, a log record per iterate (INFO, logger
+        ``xfem_contact.solvers.newton``). Either way returns a
         :class:`~xfem_contact.solvers.report.SolveReport` (the solution ``w``, its
-        fields, iterations, residual history, reason). The Newton
-        solver is kept between solves and rebuilt when loads, Dirichlet conditions
-        or ``petsc_options`` changed since.
+        fields, iterations, residual history, reason). The Newton solver is kept between
+        solves and rebuilt when the loads, the Dirichlet conditions or
+        :attr:`petsc_options` were changed since.
+
+        Args:
+            petsc_options: Deprecated (give them at construction, or set
+                :attr:`petsc_options`): options for this solve only.
+            log: Deprecated (install a handler on the ``xfem_contact`` logger, e.g.
+                :func:`~xfem_contact.solvers.log_lines.lines_to`): called with each line.
 
         Raises:
             NewtonFailure: with the iteration history, if SNES does not converge;
                 ``self.w`` then holds the state from before this solve.
             ValueError: the cut was updated after the problem was built.
         """
+        if log is not None:
+            warnings.warn(
+                "Problem.solve(log=...) is deprecated and will be removed in the next release: "
+                "the solver logs on logging.getLogger('xfem_contact'); show its lines with a "
+                "handler, e.g. with xfem_contact.solvers.log_lines.lines_to(print): ...",
+                DeprecationWarning,
+                stacklevel=2,
+            )
+        if petsc_options is None:
+            with lines_to(log):
+                return self._solve()
+        warnings.warn(
+            "Problem.solve(petsc_options=...) is deprecated and will be removed in the next "
+            "release: give the options at construction, Problem(..., petsc_options=...), "
+            "or set problem.petsc_options",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        kept, self.petsc_options = self._petsc_options, petsc_options
+        try:
+            with lines_to(log):
+                return self._solve()
+        finally:
+            self._petsc_options = kept
+            self._options_changed |= kept != petsc_options
+
+    def _solve(self) -> SolveReport:
         if self.cut.revision != self._cut_revision:
             raise ValueError(
                 "The cut changed (cut.update) after this problem was built: its enriched "
@@ -291,15 +357,21 @@ class Problem:
                 "problem.update_interface(levelset)"
             )
         if self._checked_loads != self.loads.revision:  # again only when the loads changed
-            check_support(self, log)
+            check_support(self)
             self._checked_loads = self.loads.revision
-        petsc_options = self._options(petsc_options)
+        petsc_options = self.solver_options()
         if self.linear:
             a, L = form(self.bilinear_form()), form(self.loads.linear_form())
-            start, residuals = time.perf_counter(), []
+            timer, residuals = phase("linear solve"), []
             try:
                 w, reason = solve_restricted(
-                    a, L, self.loads.bcs, self.space, petsc_options, residuals=residuals
+                    a,
+                    L,
+                    self.loads.bcs,
+                    self.space,
+                    petsc_options,
+                    self.petsc_options_prefix,
+                    residuals=residuals,
                 )
             except LinearSolveFailure as failure:  # self.w is untouched
                 self._last_report = failure.report
@@ -308,25 +380,25 @@ class Problem:
             self._last_report = SolveReport(
                 residuals,
                 reason=reason,
-                total_time=time.perf_counter() - start,
+                total_time=seconds(timer),
                 w=self.w,
                 space=self.space,
             )
             return self._last_report
-        key = (self.loads.revision, repr(sorted((petsc_options or {}).items())))
-        if self._newton is not None and key != self._newton_key:
+        changed = self._options_changed or self._newton_loads != self.loads.revision
+        if self._newton is not None and changed:
             self._newton.destroy()  # loads or solver options changed since it was built
             self._newton = None
         if self._newton is None:
-            split = (petsc_options or {}).get("pc_type") in ("fieldsplit", "python")
+            split = splits_fields(petsc_options)
             self._newton = RestrictedNewton(
                 self.residual(self.w),
                 self.w,
                 self.loads.bcs,
                 self.restriction(),
                 petsc_options,
+                self.petsc_options_prefix,
                 status=weak_method(self.interface_status),
-                log=log,
                 splits=field_splits(self.space) if split else None,
                 near_nullspace=rigid_modes(self.space) if split else None,
                 interpolation=vertex_interpolation(self.space) if split else None,
@@ -334,8 +406,7 @@ class Problem:
                 field_space=self.space.field_space,
                 transform=tip_transform(self.space, off=split or bool(self.couplings)),
             )
-            self._newton_key = key
-        self._newton.log = log
+            self._newton_loads, self._options_changed = self.loads.revision, False
         accepted = self.w.x.array.copy()
         t = self.loads.time
         if self.kinematics == "large":  # turn rotated bodies rigidly first (predictor)
@@ -364,7 +435,7 @@ class Problem:
     def newton(self) -> RestrictedNewton | None:
         """The Newton solver of the contact solves (its ``snes``, the reduced Jacobian
         ``J_r``, ``options``), kept between solves; None before the first or after the
-        loads, the solver options or the cut changed."""
+        cut changed (it is rebuilt at the next solve after the loads or the options)."""
         return self._newton
 
     @property
@@ -394,21 +465,25 @@ class Problem:
 
     # -- interface state -------------------------------------------------------------
     def interface_state(
-        self, w: dolfinx.fem.Function | None = None, name: str | None = None
+        self, w: dolfinx.fem.Function, name: str | None = None
     ) -> dict[str, np.ndarray]:
-        """The law's state at this process's rule points of interface ``name``
-        (see the law's ``state``), for ``w`` (default: the solution)."""
+        """The law's state at this process's rule points of interface ``name`` (the only
+        one for ``None``) for the state ``w`` (e.g. :attr:`w`; see the law's ``state``)."""
         name = self._name(name)
-        return self.laws[name].state(self.contexts[name], self.w if w is None else w)
+        return self.laws[name].state(self.contexts[name], w)
 
-    def interface_status(self, w: dolfinx.fem.Function) -> dict:
-        """Global counts of interface rule points by status (contact / stick / slip),
-        prefixed by the interface name when there are several. Collective."""
-        return status_counts(self.laws, self.contexts, w)
+    def interface_status(self, w: dolfinx.fem.Function, name: str | None = None) -> dict:
+        """Global counts of interface rule points by status (contact / stick / slip) for
+        the state ``w``: of interface ``name``, or for ``None`` of all, prefixed by the
+        interface name when there are several. Collective."""
+        laws = self.laws if name is None else {self._name(name): self.law(name)}
+        return status_counts(laws, self.contexts, w)
 
-    def interface_samples(self, name: str | None = None) -> dict[str, list[float]]:
-        """The state of the solution at the rule points of all processes, for plots
-        and summaries (see :func:`~xfem_contact.mechanics.contexts.samples`).
-        Collective."""
+    def interface_samples(
+        self, w: dolfinx.fem.Function, name: str | None = None
+    ) -> dict[str, list[float]]:
+        """The state ``w`` (e.g. :attr:`w`) at the rule points of all processes of
+        interface ``name`` (the only one for ``None``), for plots and summaries (see
+        :func:`~xfem_contact.mechanics.contexts.samples`). Collective."""
         name = self._name(name)
-        return samples(self.laws[name], self.contexts[name], self.w)
+        return samples(self.laws[name], self.contexts[name], w)

@@ -34,6 +34,7 @@ leave a body free, which only the solve can tell.
 from __future__ import annotations
 
 import dataclasses
+import logging
 import warnings
 
 import basix
@@ -43,6 +44,8 @@ from mpi4py import MPI
 
 from xfem_contact.fem.evaluation import interface_points
 from xfem_contact.fem.subspaces import collapse
+
+logger = logging.getLogger(__name__)
 
 #: What a closed interface of each kind transmits (the reason in the messages)
 _KIND_TEXT = {
@@ -114,12 +117,12 @@ class RigidModeWarning(UserWarning):
     """A body may spin freely (a frictionless circular interface): fine without torque."""
 
 
-def check_support(problem, log=None) -> None:
+def check_support(problem) -> None:
     """Act on the free rigid modes of ``problem``'s bodies: a body without support is
     an error naming the modes and the constraints that remove them; a spin only a
-    frictionless interface leaves free is a :class:`RigidModeWarning` (and a ``log``
-    line on rank 0): a point constraint for it would carry a spurious reaction and
-    spoil the pressure (docs' mechanics page). Collective.
+    frictionless interface leaves free is a :class:`RigidModeWarning` (and a warning
+    record on this module's logger, on rank 0): a point constraint for it would carry a
+    spurious reaction and spoil the pressure (docs' mechanics page). Collective.
 
     Raises:
         ValueError: a body has free rigid modes beyond such a spin.
@@ -129,9 +132,9 @@ def check_support(problem, log=None) -> None:
         raise ValueError("Free rigid modes: " + " | ".join(errors))
     for body in free:
         message = f"{body.message()} if the loads carry a torque"
-        warnings.warn(message, RigidModeWarning, stacklevel=3)
-        if log is not None and problem.mesh.comm.rank == 0:
-            log(f"warning: {message}")
+        warnings.warn(message, RigidModeWarning, stacklevel=4)  # the caller of solve()
+        if problem.mesh.comm.rank == 0:
+            logger.warning(message)
 
 
 def check_rigid_modes(problem, tol: float = 1e-3) -> list[str]:

@@ -5,7 +5,7 @@ the multipliers (``"lambda"``: every multiplier field); :func:`rigid_modes` give
 translations and the rotation of each side, the near null space of the displacement
 block for algebraic multigrid (GAMG). Used by
 :class:`~xfem_contact.mechanics.problem.Problem` for the ``"iterative"`` preset of
-:data:`~xfem_contact.solvers.options.LINEAR_PRESETS`.
+:data:`~xfem_contact.solvers.options.PRESETS`.
 """
 
 from __future__ import annotations

@@ -23,6 +23,7 @@ from xfem_contact.mechanics.plain import PlainElasticityProblem
 from xfem_contact.mechanics.problem import Problem
 from xfem_contact.scenes.crack_builder import crack_cut, problem_error
 from xfem_contact.scenes.expressions import compile_expression, numpy_field
+from xfem_contact.scenes.load_kinds import LOAD_KINDS
 from xfem_contact.scenes.scene import InterfaceSpec, Scene, SceneError
 
 
@@ -127,13 +128,17 @@ def interface_error(scene: Scene, error: InterfaceError) -> SceneError:
     return SceneError(f"interfaces[{index}]", error.message)
 
 
-def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
-    """Create the mesh and the problem of a scene (collective). Returns (problem, effects)."""
+def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD, petsc_options_prefix: str | None = None):
+    """Create the mesh and the problem of a scene (collective). Returns (problem, effects).
+
+    The problem takes the scene's PETSc options (``[solver]``) and ``petsc_options_prefix``
+    (``None``: a unique one, see :class:`~xfem_contact.mechanics.problem.Problem`)."""
+    solver = {"petsc_options": scene.petsc_options, "petsc_options_prefix": petsc_options_prefix}
     meshed = create_mesh(scene, comm)
     mesh = meshed.mesh
     material = next(iter(scene.materials.values()))
     if not (scene.interfaces or scene.cracks):
-        problem = PlainElasticityProblem(mesh, scene.degree, material)
+        problem = PlainElasticityProblem(mesh, scene.degree, material, **solver)
         effects = {
             "interface": None,
             "interfaces": [],
@@ -171,7 +176,7 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
             options = {"kinematics": first.kinematics, "slave": first.slave}
             options["pairing"] = first.pairing
         try:
-            problem = Problem(cut, scene.degree, materials, laws, **options)
+            problem = Problem(cut, scene.degree, materials, laws, **solver, **options)
         except ValueError as error:
             if not scene.cracks:
                 raise
@@ -208,22 +213,7 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD):
 
 
 def _apply(loads, load) -> None:
-    """Add one scene load to a problem's :class:`~xfem_contact.mechanics.loads.Loads`."""
-    path = {"history": load.history}
-    if load.type == "point_displacement":
-        loads.add_point_displacement(load.point, float(load.value), int(load.component), **path)
-    elif load.type == "displacement":
-        loads.add_displacement(load.part, _value(load.value), load.component, **path)
-    elif load.type == "pressure":
-        loads.add_pressure(load.part, _value(load.value), load.side, **path)
-    elif load.type == "traction":
-        loads.add_traction(load.part, _value(load.value), load.side, **path)
-    elif load.type == "body_force":
-        loads.add_body_force(_value(load.value), load.side, **path)
-    elif load.type == "rotation":
-        angle = {"angle": load.value} if load.angle_deg is None else {"angle_deg": load.angle_deg}
-        loads.add_rotation(load.part, centre=load.centre, **angle, **path)
-    elif load.type == "tangential_support":
-        loads.add_tangential_spring(load.part, float(load.value))
-    else:  # the scene schema admits no other type
-        raise AssertionError(f"unhandled load type {load.type!r}")
+    """Add one scene load to a problem's :class:`~xfem_contact.mechanics.loads.Loads`
+    (its type's row of :data:`~xfem_contact.scenes.load_kinds.LOAD_KINDS`)."""
+    value = None if load.value is None else _value(load.value)
+    LOAD_KINDS[load.type].add(loads, load, value, {"history": load.history})

@@ -20,7 +20,9 @@ def _run(args) -> int:
     the traceback too with ``--debug``), 3 Newton failed (the step and its iterations)."""
     from mpi4py import MPI
 
+    from xfem_contact.io.progress import note
     from xfem_contact.scenes.scene import bundled_scenes, load_scene
+    from xfem_contact.solvers.log_lines import lines_to
     from xfem_contact.solvers.report import SolveError
 
     path = pathlib.Path(args.scene)
@@ -42,12 +44,10 @@ def _run(args) -> int:
         out = pathlib.Path(args.out or f"results/{scene.name}")
         from xfem_contact.scenes.run import run
 
-        summary = run(
-            scene,
-            out,
-            log=None if args.quiet else print,
-            progress_bar=not (args.quiet or args.no_progress),
-        )
+        # the log's lines on stdout, above the progress bar (rank 0)
+        silent = args.quiet or MPI.COMM_WORLD.rank != 0
+        with lines_to(None if silent else note):
+            summary = run(scene, out, progress_bar=not (args.quiet or args.no_progress))
     except SolveError as failure:
         failed(3, str(failure).splitlines()[0])
         say(failure.report.table(), file=sys.stderr)
@@ -88,9 +88,11 @@ def _show(args) -> int:
     """Render a run folder: result.png, von_mises.png, cut.png, pressure.png and, for
     friction laws, traction.png (those with data)."""
     from xfem_contact.io.pictures import render_folder
+    from xfem_contact.solvers.log_lines import lines_to
 
     try:
-        render_folder(args.dir, log=print)
+        with lines_to(print):
+            render_folder(args.dir)
     except FileNotFoundError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2

@@ -3,16 +3,8 @@ form of its value and the stage its history names (:func:`load_spec`)."""
 
 from __future__ import annotations
 
-from xfem_contact.scenes.schema import (
-    FIELDS,
-    LOAD_KEYS,
-    LoadSpec,
-    Number,
-    Scalar,
-    SceneError,
-    Vector,
-    check_table,
-)
+from xfem_contact.scenes.load_kinds import LOAD_KINDS
+from xfem_contact.scenes.schema import FIELDS, LOAD_KEYS, LoadSpec, SceneError, check_table
 
 
 def load_spec(table, where: str, known_parts: set, stages: dict) -> LoadSpec:
@@ -36,7 +28,7 @@ def load_spec(table, where: str, known_parts: set, stages: dict) -> LoadSpec:
     if kind == "rotation" and ("value" in table) == ("angle_deg" in table):
         raise SceneError(f"{where}.value", "give the angle once: value (rad) or angle_deg")
     if "value" in table:
-        _load_value(table["value"], kind, "component" in table, f"{where}.value")
+        LOAD_KINDS[kind].check(table["value"], "component" in table, f"{where}.value")
     history = table.get("history")
     if isinstance(history, str) and history not in stages:
         message = f"{history!r}: no such stage; known: {sorted(stages)}"
@@ -52,24 +44,3 @@ def load_spec(table, where: str, known_parts: set, stages: dict) -> LoadSpec:
         history if isinstance(history, str | None) else tuple(map(tuple, history)),
         table.get("angle_deg"),
     )
-
-
-def _load_value(value, kind: str, component: bool, key: str) -> None:
-    """Check the value of a load: its form (scalar, [vx, vy]) by type, each entry a finite
-    number or an expression (UFL for loads on forms, numpy for interpolated data)."""
-    if kind in ("point_displacement", "rotation"):
-        Number()(value, key)
-    elif kind == "tangential_support":
-        Number(0.0, open=True)(value, key)
-    elif kind == "pressure":
-        Scalar("load")(value, key)
-    elif kind in ("traction", "body_force"):
-        Vector(2, Scalar("load"))(value, key)
-    elif component:
-        Scalar("number")(value, key)
-    elif isinstance(value, list | tuple):
-        Vector(2, Scalar("number"))(value, key)
-    elif isinstance(value, str):
-        raise SceneError(key, "an expression needs component = 0 or 1; for both give [vx, vy]")
-    else:
-        Scalar("number")(value, key)

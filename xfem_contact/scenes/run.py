@@ -3,21 +3,21 @@
 
 from __future__ import annotations
 
+import logging
 import pathlib
-import time
-from collections.abc import Callable
 
 import dolfinx.io
 import dolfinx.mesh
 import numpy as np
 from mpi4py import MPI
 
+from xfem_contact._timers import phase, seconds
 from xfem_contact._version import versions
 from xfem_contact.fem import forms
 from xfem_contact.io.crack_data import EnrichedDisplacements
 from xfem_contact.io.interface_data import sample_status
 from xfem_contact.io.output import write_json
-from xfem_contact.io.progress import note, progress
+from xfem_contact.io.progress import progress
 from xfem_contact.mechanics.loads import load_steps
 from xfem_contact.mechanics.reactions import balance
 from xfem_contact.mechanics.stress import StressFields
@@ -31,6 +31,8 @@ from xfem_contact.scenes.builder import (  # noqa: F401  (re-exported)
 from xfem_contact.scenes.crack_outputs import CrackOutputs
 from xfem_contact.scenes.scene import Scene
 from xfem_contact.solvers.report import NewtonFailure, SolveError
+
+logger = logging.getLogger(__name__)
 
 
 class Result:
@@ -78,19 +80,16 @@ def _stress_fields(problem, fields: list) -> StressFields:
     return StressFields(sides, problem.kinematics)
 
 
-def solve_step(
-    problem, petsc_options: dict | None = None, log: Callable[[str], None] | None = None
-) -> tuple[dolfinx.fem.Function, int, dict]:
+def solve_step(problem) -> tuple[dolfinx.fem.Function, int, dict]:
     """Solve a problem at its current time and accept the step: (solution, iterations,
     status).
 
-    Contact problems run Newton from the previous step (a ``log`` line per
-    iterate); linear ones solve once. ``petsc_options`` override the solver's
-    defaults. Raises
+    Contact problems run Newton from the previous step (a log record per
+    iterate); linear ones solve once, with the problem's options. Raises
     :class:`~xfem_contact.solvers.newton.NewtonFailure` with the iteration
     history when Newton fails.
     """
-    report = problem.solve(petsc_options=petsc_options, log=log)
+    report = problem.solve()
     problem.accept_step()
     return problem.w, report.iterations or 1, report.status[-1] if report.status else {}
 
@@ -98,15 +97,16 @@ def solve_step(
 def run(
     scene: Scene,
     out: str | pathlib.Path | None = None,
-    log: Callable[[str], None] | None = print,
     comm: MPI.Comm = MPI.COMM_WORLD,
     progress_bar: bool = True,
 ) -> dict:
     """Build, solve and summarise a scene. Collective.
 
     The pseudo-time runs to ``scene.end_time`` (default: the loads' last time, at
-    least 1) in ``scene.load_steps`` equal steps, each load following its path (a line
-    per step and per Newton iterate goes to ``log``; ``None`` for silence), with a progress bar over
+    least 1) in ``scene.load_steps`` equal steps, each load following its path (an INFO
+    record per step on this module's logger on rank 0, per Newton iterate on the
+    solver's: shown where a handler is installed, see
+    :func:`~xfem_contact.solvers.log_lines.lines_to`), with a progress bar over
     the steps when there are several and ``progress_bar`` is true
     (:func:`xfem_contact.io.progress.progress`). With ``out``, the
     fields of every step go to VTX files (``displacement.bp``, ``multiplier.bp``,
@@ -128,16 +128,14 @@ def run(
         its lips and K at the last step (``cracks``, see
         :class:`~xfem_contact.scenes.crack_outputs.CrackOutputs`).
     """
-    if log is print:  # printed lines go above the progress bar, not through it
-        log = note
-    say = log if (log and comm.rank == 0) else (lambda *a: None)
+    say = logger.info if comm.rank == 0 else (lambda *a: None)
     out = None if out is None else pathlib.Path(out)
     if out is not None and comm.rank == 0:  # a summary.json is a finished run's
         (out / "summary.json").unlink(missing_ok=True)
     compiled_before = forms.compiled_forms()
-    start = time.perf_counter()
+    total, timer = phase("scene run"), phase("scene build")
     problem, effects = build(scene, comm)
-    build_time = time.perf_counter() - start
+    build_time = seconds(timer)
     say(f"scene {scene.name}: effects {effects}")
     cracks = CrackOutputs(problem, scene) if scene.cracks else None
     result = Result(problem)
@@ -147,15 +145,13 @@ def run(
     steps, iterations, residuals, status = load_steps(scene.load_steps, end_time), [], [], {}
     pairing, records, tips = [], [], None
     forces_time = output_time = 0.0
-    solve_start = time.perf_counter()
+    solving = phase("scene load steps")
     try:
         bar = progress(steps, f"{scene.name}: load steps", progress_bar and len(steps) > 1, comm)
         for k, t in enumerate(bar, start=1):
             problem.loads.set_time(t)
             try:
-                solution, its, status = solve_step(
-                    problem, scene.petsc_options or None, say if log else None
-                )
+                solution, its, status = solve_step(problem)
             except SolveError as failure:
                 newton = isinstance(failure, NewtonFailure)
                 solver = "Newton failed (SNES" if newton else "the linear solve failed (KSP"
@@ -183,21 +179,21 @@ def run(
                 }
             result.update(solution)
             record = {"step": k, "time": float(t), "iterations": its, "status": status}
-            forces_start = time.perf_counter()  # reactions, interface resultants (N/m)
+            timer = phase("scene forces")  # reactions, interface resultants (N/m)
             record["forces"] = balance(problem, problem.w)
-            forces_time += time.perf_counter() - forces_start
+            forces_time += seconds(timer)
             if problem.laws:
                 record["interfaces"] = status_counts(problem)
             if cracks is not None:
                 tips = cracks.tips()
                 record["cracks"] = cracks.per_crack(tips)
             records.append(record)
-            output_start = time.perf_counter()
+            timer = phase("scene output")
             for writer in series:
                 writer.write(float(t))
             if grids is not None:
                 grids.write(float(t))
-            output_time += time.perf_counter() - output_start
+            output_time += seconds(timer)
             say(
                 f"load step {k}/{len(steps)} (time {t:.4g}): {its} iteration(s)"
                 + "".join(f", {key} {value}" for key, value in status.items())
@@ -205,7 +201,7 @@ def run(
     finally:
         for writer in series:
             writer.close()
-    solve_time = time.perf_counter() - solve_start - forces_time - output_time
+    solve_time = seconds(solving) - forces_time - output_time
     summary = {
         "scene": scene.name,
         "effects": effects,
@@ -224,7 +220,7 @@ def run(
     if pairing:
         summary["pairing"] = pairing
     if problem.laws:
-        samples = {name: problem.interface_samples(name) for name in problem.laws}
+        samples = {name: problem.interface_samples(problem.w, name) for name in problem.laws}
         for name, sampled in samples.items():  # 0 open, 1 stick, 2 slip
             sampled["status"] = sample_status(problem, name)
         summary["interfaces"] = {
@@ -251,10 +247,10 @@ def run(
         "forces": forces_time,
     }
     if out is not None:
-        output_start = time.perf_counter()
+        timer = phase("scene output")
         grids.write_last()
-        timings["output"] = output_time + time.perf_counter() - output_start
-    summary["timings"] = timings | {"total": time.perf_counter() - start}
+        timings["output"] = output_time + seconds(timer)
+    summary["timings"] = timings | {"total": seconds(total)}
     if out is not None:
         comm.barrier()  # every rank's files are on disk before rank 0 renders them
     if out is not None and comm.rank == 0:
@@ -262,7 +258,7 @@ def run(
         if scene.outputs["png"]:
             from xfem_contact.io.pictures import render_folder
 
-            render_folder(out, log=say)
+            render_folder(out)
     say(
         f"done in {summary['timings']['total']:.2f} s: dofs {summary['dofs']}, "
         f"iterations {summary['iterations_per_step']}"

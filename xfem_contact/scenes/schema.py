@@ -30,6 +30,7 @@ from xfem_contact.scenes.checks import (  # noqa: F401  (re-exported)
     petsc_table,
     stages_table,
 )
+from xfem_contact.scenes.load_kinds import LOAD_KINDS
 from xfem_contact.scenes.records import CrackSpec, InterfaceSpec, LoadSpec, Scene  # noqa: F401
 from xfem_contact.solvers.options import LINEAR_PRESETS, defaults
 
@@ -37,15 +38,7 @@ _NEWTON = defaults("newton")  # the [solver] defaults are the Newton solver's
 
 LAWS = LINEAR_LAWS + CONTACT_LAWS
 SHAPES = ("circle", "ellipse", "line", "half-plane", "expression")
-LOAD_TYPES = (
-    "pressure",
-    "traction",
-    "displacement",
-    "point_displacement",
-    "body_force",
-    "rotation",
-    "tangential_support",
-)
+LOAD_TYPES = tuple(LOAD_KINDS)
 KINEMATICS = ("small", "large")
 CELLS = ("quadrilateral", "triangle")
 MESH_KINDS = ("rectangle", "annulus", "gmsh")
@@ -83,15 +76,7 @@ CRACK_SHAPE_KEYS = {
 #: (:func:`~xfem_contact.fem.tip_scale.tip_lengths`: ``a`` for a crack of length ``2a``)
 CRACK_RINGS = ((0.2, 0.6), (0.3, 0.8))
 #: The keys of each load type besides ``type``: (required, optional)
-LOAD_KEYS = {
-    "pressure": (("part", "value"), ("side", "history")),
-    "traction": (("part", "value"), ("side", "history")),
-    "displacement": (("part", "value"), ("component", "history")),
-    "point_displacement": (("point", "component", "value"), ("history",)),
-    "body_force": (("value",), ("side", "history")),
-    "rotation": (("part",), ("value", "angle_deg", "centre", "history")),
-    "tangential_support": (("part", "value"), ()),
-}
+LOAD_KEYS = {name: (kind.required, kind.optional) for name, kind in LOAD_KINDS.items()}
 
 
 _POSITIVE = Number(0.0, open=True)

@@ -26,8 +26,9 @@ O(N) unknowns and the coarse level a quarter of the displacements'; the copies m
 are the band's rows, the multipliers' rows ``B`` and the coarse level.
 
 Sub-solver options live under the PC's prefix plus ``bmg_u_`` (the PCMG, or GAMG for
-degree 1) and ``bmg_band_`` (the band's LU); :data:`U_OPTIONS` and
-:data:`BAND_OPTIONS` are the defaults, which options in the database override.
+degree 1) and ``bmg_band_`` (the band's LU); the rows ``band_u``, ``band_u_degree1`` and
+``band`` of :data:`~xfem_contact.solvers.options.PRESETS` are the defaults, which options
+in the database override.
 """
 
 from __future__ import annotations
@@ -35,34 +36,8 @@ from __future__ import annotations
 import numpy as np
 from petsc4py import PETSc
 
-from xfem_contact.solvers.options import OptionValue
+from xfem_contact.solvers.options import PRESETS
 from xfem_contact.solvers.scaling import gather
-
-#: Defaults of the displacement solve, degree 2 (PCMG, 2 levels, interpolation set here)
-U_OPTIONS: dict[str, OptionValue] = {
-    "ksp_type": "preonly",
-    "mg_levels_ksp_type": "chebyshev",
-    "mg_levels_pc_type": "jacobi",
-    "mg_levels_ksp_max_it": 2,
-    "mg_levels_esteig_ksp_type": "cg",  # GMRES's basis would stay allocated
-    "mg_coarse_ksp_type": "richardson",
-    "mg_coarse_ksp_max_it": 3,
-    "mg_coarse_pc_type": "gamg",
-}
-#: Defaults of the displacement solve, degree 1 (algebraic multigrid)
-U_OPTIONS_DEGREE1: dict[str, OptionValue] = {
-    "ksp_type": "preonly",
-    "pc_type": "gamg",
-    "mg_levels_pc_type": "sor",
-    "mg_levels_ksp_max_it": 2,
-}
-#: Defaults of the band solve
-BAND_OPTIONS: dict[str, OptionValue] = {
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-    "mat_mumps_icntl_7": 4,
-}
 
 
 class BandMultigrid:
@@ -109,11 +84,11 @@ class BandMultigrid:
         if self.u is None:
             raise RuntimeError("BandMultigrid: configure() was not called before the solve")
         J = pc.getOperators()[1]
-        prefix = (pc.getOptionsPrefix() or "") + "bmg_"
+        prefix = pc.getOptionsPrefix() or ""
         self.reset(pc)  # the blocks, the augmented block and its coarse level afresh
         self._build(J, prefix)
-        for ksp, options in ((self.ksp_band, BAND_OPTIONS), (self.ksp_u, self.u_options)):
-            with _defaults(ksp.getOptionsPrefix(), options):
+        for ksp, row in ((self.ksp_band, PRESETS["band"]), (self.ksp_u, self.u_preset)):
+            with _defaults(ksp.getOptionsPrefix(), row.options):
                 ksp.setFromOptions()
                 ksp.setUp()
 
@@ -167,16 +142,16 @@ class BandMultigrid:
         self.J_b = J.createSubMatrix(self.band, self.all_columns)
         self.r_b, self.x_b = self.J_bb.createVecLeft(), self.J_bb.createVecRight()
         self.ksp_band = PETSc.KSP().create(comm)
-        self.ksp_band.setOptionsPrefix(prefix + "band_")
+        self.ksp_band.setOptionsPrefix(prefix + PRESETS["band"].prefix)
         self.ksp_band.setOperators(self.J_bb)
         self.ksp_u = PETSc.KSP().create(comm)
-        self.ksp_u.setOptionsPrefix(prefix + "u_")
+        self.ksp_u.setOptionsPrefix(prefix + PRESETS["band_u"].prefix)
         space = PETSc.NullSpace().create(vectors=self._modes, comm=comm)
         self.P = self.A_c = None
         self._objects = [self.all_columns, multipliers, self.B, self.J_bb, self.J_b]
         self._objects += [self.r_b, self.x_b, self.ksp_band, self.ksp_u, space]
         if not self._degree2:  # degree 1: GAMG on the augmented block
-            self.u_options = U_OPTIONS_DEGREE1
+            self.u_preset = PRESETS["band_u_degree1"]
             self.A = J.createSubMatrix(self.u, self.u)
             self.A.axpy(1.0, _gram(self.B), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             self.A.setBlockSize(2)
@@ -184,7 +159,7 @@ class BandMultigrid:
             self.ksp_u.setOperators(self.A)
             self._objects.append(self.A)
         else:  # degree 2: J's block itself (no copy) smoothed, the coarse level augmented
-            self.u_options = U_OPTIONS
+            self.u_preset = PRESETS["band_u"]
             if self._prolongations is None:  # the pattern of J does not change them
                 self._prolongations = _prolongation(J, self.u, *self._interpolation)
                 self._interpolation = None

@@ -39,13 +39,10 @@ from petsc4py import PETSc
 
 from xfem_contact.fem.branch import branch_values
 from xfem_contact.fem.enrichment import EnrichedSpace
-from xfem_contact.solvers.options import CRACK_OPTIONS
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.symmetry import TOLERANCE, mark_symmetric, symmetry_gap
 
 REFINEMENTS = 1
-#: The preconditioners that read the diagonal scaling (no change of unknowns then)
-SPLIT_PRECONDITIONERS = ("fieldsplit", "python")
 #: Eigenvalues of a node's scaled block below this fraction of its largest are raised
 #: to it (kept: the space is never changed)
 FLOOR = 1e-14
@@ -59,14 +56,6 @@ def tip_transform(
     if off or space.branch_field is None:
         return None
     return functools.partial(tip_scaling, space)
-
-
-def crack_options(space: EnrichedSpace, options: dict, couplings: bool) -> dict:
-    """The options a crack's solver adds under ``options``:
-    :data:`~xfem_contact.solvers.options.CRACK_OPTIONS` when it does without the change of
-    unknowns (a split preconditioner, or ``couplings``), else none. Not collective."""
-    split = options.get("pc_type") in SPLIT_PRECONDITIONERS
-    return CRACK_OPTIONS if space.branch_field is not None and (split or couplings) else {}
 
 
 def tip_scaling(space: EnrichedSpace, R: PETSc.Mat, J: PETSc.Mat) -> PETSc.Mat:

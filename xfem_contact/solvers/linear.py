@@ -19,18 +19,8 @@ from petsc4py import PETSc
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.restriction import restriction_matrix
 from xfem_contact.solvers.assembly import ReducedMatrix
-from xfem_contact.solvers.block_scaling import (
-    crack_options,
-    refined,
-    scaled,
-    tip_transform,
-)
-from xfem_contact.solvers.options import (
-    applied_options,
-    merged_options,
-    reused_lu,
-    unique_prefix,
-)
+from xfem_contact.solvers.block_scaling import refined, scaled, tip_transform
+from xfem_contact.solvers.options import applied_options, checked_prefix, merged_options
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.symmetry import mark_symmetric
@@ -79,7 +69,7 @@ def solve_restricted(
     bcs: list[dolfinx.fem.DirichletBC],
     space: EnrichedSpace,
     petsc_options: dict | None = None,
-    petsc_options_prefix: str = "xfem_linear_",
+    petsc_options_prefix: str | None = None,
     R: PETSc.Mat | None = None,
     residuals: list[float] | None = None,
     tip_scaling: bool = True,
@@ -95,8 +85,8 @@ def solve_restricted(
         space: The enriched space; the solution lives on ``space.W``.
         petsc_options: PETSc options (without prefix) overriding the ``"linear"``
             defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
-        petsc_options_prefix: Base of the KSP's options prefix (made unique per solve;
-            the options are removed from the PETSc database after use).
+        petsc_options_prefix: The KSP's options prefix; ``None``: a unique one. The
+            options are in the PETSc database only during the solve.
         R: Restriction operator, global shape ``(dim W, n_reduced)``; by default
             ``restriction_matrix(space)`` (the active dofs), built and destroyed
             here. A given ``R`` is not destroyed.
@@ -141,7 +131,7 @@ def solve_restricted(
         ksp = PETSc.KSP().create(A.getComm())
         owned.append(ksp)
         ksp.setOperators(A)
-        prefix = unique_prefix(petsc_options_prefix)
+        prefix = checked_prefix(petsc_options_prefix, "xfem_linear_")
         ksp.setOptionsPrefix(prefix)
         options = merged_options("linear", petsc_options)
         if options.get("pc_type") == "cholesky":
@@ -179,11 +169,3 @@ def solve_restricted(
     finally:
         for obj in {id(o): o for o in owned}.values():
             obj.destroy()
-
-
-def added_options(space: EnrichedSpace, options: dict, couplings: bool) -> dict:
-    """The options a problem's solver adds under its ``options``: a crack's
-    (:func:`~xfem_contact.solvers.block_scaling.crack_options`) and, with ``couplings``
-    (large sliding), the reused LU (:func:`~xfem_contact.solvers.options.reused_lu`).
-    Not collective."""
-    return {**crack_options(space, options, couplings), **reused_lu(options, couplings)}

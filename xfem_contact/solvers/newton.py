@@ -4,14 +4,14 @@ Residual and Jacobian are assembled with Dirichlet conditions (as
 :class:`dolfinx.fem.petsc.NonlinearProblem` does) and reduced: ``F_r = R^T F(R y)``,
 ``J_r = R^T J R`` (straight into the reduced numbering,
 :mod:`xfem_contact.solvers.assembly`), the same restriction as the linear solves of
-:mod:`xfem_contact.solvers.linear`. Every iterate is logged
-(residual norm and, through a callback, e.g. the contact status); failure raises
+:mod:`xfem_contact.solvers.linear`. Every iterate is logged (INFO on this module's
+logger: residual norm and, through a callback, e.g. the contact status); failure raises
 with the whole history. Default options: :mod:`xfem_contact.solvers.options`.
 """
 
 from __future__ import annotations
 
-import time
+import logging
 import weakref
 from collections.abc import Callable
 
@@ -22,6 +22,7 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.forms import form_parts
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
 from xfem_contact.solvers.block_scaling import TipFactor
@@ -29,13 +30,15 @@ from xfem_contact.solvers.jacobian import JacobianForms
 from xfem_contact.solvers.options import (
     REFACTOR_AFTER,
     applied_options,
+    checked_prefix,
     merged_options,
-    unique_prefix,
 )
 from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.split_sets import split_sets
 from xfem_contact.solvers.symmetry import mark_symmetric
+
+logger = logging.getLogger(__name__)
 
 
 class RestrictedNewton:
@@ -45,16 +48,16 @@ class RestrictedNewton:
     ``R^T J R`` (:class:`~xfem_contact.solvers.assembly.ReducedMatrix`), assembles the
     Jacobian once for the scaling ``D`` of :mod:`xfem_contact.solvers.scaling` (the
     first iterate reuses it when it sits at the same state), and creates the SNES
-    under a unique options prefix, removing its options from the PETSc database
+    under its options prefix, removing its options from the PETSc database
     afterwards). SNES iterates on the scaled unknowns ``y`` with ``w = R D y``, so the
     residual norms it reports are those of ``D R^T F``. Each :meth:`solve` starts from
     the current ``w`` (projected on the range of ``R D``) and checks the final residual
     against the tolerances. With ``pc_type = "cholesky"`` every Jacobian is checked to
     be symmetric first (:func:`~xfem_contact.solvers.symmetry.mark_symmetric`). A
-    Krylov method over a factorisation (``pc_type`` lu or cholesky, e.g.
-    :data:`~xfem_contact.solvers.options.REUSED_LU_OPTIONS`) keeps the factorisation of
-    an earlier iterate of the same solve: it refactors at the first iterate, when the
-    pattern grows, and after a linear solve that failed or took more than
+    Krylov method over a factorisation (``pc_type`` lu or cholesky, e.g. the preset
+    ``reused_lu`` of :data:`~xfem_contact.solvers.options.PRESETS`) keeps the
+    factorisation of an earlier iterate of the same solve: it refactors at the first
+    iterate, when the pattern grows, and after a linear solve that failed or took more than
     :data:`~xfem_contact.solvers.options.REFACTOR_AFTER` iterations; such a failed
     linear solve does not end the Newton solve (its step is taken as it is, the final
     residual check stands).
@@ -69,12 +72,12 @@ class RestrictedNewton:
             the solver keeps its own scaled copy ``R D`` (:attr:`R`).
         petsc_options: PETSc options (without prefix) overriding the ``"newton"``
             defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
-        petsc_options_prefix: Prefix of the SNES options in the PETSc options database.
+        petsc_options_prefix: Options prefix of the SNES (and its KSP and PC); ``None``:
+            a unique one.
         status: Called with ``w`` at every iterate, on every process; returns a
             dict shown in the log.
-        log: Called with each log line (e.g. ``print``); ``None`` for silence.
         splits: For a ``fieldsplit`` preconditioner, or the band multigrid of the
-            ``"iterative"`` preset of :data:`~xfem_contact.solvers.options.LINEAR_PRESETS`
+            ``"iterative"`` preset of :data:`~xfem_contact.solvers.options.PRESETS`
             (which reads ``"u"`` and ``"band"``): split name to the
             local dofs of ``W`` it holds: shape ``(n,)``, the reduced unknowns touching
             them; or ``(n, bs)``, blocks of dofs that are reduced unknowns themselves
@@ -111,9 +114,8 @@ class RestrictedNewton:
         bcs: list,
         R: PETSc.Mat,
         petsc_options: dict | None = None,
-        petsc_options_prefix: str = "xfem_newton_",
+        petsc_options_prefix: str | None = None,
         status: Callable[[dolfinx.fem.Function], dict] | None = None,
-        log: Callable[[str], None] | None = None,
         splits: dict[str, np.ndarray] | None = None,
         near_nullspace: list[dolfinx.fem.Function] | None = None,
         couplings: list | None = None,
@@ -123,22 +125,22 @@ class RestrictedNewton:
     ):
         self.w, self.bcs, self.R = w, bcs, R
         self.couplings = list(couplings or [])
-        start = time.perf_counter()
+        timer = phase("Newton set-up: selection")
         chosen = selection(R, w.function_space)
-        selecting = time.perf_counter() - start
-        start = time.perf_counter()
+        selecting = seconds(timer)
+        timer = phase("Newton set-up: forms")
         self.F = form_parts(residual)  # the residual: standard and runtime integrals apart
         #: The Jacobian's forms (the uncut cells' field blocks apart when possible)
         self.jacobian_forms = JacobianForms(residual, w, None if chosen is None else field_space)
         self.J = self.jacobian_forms.rest
         #: Wall time (s) of the set-up steps: forms (JIT included on a cold cache),
         #: sparsity, first Jacobian, scaling
-        self.timings = {"forms": time.perf_counter() - start}
+        self.timings = {"forms": seconds(timer)}
         self.b = dolfinx.fem.petsc.create_vector(self.F[0].function_spaces[0])
         self.y = R.createVecRight()
         self.F_r = R.createVecRight()
-        self.status, self.log = status, log
-        start = time.perf_counter()
+        self.status = status
+        timer = phase("Newton set-up: sparsity")
         self.jacobian = ReducedMatrix(
             self.J,
             bcs,
@@ -147,7 +149,7 @@ class RestrictedNewton:
             field_blocks=self.jacobian_forms.blocks,
             chosen=chosen,
         )
-        self.timings["sparsity"] = time.perf_counter() - start + selecting
+        self.timings["sparsity"] = seconds(timer) + selecting
         if self.couplings and not self.jacobian.direct:
             raise ValueError(
                 "Couplings assembled outside UFL (large sliding) need a restriction that "
@@ -157,14 +159,14 @@ class RestrictedNewton:
             coupling.bind(self.jacobian.selection.columns, bcs)
         # Solve for y_s with x = R D y_s, D the scaling of the first Jacobian (well
         # scaled saddle points: see xfem_contact.solvers.scaling); J_r = D R^T J R D
-        start = time.perf_counter()
+        timer = phase("Newton set-up: first Jacobian")
         self.J_r = self.jacobian.assemble()
-        self.timings["jacobian"] = time.perf_counter() - start
-        start = time.perf_counter()
+        self.timings["jacobian"] = seconds(timer)
+        timer = phase("Newton set-up: scaling")
         self.D = saddle_point_scaling(self.J_r)
         Z = None if transform is None else transform(R, self.J_r)
         self.J_r.diagonalScale(self.D, self.D)
-        self.timings["scaling"] = time.perf_counter() - start
+        self.timings["scaling"] = seconds(timer)
         #: The PETSc options (without prefix) of this solver's SNES, KSP and PC
         self.options = merged_options("newton", petsc_options)
         self._symmetric = self.options.get("pc_type") == "cholesky"
@@ -180,7 +182,7 @@ class RestrictedNewton:
         self.snes = PETSc.SNES().create(R.getComm())
         # Options live in the PETSc database only while PETSc may read them (here and
         # during each solve, when the factorisation reads e.g. mat_mumps_* options)
-        self._prefix = unique_prefix(petsc_options_prefix)
+        self._prefix = checked_prefix(petsc_options_prefix, "xfem_newton_")
         self.snes.setOptionsPrefix(self._prefix)
         with applied_options(self._prefix, self.options):
             self.snes.setFromOptions()
@@ -220,7 +222,7 @@ class RestrictedNewton:
         self.w.x.scatter_forward()
 
     def _residual(self, snes, y, F_r):
-        start = time.perf_counter()
+        timer = phase("Newton assembly")
         self._update(y)
         x = self.w.x.petsc_vec
         with self.b.localForm() as local:
@@ -233,10 +235,10 @@ class RestrictedNewton:
             coupling.add_residual(self.w, self.b)
         dolfinx.fem.petsc.set_bc(self.b, self.bcs, x, -1.0)
         self.R.multTranspose(self.b, F_r)
-        self.report.assembly_time += time.perf_counter() - start
+        self.report.assembly_time += seconds(timer)
 
     def _jacobian(self, snes, y, J_r, P_r):
-        start = time.perf_counter()
+        timer = phase("Newton assembly")
         self._update(y)
         x, at, self._assembled_at = self.w.x.array, self._assembled_at, None
         if at is None or not _same_state(x, at, self.R.getComm().tompi4py()):
@@ -252,7 +254,7 @@ class RestrictedNewton:
                 J_r.copy(P_r, _DIFFERENT if grown else _SAME)
                 if self._symmetric:
                     mark_symmetric(P_r)
-        self.report.assembly_time += time.perf_counter() - start
+        self.report.assembly_time += seconds(timer)
 
     def _refactor(self, snes) -> bool:
         """Whether the preconditioner takes the Jacobian of this iterate: at the first
@@ -275,18 +277,18 @@ class RestrictedNewton:
             self.snes.getKSP().getPC().reset()
 
     def _monitor(self, snes, it, norm):
-        start = time.perf_counter()
+        timer = phase("Newton interface status")
         if it > 0:
             self.report.linear_iterations.append(snes.getKSP().getIterationNumber())
         self.report.residuals.append(float(norm))
         status = self.status(self.w) if self.status else {}
         self.report.status.append(status)
-        self.report.status_time += time.perf_counter() - start
-        if self.log:
+        self.report.status_time += seconds(timer)
+        if logger.isEnabledFor(logging.INFO):
             krylov = ""
             if it > 0 and snes.getKSP().getType() != PETSc.KSP.Type.PREONLY:
                 krylov = f"  ({self.report.linear_iterations[-1]} Krylov iterations)"
-            self.log(
+            logger.info(
                 f"  Newton {it:2d}: |F| = {norm:.3e}  "
                 + "  ".join(f"{k} {v}" for k, v in status.items())
                 + krylov
@@ -323,7 +325,7 @@ class RestrictedNewton:
             NewtonFailure: SNES did not converge (reason <= 0); it holds the history.
         """
         self.report = NewtonReport()
-        start = time.perf_counter()
+        timer = phase("Newton solve")
         self._start_from_w()
         self.jacobian.keep_constant_blocks()  # the uncut cells' linear bulk: once a solve
         for coupling in self.couplings:
@@ -335,7 +337,7 @@ class RestrictedNewton:
                 if isinstance(error.__cause__, ValueError):  # Jacobian for LDL^T) is clearer
                     raise error.__cause__ from None
                 raise
-        self.report.total_time = time.perf_counter() - start
+        self.report.total_time = seconds(timer)
         self._update(self.y)
         self.report.reason = self.snes.getConvergedReason()
         if self.report.reason <= 0:

@@ -1,4 +1,4 @@
-"""Default PETSc options of the solvers, in one table.
+"""The PETSc options of the package's solvers: defaults and presets, in two tables.
 
 :data:`SOLVER_OPTIONS` is declarative, in the style of ``ffcx/options.py``: each
 entry maps a PETSc option name (without prefix) to its type, default value, a
@@ -9,8 +9,15 @@ solvers it is a default of:
 - ``"newton"``: the SNES of :class:`xfem_contact.solvers.newton.RestrictedNewton`
   (its KSP options are those of the linear solve in every Newton step).
 
-Options given by the caller override these defaults and are passed to PETSc
-unchecked, as are any other PETSc options of the same prefix.
+:data:`PRESETS` holds every other set of options the package uses, one row each with
+what selects it: the linear-solver choices, the rows a problem adds under the user's
+options (:func:`problem_options`), the plain problems' and the sub-solvers'. No other
+module writes options of its own.
+
+A problem takes its PETSc options and options prefix at construction, as DOLFINx's
+``LinearProblem`` and ``NonlinearProblem`` do; the user's options override the
+defaults and presets and are passed to PETSc unchecked, as are any other PETSc options
+of the same prefix.
 """
 
 from __future__ import annotations
@@ -92,74 +99,200 @@ SOLVER_OPTIONS: dict[str, Option] = {
 }
 
 
-#: Options added under a problem's own for a cut with a crack whose solver does without
-#: the tip enrichment's change of unknowns (:mod:`xfem_contact.solvers.block_scaling`:
-#: a split preconditioner, or large-sliding couplings): the geometric tip enrichment's
-#: branch functions are then nearly dependent on the polynomials far from the tip, and
-#: MUMPS's delayed pivots outgrow its default workspace (INFO(1) = -9, KSP reason -11,
-#: P1 and P2 at n = 128 in the Williams case): 100 % more workspace. With the change
-#: of unknowns (the direct solves) the default workspace suffices.
-CRACK_OPTIONS: dict[str, OptionValue] = {"mat_mumps_icntl_14": 100}
-
-
-#: Options added under a problem's own when its Jacobian is factored by LU and changes
-#: little from one Newton iterate to the next (large sliding): GMRES preconditioned by
-#: the LU of an earlier iterate of the same solve, refactored only when GMRES needs more
-#: than :data:`REFACTOR_AFTER` iterations
-#: (:class:`~xfem_contact.solvers.newton.RestrictedNewton`). A tolerance far below
-#: Newton's keeps the steps those of the exact Jacobian.
-REUSED_LU_OPTIONS: dict[str, OptionValue] = {
-    "ksp_type": "gmres",
-    "ksp_gmres_restart": 100,
-    "ksp_rtol": 1e-12,
-    "ksp_atol": 1e-30,
-    "ksp_max_it": 100,
-}
-
 #: A Krylov method over a factorisation (``pc_type`` lu or cholesky) keeps the
 #: factorisation across the iterates of a Newton solve while it converges within this
 #: many iterations
 REFACTOR_AFTER = 20
 
-
-def reused_lu(options: dict, couplings: bool) -> dict:
-    """:data:`REUSED_LU_OPTIONS` for a problem with ``couplings`` (large sliding) whose
-    ``options`` choose neither a Krylov method nor a preconditioner; else none. Not
-    collective."""
-    chosen = "ksp_type" in options or options.get("pc_type", "lu") != "lu"
-    return {} if chosen or not couplings else dict(REUSED_LU_OPTIONS)
+#: The preconditioners that take the fields apart (a field split, the band multigrid):
+#: they read the diagonal scaling, so a crack's solve does without the change of unknowns
+SPLIT_PRECONDITIONERS = ("fieldsplit", "python")
 
 
-#: Linear-solver presets of the Newton steps (``--solver`` of the demo, ``[solver] linear``
-#: of a scene): option name (without prefix) to value, merged over the defaults. The
-#: iterative one is GMRES(10) preconditioned by
-#: :class:`~xfem_contact.solvers.band_multigrid.BandMultigrid`: an exact solve on the
-#: band of the interface (cut cells, their neighbours, the multipliers) after a
-#: two-level p-multigrid V-cycle on the displacements (iteration counts:
-#: ``bench/iterative.py``).
-LINEAR_PRESETS: dict[str, dict[str, OptionValue]] = {
-    "direct": {},
-    "iterative": {
-        "ksp_type": "gmres",
-        "ksp_gmres_restart": 10,  # a short basis: its W-sized vectors are memory
-        "ksp_rtol": 1e-12,
-        "ksp_atol": 1e-30,
-        "ksp_max_it": 500,
-        "pc_type": "python",
-        "pc_python_type": "xfem_contact.solvers.band_multigrid.BandMultigrid",
-    },
+def splits_fields(options: dict) -> bool:
+    """Whether ``options`` choose a preconditioner of :data:`SPLIT_PRECONDITIONERS`.
+    Not collective."""
+    return options.get("pc_type") in SPLIT_PRECONDITIONERS
+
+
+class Facts(typing.NamedTuple):
+    """What a problem knows of itself when its options are chosen (:func:`problem_options`).
+
+    Attributes:
+        options: The options the user gave (names without prefix).
+        symmetric: The Jacobian is symmetric (``Problem.symmetric``).
+        crack_tip: The space has a crack's tip enrichment.
+        couplings: The problem has terms coupling two cells (large sliding).
+    """
+
+    options: dict
+    symmetric: bool = False
+    crack_tip: bool = False
+    couplings: bool = False
+
+
+class Preset(typing.NamedTuple):
+    """One row of :data:`PRESETS`: a set of PETSc options and what selects it.
+
+    Attributes:
+        options: Option name (without prefix) to value.
+        selected_by: What selects the row, in words.
+        help: What the options do.
+        applies: For the rows a problem adds itself: whether the row applies, given the
+            problem's :class:`Facts`; ``None`` for the rows selected by name.
+        prefix: For a sub-solver's defaults: the prefix under the solver's own that they
+            are written at (options in the PETSc database win over them).
+    """
+
+    options: dict[str, OptionValue]
+    selected_by: str
+    help: str
+    applies: typing.Callable[[Facts], bool] | None = None
+    prefix: str = ""
+
+
+def _reuses_lu(facts: Facts) -> bool:
+    chosen = "ksp_type" in facts.options or facts.options.get("pc_type", "lu") != "lu"
+    return facts.couplings and not chosen
+
+
+#: Every preset of the package's solvers: the linear-solver choices (``--solver`` of the
+#: demo, ``[solver] linear`` of a scene), the rows a problem adds under the user's options
+#: (``applies``), the plain problems' and the band multigrid's sub-solvers'. No other
+#: module writes PETSc options of its own.
+PRESETS: dict[str, Preset] = {
+    "direct": Preset(
+        {}, "the linear-solver choice 'direct' (the default)", "MUMPS LU (the defaults)"
+    ),
+    "iterative": Preset(
+        {
+            "ksp_type": "gmres",
+            "ksp_gmres_restart": 10,  # a short basis: its W-sized vectors are memory
+            "ksp_rtol": 1e-12,
+            "ksp_atol": 1e-30,
+            "ksp_max_it": 500,
+            "pc_type": "python",
+            "pc_python_type": "xfem_contact.solvers.band_multigrid.BandMultigrid",
+        },
+        "the linear-solver choice 'iterative' (contact problems)",
+        "GMRES(10) preconditioned by the band multigrid "
+        "(xfem_contact.solvers.band_multigrid): an exact solve on the band of the "
+        "interface (cut cells, their neighbours, the multipliers) after a two-level "
+        "p-multigrid V-cycle on the displacements",
+    ),
+    "symmetric": Preset(
+        {"pc_type": "cholesky"},
+        "a symmetric Jacobian (sticking, frictionless, bonded; small kinematics) and no "
+        "pc_type given",
+        "MUMPS LDL^T: about half the factor entries and flops of the LU "
+        "(xfem_contact.solvers.symmetry checks every matrix first)",
+        lambda facts: facts.symmetric and "pc_type" not in facts.options,
+    ),
+    "crack": Preset(
+        {"mat_mumps_icntl_14": 100},
+        "a crack's tip enrichment without the change of unknowns "
+        "(xfem_contact.solvers.block_scaling): a split preconditioner, or large sliding",
+        "100 % more MUMPS workspace: the branch functions are then nearly dependent on the "
+        "polynomials far from the tip and the delayed pivots outgrow the default workspace "
+        "(INFO(1) = -9)",
+        lambda facts: facts.crack_tip and (splits_fields(facts.options) or facts.couplings),
+    ),
+    "reused_lu": Preset(
+        {
+            "ksp_type": "gmres",
+            "ksp_gmres_restart": 100,
+            "ksp_rtol": 1e-12,
+            "ksp_atol": 1e-30,
+            "ksp_max_it": 100,
+        },
+        "large sliding (couplings) with neither a ksp_type nor a pc_type other than lu given",
+        "GMRES preconditioned by the LU of an earlier iterate of the same Newton solve, "
+        "refactored when GMRES needs more than REFACTOR_AFTER iterations; the tolerance "
+        "far below Newton's keeps the steps those of the exact Jacobian",
+        _reuses_lu,
+    ),
+    "plain": Preset(
+        {"ksp_type": "preonly", "pc_type": "lu"},
+        "PlainElasticityProblem (a scene without interfaces), under the user's options",
+        "PETSc's LU of the uncut elasticity matrix",
+    ),
+    "fitted": Preset(
+        {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"},
+        "the body-fitted Nitsche reference (xfem_contact.cases.fitted_nitsche)",
+        "MUMPS LU of the two bodies' block system",
+    ),
+    "band_u": Preset(
+        {
+            "ksp_type": "preonly",
+            "mg_levels_ksp_type": "chebyshev",
+            "mg_levels_pc_type": "jacobi",
+            "mg_levels_ksp_max_it": 2,
+            "mg_levels_esteig_ksp_type": "cg",  # GMRES's basis would stay allocated
+            "mg_coarse_ksp_type": "richardson",
+            "mg_coarse_ksp_max_it": 3,
+            "mg_coarse_pc_type": "gamg",
+        },
+        "the band multigrid's displacement solve, degree 2",
+        "PCMG with 2 levels (interpolation set by the preconditioner)",
+        prefix="bmg_u_",
+    ),
+    "band_u_degree1": Preset(
+        {
+            "ksp_type": "preonly",
+            "pc_type": "gamg",
+            "mg_levels_pc_type": "sor",
+            "mg_levels_ksp_max_it": 2,
+        },
+        "the band multigrid's displacement solve, degree 1",
+        "algebraic multigrid on the displacements augmented by the multipliers' rows",
+        prefix="bmg_u_",
+    ),
+    "band": Preset(
+        {
+            "ksp_type": "preonly",
+            "pc_type": "lu",
+            "pc_factor_mat_solver_type": "mumps",
+            "mat_mumps_icntl_7": 4,
+        },
+        "the band multigrid's band solve",
+        "MUMPS LU of the band (cut cells, their neighbours, the multipliers)",
+        prefix="bmg_band_",
+    ),
 }
+
+#: The presets a user chooses by name (``--solver``, ``[solver] linear``)
+LINEAR_PRESETS = ("direct", "iterative")
 
 
 def preset(name: str) -> dict[str, OptionValue]:
-    """The options of a linear-solver preset (a new dict). Not collective.
+    """The options of the row ``name`` of :data:`PRESETS` (a new dict). Not collective.
 
     Raises:
-        ValueError: ``name`` is not a key of :data:`LINEAR_PRESETS`.
+        ValueError: ``name`` is not a key of :data:`PRESETS`.
     """
-    if name not in LINEAR_PRESETS:
-        raise ValueError(f"Unknown linear solver {name!r}; valid: {sorted(LINEAR_PRESETS)}")
-    return dict(LINEAR_PRESETS[name])
+    if name not in PRESETS:
+        raise ValueError(f"Unknown solver preset {name!r}; valid: {sorted(PRESETS)}")
+    return dict(PRESETS[name].options)
+
+
+def problem_options(solver: str, facts: Facts) -> dict[str, OptionValue]:
+    """The PETSc options (without prefix) of a problem's ``solver``: the defaults of
+    :data:`SOLVER_OPTIONS`, the rows of :data:`PRESETS` whose ``applies`` holds for
+    ``facts``, and the user's ``facts.options``, later ones winning. Not collective.
+
+    Raises:
+        ValueError: ``pc_type = "cholesky"`` given for an unsymmetric Jacobian.
+    """
+    if facts.options.get("pc_type") == "cholesky" and not facts.symmetric:
+        raise ValueError(
+            "solver option pc_type = 'cholesky' needs a symmetric Jacobian; this problem's "
+            "is not (Coulomb friction or large sliding): use pc_type = 'lu'"
+        )
+    added = {}
+    for row in PRESETS.values():
+        if row.applies is not None and row.applies(facts):
+            added.update(row.options)
+    return {**defaults(solver), **added, **facts.options}
 
 
 def defaults(solver: str) -> dict[str, OptionValue]:
@@ -221,11 +354,30 @@ _prefixes = itertools.count()
 
 
 def unique_prefix(base: str) -> str:
-    """``base`` made unique in this process (``"xfem_newton_"`` -> ``"xfem_newton_3_"``),
-    as DOLFINx's ``NonlinearProblem`` does, so two solvers never share options.
-    Not collective, but the same on every process when solvers are created in the same
-    order (they are: construction is collective)."""
+    """``base`` made unique in this process (``"xfem_problem_"`` -> ``"xfem_problem_3_"``),
+    so two solvers never share options (DOLFINx's problems require a prefix from the
+    caller; ours make one when none is given). Not collective, but the same on every
+    process when solvers are created in the same order (they are: construction is
+    collective)."""
     return f"{base.rstrip('_')}_{next(_prefixes)}_"
+
+
+def checked_prefix(prefix: str | None, base: str) -> str:
+    """A solver's options prefix: ``prefix`` as given, or for ``None`` a unique one made
+    from ``base`` (:func:`unique_prefix`). Not collective.
+
+    Raises:
+        ValueError: ``prefix`` is empty (DOLFINx's problems refuse it too: the options
+            of every solver would mix in the database).
+    """
+    if prefix is None:
+        return unique_prefix(base)
+    if not isinstance(prefix, str) or not prefix:
+        raise ValueError(
+            f"petsc_options_prefix must be a non-empty string, got {prefix!r}; give e.g. "
+            "'mine_', or None for a unique one"
+        )
+    return prefix
 
 
 @contextlib.contextmanager

@@ -10,7 +10,8 @@ Which laws are symmetric is a property of each law
 (:attr:`~xfem_contact.mechanics.laws.base.InterfaceLaw.symmetric`); every matrix
 handed to the symmetric factorisation is checked first (:func:`mark_symmetric`), so a
 wrong declaration or a user's ``pc_type = "cholesky"`` on an unsymmetric problem is an
-error, never an LDL^T of a matrix it does not represent.
+error, never an LDL^T of a matrix it does not represent. The option itself is the row
+``"symmetric"`` of :data:`~xfem_contact.solvers.options.PRESETS`.
 """
 
 from __future__ import annotations
@@ -21,24 +22,6 @@ from petsc4py import PETSc
 #: ``|y.Ax - x.Ay|`` allowed, relative to ``|y| |Ax| + |x| |Ay|`` (round-off is ~1e-16;
 #: an unsymmetric interface block is detected well above 1e-8)
 TOLERANCE = 1e-12
-
-
-def symmetric_options(petsc_options: dict | None, symmetric: bool) -> dict:
-    """``petsc_options`` with ``pc_type = "cholesky"`` added when the Jacobian is
-    ``symmetric`` and the options choose no preconditioner themselves. Not collective.
-
-    Raises:
-        ValueError: ``pc_type = "cholesky"`` asked for an unsymmetric Jacobian.
-    """
-    options = dict(petsc_options or {})
-    if options.get("pc_type") == "cholesky" and not symmetric:
-        raise ValueError(
-            "solver option pc_type = 'cholesky' needs a symmetric Jacobian; this problem's "
-            "is not (Coulomb friction or large sliding): use pc_type = 'lu'"
-        )
-    if symmetric and "pc_type" not in options:
-        options["pc_type"] = "cholesky"
-    return options
 
 
 def symmetry_gap(A: PETSc.Mat) -> tuple[float, float]:
