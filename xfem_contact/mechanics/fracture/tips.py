@@ -78,6 +78,7 @@ class TipIntegrals:
                     f"{cracks.pair[0]!r} and {cracks.pair[1]!r} lie {cracks.gap:.4g} m apart)"
                 )
         names = crack.tip_names or (cut.interface_names[0],) * len(crack.tips)
+        self._names = tuple(names)
         #: One interaction integral per tip, in the order of ``cut.crack.tips``
         self.integrals = [
             InteractionIntegral(
@@ -107,12 +108,13 @@ class TipIntegrals:
             ValueError: the two sides' materials differ (each side owns its moduli: the
                 interaction integral here is that of one homogeneous material).
         """
-        sides = self.problem.bulk.materials
-        if (sides[-1].E, sides[-1].nu) != (sides[1].E, sides[1].nu):
-            raise ValueError(
-                "K, J and G need one material around the tips, but the crack's sides "
-                f"differ: side -1 E = {sides[-1].E:.6g} Pa, nu = {sides[-1].nu:.6g}; side "
-                f"+1 E = {sides[1].E:.6g} Pa, nu = {sides[1].nu:.6g}. Set the same E and "
-                "nu on problem.materials[-1] and problem.materials[1]"
-            )
+        for name in dict.fromkeys(self._names):
+            sides = self.problem.contexts[name].materials  # the crack's two sides
+            if (sides[-1].E, sides[-1].nu) != (sides[1].E, sides[1].nu):
+                raise ValueError(
+                    f"K, J and G need one material around the tips, but the sides of crack "
+                    f"{name!r} differ: side -1 E = {sides[-1].E:.6g} Pa, nu = "
+                    f"{sides[-1].nu:.6g}; side +1 E = {sides[1].E:.6g} Pa, nu = "
+                    f"{sides[1].nu:.6g}. Set the same E and nu on both sides' materials"
+                )
         return [integral.evaluate() for integral in self.integrals]
