@@ -354,7 +354,7 @@ def _bodies(problem) -> tuple[list[_Body], dict[int, np.ndarray]]:
         holds[pieces[field][pieces[field] >= 0], field] = True
     inside = pieces[0] >= 0
     holds[pieces[0][inside], 2 + regions[inside]] = True
-    holds = comm.allreduce(holds, op=MPI.LOR)
+    holds = comm.allreduce(holds.astype(np.int64), op=MPI.SUM) > 0
     # the other side's dof at the same node and component (the two fields' elements match)
     partner = np.full(space.active.size, -1, dtype=np.int64)
     for f in (0, 1):
