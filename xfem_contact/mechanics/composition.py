@@ -21,19 +21,24 @@ from xfem_contact.mechanics.materials import Material, MaterialField, Moduli
 Materials = Material | Mapping[int, Material | Mapping[str, Material]]
 
 
+#: The LBB treatment of a crack's law given by name (see :func:`interface_laws`)
+CRACK_LBB = "restriction"
+
+
 def crack_law(name: str, **options) -> InterfaceLaw:
     """:func:`~xfem_contact.mechanics.laws.make_law` with a crack's default LBB treatment,
-    ``lbb="none"`` (see :func:`interface_laws`), for a law that takes one."""
+    :data:`CRACK_LBB` (see :func:`interface_laws`), for a law that takes one."""
     if options.get("lbb") is None and "lbb" in LAW_OPTIONS.get(name, ()):
-        options["lbb"] = "none"
+        options["lbb"] = CRACK_LBB
     return make_law(name, **options)
 
 
 def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
-    """One law object per interface name of ``cut``. A crack's law given by name has no
-    LBB term (``lbb="none"``): the Barbosa-Hughes stabilisation squares the traction of
-    the tip's singular stress along the lips (``1/r``, not integrable), and the
-    restriction's vital vertices of the lips depend on the partition."""
+    """One law object per interface name of ``cut``. A crack's law given by name takes
+    the vital-vertex restriction (``lbb="restriction"``): without an LBB treatment the
+    lips' multiplier oscillates and K depends on the mesh, and the Barbosa-Hughes
+    stabilisation squares the traction of the tip's singular stress along the lips
+    (``1/r``, not integrable), so a crack refuses it."""
     names = cut.interface_names
     if not isinstance(interfaces, Mapping):
         interfaces = {name: interfaces for name in names}
@@ -52,7 +57,7 @@ def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
         if crack and getattr(law, "lbb", "none") == "stabilized":
             raise ValueError(
                 f"Crack {name!r}: lbb='stabilized' squares the tip's singular traction on "
-                "the lips (K_I of a closed crack 30 % off); give the law lbb='none'"
+                "the lips (K_I of a closed crack 30 % off); give the law lbb='restriction'"
             )
     return laws
 
