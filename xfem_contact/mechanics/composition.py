@@ -13,6 +13,7 @@ from collections.abc import Mapping
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.mechanics.bulk import SIDES
+from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws import LAW_OPTIONS, InterfaceLaw, make_law
 from xfem_contact.mechanics.materials import Material, MaterialField, Moduli
 
@@ -21,15 +22,11 @@ from xfem_contact.mechanics.materials import Material, MaterialField, Moduli
 Materials = Material | Mapping[int, Material | Mapping[str, Material]]
 
 
-#: The LBB treatment of a crack's law given by name (see :func:`interface_laws`)
-CRACK_LBB = "restriction"
-
-
 def crack_law(name: str, **options) -> InterfaceLaw:
     """:func:`~xfem_contact.mechanics.laws.make_law` with a crack's default LBB treatment,
-    :data:`CRACK_LBB` (see :func:`interface_laws`), for a law that takes one."""
+    ``DEFAULT.crack_lbb`` (see :func:`interface_laws`), for a law that takes one."""
     if options.get("lbb") is None and "lbb" in LAW_OPTIONS.get(name, ()):
-        options["lbb"] = CRACK_LBB
+        options["lbb"] = DEFAULT.crack_lbb
     return make_law(name, **options)
 
 
