@@ -370,7 +370,7 @@ def _bodies(problem) -> tuple[list[_Body], dict[int, np.ndarray]]:
         for c in (0, 1):  # components x, y
             parents = [nodes[f][0][c] for f in (0, 1)]
             keep = [(parent < nowned) & (part[parent] == p) for parent in parents]
-            dofs.append(np.concatenate([parent[k] for parent, k in zip(parents, keep, strict=True)]))
+            dofs.append(np.concatenate([parents[f][keep[f]] for f in (0, 1)]))
             coords.append(np.concatenate([nodes[f][1][keep[f], :2] for f in (0, 1)]))
             alone.append(~space.active[partner[dofs[-1]]])
         if comm.allreduce(coords[0].shape[0], op=MPI.SUM) == 0:
