@@ -202,3 +202,86 @@ def test_solve_warns_of_a_free_spin():
     problem = case2("frictionless", outer_fixed=True)
     with pytest.warns(RigidModeWarning, match="rotation.*add_point_displacement"):
         problem.solve()
+
+
+# -- cracks: the two sides are one body where the crack ends inside it -----------------------
+
+
+def cracked_plate(half: float, n: int = 64, supports: bool = True) -> Problem:
+    """A square plate of half width 2 (P1, n cells a side) with a short inclined crack of
+    half length ``half`` about its centre, pulled down by 1 Pa on its top, held by a pin
+    at its lower left corner and a roller at its lower right one (statically determinate:
+    the roller carries half the load, whatever the crack)."""
+    from xfem_contact.geometry.crack_paths import polyline
+
+    mesh = dolfinx.mesh.create_rectangle(MPI.COMM_WORLD, [[-2.0, -2.0], [2.0, 2.0]], [n, n])
+    centre, d = np.array([0.0123, 0.0271]), np.array([np.cos(0.3), np.sin(0.3)])
+    phi, psi = polyline([centre - half * d, centre + half * d]).levelsets()
+    cut = CutMesh(mesh, phi, degree=1, tangent=psi)
+    problem = Problem(cut, 1, Material(1.0, 0.3), "free", ghost_penalty=0.0)
+    problem.loads.add_traction(lambda x: np.isclose(x[1], 2.0), (0.0, -1.0))
+    if supports:
+        for point, component in (([-2.0, -2.0], 0), ([-2.0, -2.0], 1), ([2.0, -2.0], 1)):
+            problem.loads.add_point_displacement(point, 0.0, component)
+    return problem
+
+
+@pytest.mark.mpi
+def test_a_pin_and_a_roller_hold_a_plate_with_a_short_crack():
+    """The lips hold nothing (a free crack): the two sides are joined beyond the tips.
+    Before, they were two bodies joined along the lips only: the crack being short
+    (a / R = 0.05), their relative rotation was judged free and a third support asked
+    for."""
+    from xfem_contact.mechanics.reactions import balance, residual_vector, unit_vectors
+
+    problem = cracked_plate(0.07)
+    assert check(problem) == []
+    assert problem.solve().converged
+    result = balance(problem)
+    assert result["balance_relative"] < 1e-10
+    assert result["reactions"]["point displacement"] == pytest.approx([0.0, 4.0], abs=1e-9)
+    vec = residual_vector(problem)
+    dofs, owned = problem.loads.bcs[2].dof_indices()  # the roller's
+    roller = vec.array_r[dofs[:owned]] @ unit_vectors(problem)[1][dofs[:owned]]
+    vec.destroy()
+    # half of the 4 N/m on the top, as statics says
+    assert problem.mesh.comm.allreduce(roller, op=MPI.SUM) == pytest.approx(2.0, rel=1e-9)
+
+
+@pytest.mark.mpi
+def test_a_cracked_plate_without_support_is_one_free_body():
+    """Its three modes, fixed by three point constraints (not one more)."""
+    problem = cracked_plate(0.07, supports=False)
+    (body,) = free_bodies(problem)
+    assert body.message().startswith(
+        "the body cracked by 'interface': translations x, y and rotation about (0, 0) are not "
+        "constrained (no Dirichlet condition; interface 'interface' is free: it transmits nothing)"
+    )
+    assert len(body.remedies) == 3
+    assert fixed_by_the_remedies(problem)
+
+
+@pytest.mark.mpi
+def test_a_line_cutting_the_body_in_two_leaves_two_bodies():
+    """A free line from edge to edge (given as an interface among the cracks) cuts off the
+    top of a plate held at its bottom: that part is free, named and fixed by three point
+    constraints (the cracks' laws used to be taken as tying every side together)."""
+    from xfem_contact.geometry.crack_paths import polyline
+
+    mesh = dolfinx.mesh.create_rectangle(MPI.COMM_WORLD, [[-2.0, -2.0], [2.0, 2.0]], [24, 24])
+    phi, psi = polyline([(-0.61, -1.12), (0.43, -0.91)]).levelsets()
+    cut = CutMesh(
+        mesh, {"a": phi, "b": lambda x: 1.013 - x[1]}, degree=1, tangent={"a": psi, "b": None}
+    )
+    material = Material(1.0, 0.3)
+    materials = {-1: {"a": material, "b": material}, 1: material}
+    problem = Problem(cut, 1, materials, {"a": "free", "b": "free"}, ghost_penalty=0.0)
+    for point, component in (([-2.0, -2.0], 0), ([-2.0, -2.0], 1), ([2.0, -2.0], 1)):
+        problem.loads.add_point_displacement(point, 0.0, component)
+    (body,) = free_bodies(problem)
+    assert body.message().startswith(
+        "side -1 (inside interface 'b'): translations x, y and rotation about (0, 1.51) are not "
+        "constrained (no Dirichlet condition; interface 'b' is free: it transmits nothing)"
+    )
+    assert len(body.remedies) == 3
+    assert fixed_by_the_remedies(problem)

@@ -23,8 +23,8 @@ from xfem_contact.fem.branch import NUMPY, branch_values
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.forms import form
 from xfem_contact.io.meshes import ghosted_partitioner
+from xfem_contact.mechanics.composition import crack_law
 from xfem_contact.mechanics.fracture import UFL, GriffithCrack, WilliamsField, kolosov, tip_frame
-from xfem_contact.mechanics.laws import make_law
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.problem import Problem
 
@@ -216,21 +216,29 @@ def frictional_crack_case(
     tip_radius: float | str | None = 0.3,
     width: float = 2.0,
     comm: MPI.Comm = MPI.COMM_WORLD,
-    lbb: str = "none",
+    lbb: str | None = None,
     angle: float = ANGLE,
     offset: tuple[float, float] = tuple(OFFSET),
     mesh: dolfinx.mesh.Mesh | None = None,
+    cell: str = "triangle",
+    along_row: float | None = None,
 ) -> CrackCase:
     """A closed crack of half length ``a = 1`` m inclined at ``beta`` to a remote
     compression of 1 Pa, Coulomb friction ``friction`` on its lips, in the square of half
     width ``width`` meshed with ``h = a / N``. The exact solution (sliding when
     ``|tau| > friction |sigma_n|``): the uniform stress plus Westergaard's mode II field of
     the crack loaded by the effective shear ``tau_eff = |tau| - friction |sigma_n|``;
-    imposed on the boundary. ``K_I = 0``, ``K_II = sign(tau) tau_eff sqrt(pi a)``. ``lbb``:
-    the law's LBB treatment; ``angle``, ``offset``, ``mesh``: as for
-    :func:`griffith_case`."""
+    imposed on the boundary. ``K_I = 0``, ``K_II = sign(tau) tau_eff sqrt(pi a)``. The law
+    is ``frictionless`` for ``friction = 0``. ``lbb``: the law's LBB treatment (None: a
+    crack's default). ``angle``, ``offset``, ``mesh``: as for :func:`griffith_case`;
+    ``cell``: ``"triangle"`` or ``"quadrilateral"``; ``along_row``: None, or the crack
+    along a row of cells, this fraction of a cell above a mesh line (``angle`` and the
+    second component of ``offset`` are then unused)."""
     a, (d, normal) = 1.0, _frame(angle)
     centre = np.asarray(offset, dtype=float) * a
+    if along_row is not None:
+        d, normal = np.array([1.0, 0.0]), np.array([0.0, 1.0])
+        centre = np.array([centre[0], along_row * a / N])
     S11, S22, S12 = GriffithCrack.uniaxial(a, -1.0, beta).remote
     T = math.copysign(max(abs(S12) - friction * abs(S22), 0.0), S12)
     sliding = GriffithCrack(a, (0.0, 0.0, T), center=tuple(centre), direction=tuple(d))
@@ -249,12 +257,16 @@ def frictional_crack_case(
         return uniform + sliding.displacement(x, MATERIAL.E, MATERIAL.nu, MATERIAL.plane)
 
     cut = CutMesh(
-        _plate(mesh, width, int(round(2 * width * N / a)), "triangle", comm),
+        _plate(mesh, width, int(round(2 * width * N / a)), cell, comm),
         lambda x: (x[0] - centre[0]) * normal[0] + (x[1] - centre[1]) * normal[1],
         degree=degree,
         tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
     )
-    law = make_law("coulomb", friction=friction, lbb=lbb)
+    law = (
+        crack_law("coulomb", friction=friction, lbb=lbb)
+        if friction > 0
+        else crack_law("frictionless", lbb=lbb)
+    )
     problem = Problem(cut, degree, MATERIAL, law, ghost_penalty=0.0, tip_radius=tip_radius)
     problem.loads.add_displacement(_on_boundary(width), _boundary_values(width, exact))
     K = (0.0, T * math.sqrt(math.pi * a))

@@ -13,6 +13,7 @@ from collections.abc import Mapping
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.mechanics.bulk import SIDES
+from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws import LAW_OPTIONS, InterfaceLaw, make_law
 from xfem_contact.mechanics.materials import Material, MaterialField, Moduli
 
@@ -23,17 +24,18 @@ Materials = Material | Mapping[int, Material | Mapping[str, Material]]
 
 def crack_law(name: str, **options) -> InterfaceLaw:
     """:func:`~xfem_contact.mechanics.laws.make_law` with a crack's default LBB treatment,
-    ``lbb="none"`` (see :func:`interface_laws`), for a law that takes one."""
+    ``DEFAULT.crack_lbb`` (see :func:`interface_laws`), for a law that takes one."""
     if options.get("lbb") is None and "lbb" in LAW_OPTIONS.get(name, ()):
-        options["lbb"] = "none"
+        options["lbb"] = DEFAULT.crack_lbb
     return make_law(name, **options)
 
 
 def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
-    """One law object per interface name of ``cut``. A crack's law given by name has no
-    LBB term (``lbb="none"``): the Barbosa-Hughes stabilisation squares the traction of
-    the tip's singular stress along the lips (``1/r``, not integrable), and the
-    restriction's vital vertices of the lips depend on the partition."""
+    """One law object per interface name of ``cut``. A crack's law given by name takes
+    the vital-vertex restriction (``lbb="restriction"``): without an LBB treatment the
+    lips' multiplier oscillates and K depends on the mesh, and the Barbosa-Hughes
+    stabilisation squares the traction of the tip's singular stress along the lips
+    (``1/r``, not integrable), so a crack refuses it."""
     names = cut.interface_names
     if not isinstance(interfaces, Mapping):
         interfaces = {name: interfaces for name in names}
@@ -52,7 +54,7 @@ def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
         if crack and law.lbb == "stabilized":
             raise ValueError(
                 f"Crack {name!r}: lbb='stabilized' squares the tip's singular traction on "
-                "the lips (K_I of a closed crack 30 % off); give the law lbb='none'"
+                "the lips (K_I of a closed crack 30 % off); give the law lbb='restriction'"
             )
     return laws
 

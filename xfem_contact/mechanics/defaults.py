@@ -29,6 +29,9 @@ DEFAULTS: dict[str, Default] = {
     ),
     "augmentation": Default(1.0, "dimensionless factor of r = augmentation E / h (contact laws)"),
     "lbb": Default("stabilized", "LBB treatment: 'stabilized', 'restriction' or 'none'"),
+    "crack_lbb": Default(
+        "restriction", "LBB treatment of a crack's law given by name ('stabilized' refused)"
+    ),
     "multiplier_stabilization": Default(0.1, "weight of the Barbosa-Hughes term"),
     "multiplier_extension": Default(1e-12, "weight of the multiplier's normal-gradient term"),
     "slave": Default(-1, "slave side of large sliding (-1 or +1)"),

@@ -9,6 +9,7 @@ from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.restriction import MultiplierProlongation
+from xfem_contact.geometry.crack import NONE
 from xfem_contact.mechanics import lbb as lbb_module
 
 
@@ -18,9 +19,12 @@ def vital_vertex_prolongation(
     """Multiplier prolongation from the vital vertices of the cut edges. Collective.
 
     Cut edges (end vertices on opposite sides of the interpolated level set) of
-    the cut cells are gathered globally, vital vertices chosen identically on
-    every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`), and each multiplier
-    dof of a vertex on a cut edge expressed by :func:`xfem_contact.mechanics.lbb.prolongation`.
+    the cut cells (a crack's: those it crosses and its tip cells, so that the tip
+    cells' own vertices carry the multiplier too; not the cells cut ahead of its tips,
+    where it would act on nothing) are gathered globally, vital vertices chosen
+    identically on every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`), and
+    each multiplier dof of a vertex on a cut edge expressed by
+    :func:`xfem_contact.mechanics.lbb.prolongation`.
     Multiplier dofs of vertices on no cut edge stay free unknowns.
 
     Args:
@@ -48,6 +52,8 @@ def vital_vertex_prolongation(
     vertex_side = np.where(vertex_phi < 0.0, -1, 1).astype(np.int8)
     ne_cell = c2e.offsets[1] - c2e.offsets[0]
     cut_cells = cut.interface_cells(interface)
+    if cut.crack is not None:  # not the cells cut ahead of a tip: the crack is not there
+        cut_cells = cut_cells[np.isin(cut_cells, cut.cut_cells[cut.crack.kind != NONE])]
     edges = np.unique(c2e.array.reshape(-1, ne_cell)[cut_cells].ravel())
     ends = e2v.array.reshape(-1, 2)[edges]
     crossing = vertex_side[ends[:, 0]] != vertex_side[ends[:, 1]]

@@ -6,12 +6,15 @@ with an arbitrary rigid motion in it.
 :func:`check_rigid_modes` finds those motions from the data that decide them,
 without assembling anything:
 
-- the *bodies*: side +1 (field 1) and, for each interface, the part of side -1
-  inside it (field 0 on that interface's region), each with its rigid modes
-  (translations x, y and the rotation about its centroid);
+- the *bodies*: the connected parts of the sides' fields (field 1 on side +1, field 0
+  on side -1, joined through the dofs their cells share and, beside a crack, through
+  the ties of the two sides' dofs where the crack does not cut the body: around its
+  tips and along its extension), each with its rigid modes (translations x, y and the
+  rotation about its centroid). The two sides of a crack ending inside the body are
+  thus one body; a line that cuts the body in two leaves two;
 - the *Dirichlet conditions* (``problem.loads.bcs``): the values of each mode at the
   prescribed active dofs of its body;
-- the *interface laws*, by what they transmit once the interface is closed:
+- the *interface laws* (a crack's lips too), by what they transmit once closed:
   ``free`` nothing; ``frictionless`` (and ``coulomb`` with ``mu = 0``) the normal
   jump only; ``bonded``, ``sticking``, ``coulomb`` (``mu > 0``) and any other law
   the whole jump: the jump of the bodies' modes at the interface rule points, with
@@ -57,10 +60,9 @@ _KIND_TEXT = {
 
 @dataclasses.dataclass
 class _Body:
-    """A side's field on the cells of one region: its owned active dofs per component."""
+    """A connected part of the sides' fields: its owned active dofs per component."""
 
     name: str
-    field: int
     dofs: list[np.ndarray]  # per component: owned local dofs of W
     coords: list[np.ndarray]  # their coordinates, (n, 2)
     alone: list[np.ndarray]  # per component: whether no other side's field is active there
@@ -146,16 +148,17 @@ def check_rigid_modes(problem, tol: float = 1e-3) -> list[str]:
 
 def free_bodies(problem, tol: float = 1e-3) -> list[FreeBody]:
     """The bodies with free rigid modes (:class:`FreeBody`), collective."""
-    bodies, plus, inside = _bodies(problem)
+    bodies, pieces = _bodies(problem)
     nb = len(bodies)
     Q = _dirichlet_gram(problem, bodies)
     held = [np.trace(Q[3 * b : 3 * b + 3, 3 * b : 3 * b + 3]) >= tol for b in range(nb)]
-    # the two sides of a crack are one body: joined ahead of its tips
-    joined = getattr(problem.cut, "crack", None) is not None
-    kinds = {name: "full" if joined else law.transmits for name, law in problem.laws.items()}
+    kinds = {name: law.transmits for name, law in problem.laws.items()}
+    bounding: list[set[str]] = [set() for _ in bodies]  # the interfaces along each body
     for name, kind in kinds.items():
-        if kind != "none" and name in inside and plus is not None:
-            Q += _interface_gram(problem, bodies, name, inside[name], plus, kind)
+        gram, touched = _interface_gram(problem, bodies, pieces, name, kind)
+        Q += gram
+        for b in touched:
+            bounding[b].add(name)
     values, vectors = np.linalg.eigh(0.5 * (Q + Q.T))
     null = vectors[:, values < tol]  # the free combinations, orthonormal columns
     found = []
@@ -165,7 +168,7 @@ def free_bodies(problem, tol: float = 1e-3) -> list[FreeBody]:
         S = U[:, s > 0.1]  # the body's motions in free modes, (3, r) in (ax, ay, theta)
         if S.shape[1] == 0:
             continue
-        names = [name for name, k in inside.items() if k == b] if b != plus else list(kinds)
+        names = [name for name in kinds if name in bounding[b]]
         reasons = ["Dirichlet conditions hold it in part" if held[b] else "no Dirichlet condition"]
         reasons += [
             f"interface {n!r} is {problem.laws[n].name}: it {_KIND_TEXT[kinds[n]]}" for n in names
@@ -251,32 +254,98 @@ def _node(problem, body: _Body, component, point, farthest: bool) -> list[float]
     return list(max(candidates)[1:])
 
 
-def _marked(W, field: int, cells: np.ndarray) -> np.ndarray:
-    """Flags of the local dofs of ``W`` that ``field`` has on ``cells`` (any process)."""
-    vec = dolfinx.la.vector(W.dofmap.index_map, W.dofmap.index_map_bs)
-    np.add.at(vec.array, W.sub(field).dofmap.list[cells].ravel(), 1.0)
-    vec.scatter_reverse(dolfinx.la.InsertMode.add)
-    vec.scatter_forward()
-    return vec.array > 0
+def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Connected components of the graph of ``n`` nodes and edges ``(a[i], b[i])``: each
+    node's label is the smallest node of its component, shape (n,)."""
+    label = np.arange(n)
+    while True:
+        low = np.minimum(label[a], label[b])
+        new = label.copy()
+        np.minimum.at(new, label[a], low)  # hook the roots onto the smaller label
+        np.minimum.at(new, label[b], low)
+        while not np.array_equal(new, new[new]):  # then jump to the roots
+            new = new[new]
+        if np.array_equal(new, label):
+            return label
+        label = new
 
 
-def _bodies(problem) -> tuple[list[_Body], int | None, dict[str, int]]:
-    """The bodies that have active dofs; the index of side +1 and of the side -1 body
-    inside each interface."""
+def _pieces(problem) -> tuple[dict[int, np.ndarray], np.ndarray]:
+    """The connected parts of the sides' fields. Collective.
+
+    Returns:
+        ``pieces``: per field (0, 1), the global part of each owned cell, shape
+        (num_cells,), -1 where the field has no active dof on the cell (field 0 lives on
+        side -1 and cut cells, field 1 on side +1 and cut cells);
+        ``part``: the global part of each local dof of ``W`` (-1: none), the parts
+        numbered 0, 1, ... alike on every process.
+    """
+    cut, space = problem.cut, problem.space
+    W, comm = space.W, problem.mesh.comm
+    imap, bs = W.dofmap.index_map, W.dofmap.index_map_bs
+    ndofs = (imap.size_local + imap.num_ghosts) * bs
+    sides = cut.cell_sides
+    cells = {0: np.flatnonzero(sides <= 0), 1: np.flatnonzero(sides >= 0)}
+    active = space.active
+    a, b = [space.ties[:, 0]], [space.ties[:, 1]]  # the crack's ties join the two sides
+    for field, where in cells.items():
+        dofs = W.sub(field).dofmap.list[where]
+        on = active[dofs]
+        first = dofs[np.arange(dofs.shape[0]), np.argmax(on, axis=1)]
+        a.append(dofs[on])
+        b.append(np.broadcast_to(first[:, None], dofs.shape)[on])
+    a, b = np.concatenate(a), np.concatenate(b)
+    local = _components(ndofs, a, b)
+    used = np.zeros(ndofs, bool)
+    used[a] = used[b] = True
+    # the local parts of all processes as nodes of one graph, joined by the dofs they share
+    labels = np.unique(local[used])
+    counts = comm.allgather(labels.size)
+    offset = int(np.sum(counts[: comm.rank]))
+    node = np.full(ndofs, -1, dtype=np.int64)
+    node[used] = offset + np.searchsorted(labels, local[used])
+    shared = dolfinx.la.vector(imap, bs)
+    shared.array[imap.size_local * bs :] = 1.0
+    shared.scatter_reverse(dolfinx.la.InsertMode.add)
+    mine = np.flatnonzero(used & ((shared.array > 0) | (np.arange(ndofs) >= imap.size_local * bs)))
+    blocks = imap.local_to_global((mine // bs).astype(np.int32))
+    keys = np.concatenate(comm.allgather(blocks * bs + mine % bs))
+    nodes = np.concatenate(comm.allgather(node[mine]))
+    order = np.argsort(keys, kind="stable")
+    keys, nodes = keys[order], nodes[order]
+    same = keys[1:] == keys[:-1]
+    root = _components(int(np.sum(counts)), nodes[1:][same], nodes[:-1][same])
+    _, glob = np.unique(root, return_inverse=True)
+    part = np.where(node >= 0, glob[np.maximum(node, 0)], -1)
+    pieces = {}
+    for field, where in cells.items():
+        dofs = W.sub(field).dofmap.list
+        pieces[field] = np.full(sides.size, -1, dtype=np.int64)
+        on = active[dofs[where]]
+        first = dofs[where][np.arange(where.size), np.argmax(on, axis=1)]
+        pieces[field][where] = np.where(on.any(axis=1), part[first], -1)
+    return pieces, part
+
+
+def _bodies(problem) -> tuple[list[_Body], dict[int, np.ndarray]]:
+    """The bodies (the connected parts with active dofs, see :func:`_pieces`), side +1's
+    first, and per field the body of each owned cell (-1: none). Collective."""
     cut, space = problem.cut, problem.space
     W, comm = space.W, problem.mesh.comm
     nowned = W.dofmap.index_map.size_local * W.dofmap.index_map_bs
-    sides = cut.cell_sides
-    owned = np.arange(sides.size, dtype=np.int32)
+    pieces, part = _pieces(problem)
     names = cut.interface_names
     region = cut.cell_regions()
+    owned = np.arange(cut.cell_sides.size, dtype=np.int32)
     regions = np.rint(region.x.array[region.function_space.dofmap.list[owned, 0]]).astype(int)
-    where = "interface " + repr(names[0]) if len(names) == 1 else "the interfaces"
-    parts = [(f"side +1 (outside {where})", 1, owned[sides >= 0], None)]
-    parts += [
-        (f"side -1 (inside interface {name!r})", 0, owned[(sides <= 0) & (regions == k)], name)
-        for k, name in enumerate(names)
-    ]
+    nparts = 1 + max(comm.allreduce(int(p.max(initial=-1)), op=MPI.MAX) for p in pieces.values())
+    # per part: whether it holds each field, and the interfaces of its side -1 cells
+    holds = np.zeros((nparts, 2 + len(names)), bool)
+    for field in (0, 1):
+        holds[pieces[field][pieces[field] >= 0], field] = True
+    inside = pieces[0] >= 0
+    holds[pieces[0][inside], 2 + regions[inside]] = True
+    holds = comm.allreduce(holds.astype(np.int64), op=MPI.SUM) > 0
     # the other side's dof at the same node and component (the two fields' elements match)
     partner = np.full(space.active.size, -1, dtype=np.int64)
     for f in (0, 1):
@@ -284,41 +353,61 @@ def _bodies(problem) -> tuple[list[_Body], int | None, dict[str, int]]:
     nodes = {}  # field -> (parent dof of each component of each node, node coordinates)
     for field in (0, 1):
         V, parent = collapse(W.sub(field))
-        bs = V.dofmap.bs
-        nodes[field] = ([parent[c::bs] for c in range(bs)], V.tabulate_dof_coordinates())
-    bodies, plus, inside = [], None, {}
-    for label, field, cells, name in parts:
-        mask = _marked(W, field, cells) & space.active
+        nodes[field] = ([parent[c :: V.dofmap.bs] for c in range(2)], V.tabulate_dof_coordinates())
+    where = "interface " + repr(names[0]) if len(names) == 1 else "the interfaces"
+    found = []
+    for p in range(nparts):
         dofs, coords, alone = [], [], []
-        parents, x = nodes[field]
-        for parent in parents[:2]:  # components x, y
-            keep = (parent < nowned) & mask[parent]
-            dofs.append(parent[keep])
-            coords.append(x[keep, :2])
-            alone.append(~space.active[partner[parent[keep]]])
+        for c in (0, 1):  # components x, y
+            parents = [nodes[f][0][c] for f in (0, 1)]
+            keep = [(parent < nowned) & (part[parent] == p) for parent in parents]
+            dofs.append(np.concatenate([parents[f][keep[f]] for f in (0, 1)]))
+            coords.append(np.concatenate([nodes[f][1][keep[f], :2] for f in (0, 1)]))
+            alone.append(~space.active[partner[dofs[-1]]])
         if comm.allreduce(coords[0].shape[0], op=MPI.SUM) == 0:
             continue
-        centre, radius = _centroid(cut, cells, 2 * field - 1)
-        if name is None:
-            plus = len(bodies)
+        around = [names[k] for k in np.flatnonzero(holds[p, 2:])]
+        if holds[p, 0] and holds[p, 1]:
+            label = f"the body cracked by {', '.join(map(repr, around))}"
+        elif holds[p, 1]:
+            label = f"side +1 (outside {where})"
         else:
-            inside[name] = len(bodies)
-        bodies.append(_Body(label, field, dofs, coords, alone, centre, radius))
-    return bodies, plus, inside
+            label = f"side -1 (inside interface {around[0]!r})"
+        centre, radius = _centroid(cut, {f: owned[pieces[f] == p] for f in (0, 1)})
+        first = int(np.argmax(holds[p, 2:])) if holds[p, 2:].any() else -1
+        body = _Body(label, dofs, coords, alone, centre, radius)
+        found.append(((not holds[p, 1], first, p), body))
+    found.sort(key=lambda item: item[0])  # side +1's first, then by interface
+    bodies = [body for _, body in found]
+    for label in {body.name for body in bodies}:
+        twins = [body for body in bodies if body.name == label]
+        for body in twins if len(twins) > 1 else []:
+            body.name += f", the part about ({_num(body.centre[0], 3)}, {_num(body.centre[1], 3)})"
+    of_part = np.full(nparts + 1, -1)  # the body of each part, -1 (index -1 too): none
+    of_part[[key[2] for key, _ in found]] = np.arange(len(found))
+    return bodies, {f: of_part[pieces[f]] for f in (0, 1)}
 
 
-def _centroid(cut, cells: np.ndarray, side: int) -> tuple[np.ndarray, float]:
-    """Centroid (m) and radius of gyration (m) of the part of ``cells`` on ``side``: uncut
-    cells by a degree-2 rule, cut cells by the side's rules. Collective."""
+def _centroid(cut, cells: dict[int, np.ndarray]) -> tuple[np.ndarray, float]:
+    """Centroid (m) and radius of gyration (m) of the part of ``cells[f]`` on the side of
+    field ``f`` (0: side -1, 1: side +1): uncut cells by a degree-2 rule, cut cells by
+    the side's rules. Collective."""
     maps, comm = cut.maps, cut.mesh.comm
-    whole = cells[cut.cell_sides[cells] == side]
     X, W = basix.make_quadrature(cut.mesh.basix_cell(), 2)
-    rows = np.repeat(whole, W.size)
-    points, weights = np.tile(X, (whole.size, 1)), np.tile(W, whole.size)
-    rules = cut.side_rules(side)
-    mine = np.isin(cut.cut_cells[rules.point_rows], cells)
-    rows = np.r_[rows, cut.cut_cells[rules.point_rows[mine]]].astype(np.int32)
-    points, weights = np.r_[points, rules.points[mine]], np.r_[weights, rules.weights[mine]]
+    rows, points, weights = [np.zeros(0, np.int32)], [np.zeros((0, X.shape[1]))], [np.zeros(0)]
+    for field, where in cells.items():
+        side = 2 * field - 1
+        whole = where[cut.cell_sides[where] == side]
+        rows.append(np.repeat(whole, W.size))
+        points.append(np.tile(X, (whole.size, 1)))
+        weights.append(np.tile(W, whole.size))
+        rules = cut.side_rules(side)
+        mine = np.isin(cut.cut_cells[rules.point_rows], where)
+        rows.append(cut.cut_cells[rules.point_rows[mine]])
+        points.append(rules.points[mine])
+        weights.append(rules.weights[mine])
+    rows = np.concatenate(rows).astype(np.int32)
+    points, weights = np.concatenate(points), np.concatenate(weights)
     x = maps.push_forward(rows, points)[:, :2] if rows.size else np.zeros((0, 2))
     if rows.size:
         weights = weights * np.abs(np.linalg.det(maps.jacobian(rows, points)))
@@ -343,21 +432,33 @@ def _dirichlet_gram(problem, bodies: list[_Body]) -> np.ndarray:
     return problem.mesh.comm.allreduce(G, op=MPI.SUM)
 
 
-def _interface_gram(problem, bodies, name: str, minus: int, plus: int, kind: str) -> np.ndarray:
-    """Gram (global, per unit length) of the jump of the modes of bodies ``minus`` and
-    ``plus`` across interface ``name``: the whole jump or its normal part."""
-    cut = problem.cut
+def _interface_gram(
+    problem, bodies: list[_Body], pieces: dict[int, np.ndarray], name: str, kind: str
+) -> tuple[np.ndarray, set[int]]:
+    """Gram (global, per unit length) of the jump of the bodies' modes across interface
+    ``name`` (at each rule point, from the body of field 0 of its cell to that of field
+    1): the whole jump, its normal part or nothing (``kind``); and the bodies along it."""
+    cut, comm = problem.cut, problem.mesh.comm
     rules = cut.interface_rules_of(name)
+    cells = cut.cut_cells[rules.point_rows]
+    minus, plus = pieces[0][cells], pieces[1][cells]
+    touched = {int(b) for mine in comm.allgather(np.unique(np.r_[minus, plus])) for b in mine}
+    touched.discard(-1)
+    nb = len(bodies)
+    if kind == "none":
+        return np.zeros((3 * nb, 3 * nb)), touched
     x = interface_points(cut, rules)[:, :2]
     n = cut.normal_at(rules)[:, :2]
-    J = cut.maps.jacobian(cut.cut_cells[rules.point_rows], rules.points)
+    J = cut.maps.jacobian(cells, rules.points)
     w = rules.weights * np.abs(np.linalg.det(J))
-    jump = np.zeros((x.shape[0], 2, 3 * len(bodies)))  # per point, component, coefficient
-    for c in (0, 1):
-        for b, sign in ((minus, -1.0), (plus, 1.0)):
-            jump[:, c, 3 * b : 3 * b + 3] += sign * bodies[b].modes(x, c)
+    jump = np.zeros((x.shape[0], 2, 3 * nb))  # per point, component, coefficient
+    for bs, sign in ((minus, -1.0), (plus, 1.0)):
+        for b in np.unique(bs[bs >= 0]):
+            at = bs == b
+            for c in (0, 1):
+                jump[at, c, 3 * b : 3 * b + 3] += sign * bodies[b].modes(x[at], c)
+    jump[(minus == plus) | (minus < 0) | (plus < 0)] = 0.0  # one body, or a side without
     if kind == "normal":
         jump = np.einsum("pc,pcm->pm", n, jump)[:, None, :]
-    comm = problem.mesh.comm
     G = comm.allreduce(np.einsum("p,pcm,pcl->ml", w, jump, jump), op=MPI.SUM)
-    return G / comm.allreduce(float(w.sum()), op=MPI.SUM)
+    return G / comm.allreduce(float(w.sum()), op=MPI.SUM), touched

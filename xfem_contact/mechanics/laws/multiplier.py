@@ -11,7 +11,8 @@ takes an ``lbb`` option:
 - ``"none"``: neither (for studies: it oscillates or diverges).
 
 Besides, a tiny normal-gradient term (:meth:`MultiplierLaw.extension_form`) fixes
-the multiplier off the interface (not with ``"none"``).
+the multiplier off the interface (not with ``"none"``, but for the cells whose piece
+follows a line of their reference coordinates, where it is needed with any treatment).
 """
 
 from __future__ import annotations
@@ -129,11 +130,13 @@ class MultiplierLaw(InterfaceLaw):
         independent of its values on it): it gets the weight ``ALIGNED_EXTENSION``
         instead, so that they are fixed by a term of the size of the others, not by a
         tiny one (the pressure does not depend on that weight; the conditioning does).
+        That part holds with every LBB treatment, ``"none"`` too (without it the matrix
+        is singular); the tiny term elsewhere only with :attr:`extended`.
         ``lam``, ``mu``: multiplier (scalar or vector) trial/test or coefficient.
         """
         n = ctx.normal
         shear = 0.5 * (ctx.materials[-1].ufl_mu + ctx.materials[1].ufl_mu)
-        weight = constant(self, "multiplier_extension") * ctx.cut_cells
+        weight = constant(self, "multiplier_extension") * ctx.cut_cells if self.extended else 0
         if ctx.aligned_cells is not None:
             weight = weight + ALIGNED_EXTENSION * ctx.aligned_cells
         scale = weight * ctx.cell_size**2 / (2.0 * shear)
@@ -144,7 +147,7 @@ class MultiplierLaw(InterfaceLaw):
         """The LBB terms to subtract from the residual: extension and stabilisation
         (``lam``, ``mu``: Cartesian multiplier vectors of ``u``, ``v``), or None."""
         terms = []
-        if self.extended:
+        if self.extended or ctx.aligned_cells is not None:
             terms.append(self.extension_form(ctx, u.multiplier, v.multiplier))
         if self.stabilized:
             terms.append(self.stabilization_form(ctx, lam, mu, u, v))
