@@ -69,6 +69,7 @@ def test_the_probe_check_finds_probes(source, count):
     assert len(self_probes(source, "x.py")) == count
 
 
+@pytest.mark.mpi
 def test_the_state_is_frozen(cut):
     state = cut.state
     assert isinstance(state, CutState) and state.revision == 0
@@ -82,6 +83,7 @@ def test_the_state_is_frozen(cut):
         cut.revision = 3
 
 
+@pytest.mark.mpi
 def test_update_installs_the_next_state_and_keeps_the_old_one(cut):
     old = cut.state
     cells, sides, rules = old.cut_cells.copy(), old.cell_sides.copy(), old.rules
@@ -99,6 +101,7 @@ def test_update_installs_the_next_state_and_keeps_the_old_one(cut):
     assert inside > cut.mesh.comm.allreduce(int(np.sum(sides == -1)), op=MPI.SUM)
 
 
+@pytest.mark.mpi
 def test_a_problem_on_an_older_state_refuses_to_solve():
     problem = inclusion_problem(4, 1, "bonded")
     attached = problem.cut_state
@@ -112,6 +115,7 @@ def test_a_problem_on_an_older_state_refuses_to_solve():
     assert problem.solve().converged
 
 
+@pytest.mark.mpi
 def test_cracks_have_one_type():
     mesh = dolfinx.mesh.create_rectangle(MPI.COMM_WORLD, [[-2, -2], [2, 2]], [24, 24])
     paths = {
