@@ -23,8 +23,7 @@ from xfem_contact.geometry.levelset import CellMaps, LevelSet, LevelSetCallable
 from xfem_contact.quadrature import rules as quadrature
 from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart, marker_space
 
-_SIDE_MINUS, _SIDE_PLUS, _INTERFACE = SIDE_MINUS, SIDE_PLUS, INTERFACE
-_SPLIT = {_SIDE_MINUS: (4, 6), _SIDE_PLUS: (5, 7)}  # side measure: uncut, cut cells parts
+_SPLIT = {SIDE_MINUS: (4, 6), SIDE_PLUS: (5, 7)}  # side measure: uncut, cut cells parts
 _INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + index
 _BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
 _CUT_CELLS0 = 50  # measure ids of cut.dx_cut(name): _CUT_CELLS0 + index, _CUT_CELLS0 - 1 all
@@ -38,6 +37,11 @@ class CutMesh:
     -1 to side +1. Cut cells are sub-triangulated into curved 6-node triangles on each side
     and a 3-node curved segment on the interface (straight for ``degree=1``), integrated
     with per-cell runtime rules; uncut cells use FFCx's standard rule.
+
+    The cut is a frozen :class:`~xfem_contact.fem.cut_state.CutState` (:attr:`state`),
+    built by the constructor; :meth:`update` installs the next one. The attributes
+    :attr:`cut_cells`, :attr:`geometry`, :attr:`rules`, :attr:`crack`, ... read the
+    current state.
 
     Args:
         mesh: A triangle or quadrilateral mesh (affine, distorted or curved).
@@ -124,8 +128,8 @@ class CutMesh:
         self.state = state
         owned = np.arange(state.cell_sides.size, dtype=np.int32)
         self._standard = {
-            _SIDE_MINUS: owned[state.cell_sides == -1],
-            _SIDE_PLUS: owned[state.cell_sides == 1],
+            SIDE_MINUS: owned[state.cell_sides == -1],
+            SIDE_PLUS: owned[state.cell_sides == 1],
         }
         self._cell_rules = {sid: self._rules(state.cut_cells, r) for sid, r in state.rules.items()}
         self._interface_rules: dict[int, quadrature.RuleSet] = {}
@@ -221,12 +225,12 @@ class CutMesh:
         """Per-cut-cell rules of side -1 or +1 (reference points, weights)."""
         if side not in (-1, 1):
             raise ValueError(f"side must be -1 or +1, got {side!r}")
-        return self.rules[_SIDE_MINUS if side == -1 else _SIDE_PLUS]
+        return self.rules[SIDE_MINUS if side == -1 else SIDE_PLUS]
 
     @property
     def interface_rules(self) -> quadrature.RuleSet:
         """Per-cut-cell interface rules (weights ``ds / |det J|``, physical normals)."""
-        return self.rules[_INTERFACE]
+        return self.rules[INTERFACE]
 
     def _interface_index(self, name: str | None) -> int | None:
         """Index of an interface name; None for all of them (or the only one)."""
@@ -312,7 +316,7 @@ class CutMesh:
         """
         if side not in (-1, 1):
             raise ValueError(f"side must be -1 or +1, got {side!r}")
-        sid = _SIDE_MINUS if side == -1 else _SIDE_PLUS
+        sid = SIDE_MINUS if side == -1 else SIDE_PLUS
         return ufl.Measure(
             "dx", domain=self.mesh, subdomain_data=self, subdomain_id=sid, metadata=metadata or {}
         )
@@ -326,7 +330,7 @@ class CutMesh:
     @property
     def dGamma(self) -> ufl.Measure:
         """Measure of the interface (arc length in physical units): ``expr * cut.dGamma``."""
-        return ufl.Measure("dx", domain=self.mesh, subdomain_data=self, subdomain_id=_INTERFACE)
+        return ufl.Measure("dx", domain=self.mesh, subdomain_data=self, subdomain_id=INTERFACE)
 
     @property
     def normal(self) -> ufl.core.expr.Expr:
