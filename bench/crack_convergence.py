@@ -405,7 +405,7 @@ def edge(say, quick: bool) -> list[dict]:
 
     from xfem_contact.fem.cutmesh import CutMesh
     from xfem_contact.io.meshes import ghosted_partitioner
-    from xfem_contact.mechanics.fracture import CrackPath
+    from xfem_contact.mechanics.fracture import GrowthPath
     from xfem_contact.mechanics.problem import Problem
 
     H, a, y0, rows = 2.0, 0.3013, 0.0127, []
@@ -414,7 +414,7 @@ def edge(say, quick: bool) -> list[dict]:
     for degree in (1, 2):
         for nx in (40,) if quick else (40, 60):
             start = time.perf_counter()
-            path = CrackPath([[-0.1, y0], [a, y0]], moving=(False, True))
+            path = GrowthPath([[-0.1, y0], [a, y0]], moving=(False, True))
             mesh = dolfinx.mesh.create_rectangle(
                 MPI.COMM_WORLD, [[0, -H], [1, H]], [nx, 4 * nx], partitioner=ghosted_partitioner()
             )
@@ -450,7 +450,7 @@ def growth(say, quick: bool) -> list[dict]:
     """An inclined crack (half length 0.5 m, 0.5 rad) in a plate of half width 2 m under
     a tension of 1 Pa (tractions top and bottom): three steps of 0.25 m on two meshes;
     the paths' largest distance apart, and a PNG and JSON of both."""
-    from xfem_contact.mechanics.fracture import CrackPath, grow
+    from xfem_contact.mechanics.fracture import GrowthPath, grow
 
     W, a, angle, da, steps = 2.0, 0.5, 0.5, 0.25, 3
     centre = np.array([0.0123, 0.0271])
@@ -458,7 +458,7 @@ def growth(say, quick: bool) -> list[dict]:
     paths, rows = {}, []
     for n in (32, 48):
         start = time.perf_counter()
-        path = CrackPath([centre - a * d, centre + a * d])
+        path = GrowthPath([centre - a * d, centre + a * d])
         problem = plate_in_tension(path, n, tip_radius=0.3, width=W)
         problem.solve()
         for step in range(steps):

@@ -49,14 +49,14 @@ from xfem_contact.io.crack_report import Reference, crack_table, load_words, tip
 from xfem_contact.io.meshes import ghosted_partitioner
 from xfem_contact.io.output import write_fields, write_json, write_lips
 from xfem_contact.io.plots import plot_lips
-from xfem_contact.mechanics.fracture import CrackPath, TipIntegrals, effective_modulus
+from xfem_contact.mechanics.fracture import GrowthPath, TipIntegrals, effective_modulus
 from xfem_contact.mechanics.laws import make_law
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.problem import Problem
 
 # %% [markdown]
 # ## The crack and the problem
-# The crack is a `CrackPath` (a segment here): its level sets `phi` (signed distance)
+# The crack is a `GrowthPath` (a segment here): its level sets `phi` (signed distance)
 # and `psi` (distance ahead of the nearer tip) cut the mesh; the law of its lips is a
 # Coulomb law with multipliers (LBB-stable P2-P1 pair), which also holds the open
 # crack: with tension the lips separate and carry nothing.
@@ -67,7 +67,7 @@ def build(n: int, a: float, beta: float, friction: float, comm) -> tuple:
     half = 4 * a
     d = np.array([math.cos(math.pi / 2 - beta), math.sin(math.pi / 2 - beta)])
     centre = np.array([0.0123, 0.0271]) * a  # off the mesh lines
-    path = CrackPath([centre - a * d, centre + a * d])
+    path = GrowthPath([centre - a * d, centre + a * d])
     mesh = dolfinx.mesh.create_rectangle(
         comm, [[-half, -half], [half, half]], [n, n], partitioner=ghosted_partitioner()
     )

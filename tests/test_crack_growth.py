@@ -11,7 +11,7 @@ import pytest
 
 from xfem_contact.cases.cracks import plate_in_tension
 from xfem_contact.mechanics.fracture.growth import (
-    CrackPath,
+    GrowthPath,
     grow,
     kink_angle,
     paris_increment,
@@ -27,7 +27,7 @@ def test_kink_angle():
 
 
 def test_polyline_level_sets():
-    path = CrackPath([[-1.0, 0.0], [0.0, 0.0], [1.0, 1.0]])
+    path = GrowthPath([[-1.0, 0.0], [0.0, 0.0], [1.0, 1.0]])
     x = np.array([[-0.5, 0.5, -2.0, 2.0, 0.5], [0.3, 0.0, -0.2, 2.0, 0.6], [0, 0, 0, 0, 0]])
     phi, psi = path.phi(x), path.psi(x)
     # signed distance to the path (rays beyond its ends), left positive
@@ -38,7 +38,7 @@ def test_polyline_level_sets():
     # psi: negative along the crack, positive beyond either end
     assert psi[0] < 0 and psi[4] < 0 and psi[2] > 0 and psi[3] > 0
     with pytest.raises(ValueError, match="distinct"):
-        CrackPath([[0.0, 0.0], [0.0, 0.0]])
+        GrowthPath([[0.0, 0.0], [0.0, 0.0]])
     with pytest.raises(ValueError, match="da must be a positive length"):
         grow(None, path, 0.0, [(0.1, 0.2)])
 
@@ -47,7 +47,7 @@ def test_inclined_crack_turns_towards_mode_one():
     W, a, angle = 2.0, 0.5, 0.5
     centre = np.array([0.0123, 0.0271])
     d = np.array([math.cos(angle), math.sin(angle)])
-    path = CrackPath([centre - a * d, centre + a * d])
+    path = GrowthPath([centre - a * d, centre + a * d])
     problem = plate_in_tension(path, 24, tip_radius=0.35, width=W)
     problem.solve()
     ratios = []

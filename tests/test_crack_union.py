@@ -256,7 +256,7 @@ def test_a_closed_interface_among_cracks(single):
     stiff = Material(10 * MATERIAL.E, MATERIAL.nu, MATERIAL.plane)
     problem = plate([XC], law={"c0": "free", "inc": "bonded"}, inclusion=stiff)
     cut = problem.cut
-    assert cut.interface_names == ("c0", "inc") and cut.cracks.interfaces == ("inc",)
+    assert cut.interface_names == ("c0", "inc") and cut.crack.union.interfaces == ("inc",)
     assert cut.crack.tip_names == ("c0", "c0")
     K = K_by_tip(problem)
     for key, (K_I, _) in single.items():

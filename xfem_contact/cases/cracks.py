@@ -291,7 +291,7 @@ def plate_in_tension(
     comm: MPI.Comm = MPI.COMM_WORLD,
 ) -> Problem:
     """A square plate of half width ``width`` (m, ``n`` P2 triangles a side) with the crack
-    ``path`` (a :class:`~xfem_contact.mechanics.fracture.CrackPath`, traction-free lips),
+    ``path`` (a :class:`~xfem_contact.mechanics.fracture.GrowthPath`, traction-free lips),
     pulled by 1 Pa on its top and bottom sides, the rigid modes held at two corners (they
     carry no load). Not solved. For growth: ``grow(problem, path, da, rings)``."""
     cut = CutMesh(_square(width, n, "triangle", comm), path.phi, degree=2, tangent=path.psi)

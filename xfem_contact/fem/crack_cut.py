@@ -20,6 +20,7 @@ from mpi4py import MPI
 
 from xfem_contact.geometry.crack import CROSSED, NONE, TIP, classify_crack
 from xfem_contact.geometry.crack_tip_cell import cut_tip_cells
+from xfem_contact.geometry.crack_union import CrackUnion
 from xfem_contact.geometry.cut import CutGeometry
 from xfem_contact.geometry.levelset import CellMaps, LevelSet
 from xfem_contact.quadrature.rules import RuleSet
@@ -44,6 +45,9 @@ class Crack:
             direction: the upper lip (``theta = pi``) of the tip's frame, ``(ntips,)``.
         tip_names: Per tip, the name of its crack (one of the cut's ``interface_names``;
             set by the cut, empty until then).
+        union: Several cracks cut as one (their names, zones, gap, closed interfaces:
+            :class:`~xfem_contact.geometry.crack_union.CrackUnion`); ``None`` for a
+            crack given by one pair of level sets.
     """
 
     tangent: LevelSet
@@ -52,6 +56,7 @@ class Crack:
     directions: npt.NDArray[np.float64]
     upper_sides: npt.NDArray[np.int64]
     tip_names: tuple[str, ...] = ()
+    union: CrackUnion | None = None
 
     def cells(self, kind: int, cut_cells: npt.NDArray[np.int32]) -> npt.NDArray[np.int32]:
         """Local indices of the owned cut cells of ``kind``."""

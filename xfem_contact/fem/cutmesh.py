@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import itertools
+import warnings
 from collections.abc import Mapping
 
 import dolfinx.fem
@@ -12,27 +12,18 @@ import dolfinx.mesh
 import numpy as np
 import numpy.typing as npt
 import ufl
-from mpi4py import MPI
 
-from xfem_contact._timers import phase, seconds
 from xfem_contact.fem import cut_boundary
-from xfem_contact.fem.crack_cut import Crack, crack_rules
-from xfem_contact.fem.interface_cells import cell_interfaces, trace_nullity, without_slivers
+from xfem_contact.fem.crack_cut import Crack
+from xfem_contact.fem.cut_state import INTERFACE, SIDE_MINUS, SIDE_PLUS, CutState, cut_state
+from xfem_contact.fem.interface_cells import trace_nullity
 from xfem_contact.geometry import cut
-from xfem_contact.geometry.crack_union import CrackUnion, crack_union, interpolate_tangent
-from xfem_contact.geometry.levelset import (
-    CellMaps,
-    InterfaceError,
-    LevelSet,
-    LevelSetCallable,
-    interpolate,
-    named_interfaces,
-)
+from xfem_contact.geometry.crack_union import CrackUnion
+from xfem_contact.geometry.levelset import CellMaps, LevelSet, LevelSetCallable
 from xfem_contact.quadrature import rules as quadrature
 from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart, marker_space
 
-_SIDE_MINUS, _SIDE_PLUS, _INTERFACE = 1, 2, 3
-_SPLIT = {_SIDE_MINUS: (4, 6), _SIDE_PLUS: (5, 7)}  # side measure: uncut, cut cells parts
+_SPLIT = {SIDE_MINUS: (4, 6), SIDE_PLUS: (5, 7)}  # side measure: uncut, cut cells parts
 _INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + index
 _BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
 _CUT_CELLS0 = 50  # measure ids of cut.dx_cut(name): _CUT_CELLS0 + index, _CUT_CELLS0 - 1 all
@@ -46,6 +37,11 @@ class CutMesh:
     -1 to side +1. Cut cells are sub-triangulated into curved 6-node triangles on each side
     and a 3-node curved segment on the interface (straight for ``degree=1``), integrated
     with per-cell runtime rules; uncut cells use FFCx's standard rule.
+
+    The cut is a frozen :class:`~xfem_contact.fem.cut_state.CutState` (:attr:`state`),
+    built by the constructor; :meth:`update` installs the next one. The attributes
+    :attr:`cut_cells`, :attr:`geometry`, :attr:`rules`, :attr:`crack`, ... read the
+    current state.
 
     Args:
         mesh: A triangle or quadrilateral mesh (affine, distorted or curved).
@@ -64,7 +60,7 @@ class CutMesh:
             ``psi < 0`` (see :mod:`xfem_contact.fem.crack_cut`), :attr:`crack` its data.
             Several disjoint cracks: ``levelset`` and ``tangent`` mappings ``{name: ...}``
             with the same names (``psi = None``: a closed interface), cut as one pair
-            (:mod:`xfem_contact.geometry.crack_union`, :attr:`cracks`), each with its
+            (:mod:`xfem_contact.geometry.crack_union`, ``crack.union``), each with its
             own measure.
         tip_points: Gauss points per direction of a tip cell's Duffy rules (K: 12 too few).
 
@@ -95,114 +91,127 @@ class CutMesh:
         self.degree = degree
         self.quadrature_degree = quadrature_degree
         self.id = next(_counter)
-        self._boundary_sets: list[tuple[tuple[int, str], np.ndarray]] = []
-        self._boundary_parts: dict[int, list[IntegrationPart]] = {}
         self.tip_points = int(tip_points)
-        #: The crack's data on the current cut (None for interfaces)
-        self.crack: Crack | None = None
         self._is_crack = tangent is not None
-        self.update(levelset, tangent)
+        self._boundary_sets: list[tuple[tuple[int, str], np.ndarray]] = []
+        self._marker_space = marker_space(mesh)  # one for all the rules, all cuts
+        self._install(self._next(levelset, tangent, previous=None))
 
     def update(
         self,
         levelset: LevelSetCallable | dolfinx.fem.Function | Mapping[str, LevelSetCallable],
         tangent: LevelSetCallable | dolfinx.fem.Function | None = None,
-    ) -> None:
-        """Cut the mesh with a new level set (collective). Compiled forms are
-        reused: call :func:`xfem_contact.form` again to integrate on the new cut.
-        With several interfaces, give the same names as at construction; a crack
-        takes its new ``tangent`` too."""
+    ) -> CutState:
+        """Cut the mesh with a new level set (collective): the next :attr:`state`
+        (revision + 1) becomes the current one and is returned; the previous state
+        object is left as it was. Compiled forms are reused: call
+        :func:`xfem_contact.form` again to integrate on the new cut. With several
+        interfaces, give the same names as at construction; a crack takes its new
+        ``tangent`` too."""
+        state = self._next(levelset, tangent, previous=self.state)
+        self._install(state)
+        return state
+
+    def _next(self, levelset, tangent, previous: CutState | None) -> CutState:
+        """The cut by ``levelset`` (and ``tangent``) following ``previous``. Collective."""
         if self._is_crack != (tangent is not None):
             raise ValueError(
                 "tangent: a crack's cut takes its tangential level set psi (the crack "
                 "is phi = 0 where psi < 0); an interface's none"
             )
-        mesh = self.mesh
-        tdim = mesh.topology.dim
-        cell_name = mesh.topology.cell_name()
-        timer = phase("cut")
-        known = getattr(self, "interface_names", None)
-        #: The cracks (names, union level sets, zones) of a cut by cracks, else None
-        self.cracks: CrackUnion | None = None
-        if tangent is not None and isinstance(levelset, Mapping):
-            self.cracks = crack_union(mesh, levelset, tangent, self.degree, known)
-            names, components = self.cracks.names, None
-            levelset, tangent = self.cracks.phi, self.cracks.psi
-        else:
-            names, components, levelset = named_interfaces(mesh, levelset, self.degree, known)
-        #: Names of the interfaces, in the order of their measure ids
-        self.interface_names: tuple[str, ...] = names
-        self._components = components
-        previous = getattr(self, "levelset", None)  # kept: forms keep their signatures
-        try:
-            self.levelset: LevelSet = interpolate(
-                mesh, levelset, self.degree, into=None if previous is None else previous.function
-            )
-        except ValueError as error:
-            if len(names) > 1:  # the union: each interface was checked by name
-                raise
-            raise InterfaceError(names[0], str(error)) from None
-        maps = CellMaps(mesh, self.levelset)
-        num_owned = mesh.topology.index_map(tdim).size_local
-        owned = np.arange(num_owned, dtype=np.int32)
-        side = cut.classify(cell_name, self.degree, maps.nodal_values(owned))
-        self.cell_sides: npt.NDArray[np.int8] = side
-        cut_cells = owned[side == 0]
-        ncut = cut_cells.size
-        geometry = cut.subtriangulate(
-            cell_name, self.degree, maps.nodal_values(cut_cells), exact=maps.exact(cut_cells)
-        )
-        self.geometry = geometry
-        self.cut_cells = cut_cells
-        cut_time, timer = seconds(timer), phase("cut rules")
-        q = self.quadrature_degree
-        rules = {
-            _SIDE_MINUS: quadrature.side_rules(geometry, -1, q, ncut),
-            _SIDE_PLUS: quadrature.side_rules(geometry, +1, q, ncut),
-            _INTERFACE: quadrature.interface_rule(
-                geometry,
-                q,
-                ncut,
-                lambda rows, X: maps.jacobian(cut_cells[rows], X),
-                lambda rows, X: maps.grad_ref(cut_cells[rows], X),
-            ),
-        }
-        rules[_INTERFACE] = without_slivers(mesh, cut_cells, rules[_INTERFACE], maps)
-        if tangent is not None:
-            rules = self._crack_rules(rules, tangent, maps)
-        self.rules = rules
-        #: Interface (index into ``interface_names``) of every cut cell, shape ``(ncut,)``
-        self.cell_interface = cell_interfaces(maps, cut_cells, rules[_INTERFACE], components)
-        if self.cracks is not None and len(names) > 1:
-            self.cell_interface = self.cracks.cell_crack[cut_cells]
-        self._interface_rules = {}
-        if getattr(self, "_marker_space", None) is None:  # one for all the rules, all cuts
-            self._marker_space = marker_space(mesh)
-        self._cell_rules = {sid: self._rules(cut_cells, r) for sid, r in rules.items()}
-        self._standard = {_SIDE_MINUS: owned[side == -1], _SIDE_PLUS: owned[side == 1]}
-        self.maps = maps
-        self._boundary_parts = {}
-        #: Incremented by every cut (what was built on an older cut is stale)
-        self.revision = getattr(self, "revision", -1) + 1
-        self.num_cut_cells_global = mesh.comm.allreduce(ncut, op=MPI.SUM)
-        #: Wall time (s) of the last update: level set + classification +
-        #: sub-triangulation ("cut"), and per-cell rules ("quadrature")
-        self.timings = {"cut": cut_time, "quadrature": seconds(timer)}
+        args = (self.degree, self.quadrature_degree, self.tip_points)
+        return cut_state(self.mesh, levelset, tangent, *args, previous=previous)
 
-    def _crack_rules(self, rules: dict, tangent, maps: CellMaps) -> dict:
-        """The rules of the crack ``phi = 0, psi < 0`` from those of the cut by ``phi``;
-        sets :attr:`crack`. Collective."""
-        previous = None if self.crack is None else self.crack.tangent.function
-        psi = interpolate_tangent(self.mesh, tangent, self.degree, into=previous)
-        keys = {"minus": _SIDE_MINUS, "plus": _SIDE_PLUS, "interface": _INTERFACE}
-        named = {key: rules[sid] for key, sid in keys.items()}
-        named, crack = crack_rules(self.cut_cells, named, maps, psi, self.geometry, self.tip_points)
-        names = self.interface_names
-        at = np.zeros(len(crack.tips), dtype=int)
-        if self.cracks is not None and len(names) > 1:  # the crack of each tip
-            at = self.cracks.nearest(crack.tips)
-        self.crack = dataclasses.replace(crack, tip_names=tuple(names[k] for k in at))
-        return {sid: named[key] for key, sid in keys.items()}
+    def _install(self, state: CutState) -> None:
+        """Make ``state`` the current cut and rebuild what is derived from it."""
+        #: The current cut (a frozen :class:`~xfem_contact.fem.cut_state.CutState`)
+        self.state = state
+        owned = np.arange(state.cell_sides.size, dtype=np.int32)
+        self._standard = {
+            SIDE_MINUS: owned[state.cell_sides == -1],
+            SIDE_PLUS: owned[state.cell_sides == 1],
+        }
+        self._cell_rules = {sid: self._rules(state.cut_cells, r) for sid, r in state.rules.items()}
+        self._interface_rules: dict[int, quadrature.RuleSet] = {}
+        self._boundary_parts: dict[int, list[IntegrationPart]] = {}
+
+    # -- the current state --------------------------------------------------
+    @property
+    def revision(self) -> int:
+        """Revision of the current cut: 0 at construction, + 1 per update."""
+        return self.state.revision
+
+    @property
+    def levelset(self) -> LevelSet:
+        """The interpolated level set of the current cut."""
+        return self.state.levelset
+
+    @property
+    def maps(self) -> CellMaps:
+        """Cell maps and level-set values of the current cut."""
+        return self.state.maps
+
+    @property
+    def interface_names(self) -> tuple[str, ...]:
+        """Names of the interfaces, in the order of their measure ids."""
+        return self.state.interface_names
+
+    @property
+    def cell_sides(self) -> npt.NDArray[np.int8]:
+        """Side of every owned cell (-1, +1, 0 when cut), ``(num_owned,)``."""
+        return self.state.cell_sides
+
+    @property
+    def cut_cells(self) -> npt.NDArray[np.int32]:
+        """Local indices of the owned cut cells, ``(ncut,)``."""
+        return self.state.cut_cells
+
+    @property
+    def geometry(self) -> cut.CutGeometry:
+        """Sub-triangulation of the cut cells (rows of :attr:`cut_cells`)."""
+        return self.state.geometry
+
+    @property
+    def rules(self) -> Mapping[int, quadrature.RuleSet]:
+        """Per-cut-cell rules of the current cut, by measure id (read-only)."""
+        return self.state.rules
+
+    @property
+    def cell_interface(self) -> npt.NDArray[np.int64]:
+        """Interface (index into :attr:`interface_names`) of every cut cell, ``(ncut,)``."""
+        return self.state.cell_interface
+
+    @property
+    def crack(self) -> Crack | None:
+        """The crack data of the current cut (``None`` for interfaces); several cracks
+        cut as one: ``crack.union``."""
+        return self.state.crack
+
+    @property
+    def cracks(self) -> CrackUnion | None:
+        """Deprecated: ``crack.union``."""
+        warnings.warn(
+            "CutMesh.cracks is deprecated and will be removed in the next release: "
+            "use cut.crack.union (cut.crack is the crack data of every cut by cracks)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return self._union
+
+    @property
+    def _union(self) -> CrackUnion | None:
+        return None if self.state.crack is None else self.state.crack.union
+
+    @property
+    def num_cut_cells_global(self) -> int:
+        """Number of cut cells over all processes."""
+        return self.state.num_cut_cells_global
+
+    @property
+    def timings(self) -> Mapping[str, float]:
+        """Wall time (s) of the current cut: level set, classification and
+        sub-triangulation (``"cut"``), per-cell rules (``"quadrature"``)."""
+        return self.state.timings
 
     def side_indicator(self) -> dolfinx.fem.Function:
         """DG0 function of each cell's side (-1, 0 for cut, +1), ghosts included. Collective."""
@@ -216,12 +225,12 @@ class CutMesh:
         """Per-cut-cell rules of side -1 or +1 (reference points, weights)."""
         if side not in (-1, 1):
             raise ValueError(f"side must be -1 or +1, got {side!r}")
-        return self.rules[_SIDE_MINUS if side == -1 else _SIDE_PLUS]
+        return self.rules[SIDE_MINUS if side == -1 else SIDE_PLUS]
 
     @property
     def interface_rules(self) -> quadrature.RuleSet:
         """Per-cut-cell interface rules (weights ``ds / |det J|``, physical normals)."""
-        return self.rules[_INTERFACE]
+        return self.rules[INTERFACE]
 
     def _interface_index(self, name: str | None) -> int | None:
         """Index of an interface name; None for all of them (or the only one)."""
@@ -253,11 +262,11 @@ class CutMesh:
         V0 = dolfinx.fem.functionspace(self.mesh, ("DG", 0))
         regions = dolfinx.fem.Function(V0, name="region")
         owned = np.arange(self.cell_sides.size, dtype=np.int32)
-        if self.cracks is not None and len(self.interface_names) > 1:  # of their side -1
-            regions.x.array[V0.dofmap.list[owned, 0]] = self.cracks.cell_crack
-        elif self._components is not None and len(self._components) > 1:
+        if self._union is not None and len(self.interface_names) > 1:  # of their side -1
+            regions.x.array[V0.dofmap.list[owned, 0]] = self._union.cell_crack
+        elif (components := self.state.components) is not None and len(components) > 1:
             x = dolfinx.mesh.compute_midpoints(self.mesh, self.mesh.topology.dim, owned).T
-            phi = np.array([np.asarray(f(x), dtype=np.float64) for f in self._components.values()])
+            phi = np.array([np.asarray(f(x), dtype=np.float64) for f in components.values()])
             index = np.argmin(phi, axis=0)
             index[self.cut_cells] = self.cell_interface
             regions.x.array[V0.dofmap.list[owned, 0]] = index
@@ -307,7 +316,7 @@ class CutMesh:
         """
         if side not in (-1, 1):
             raise ValueError(f"side must be -1 or +1, got {side!r}")
-        sid = _SIDE_MINUS if side == -1 else _SIDE_PLUS
+        sid = SIDE_MINUS if side == -1 else SIDE_PLUS
         return ufl.Measure(
             "dx", domain=self.mesh, subdomain_data=self, subdomain_id=sid, metadata=metadata or {}
         )
@@ -321,7 +330,7 @@ class CutMesh:
     @property
     def dGamma(self) -> ufl.Measure:
         """Measure of the interface (arc length in physical units): ``expr * cut.dGamma``."""
-        return ufl.Measure("dx", domain=self.mesh, subdomain_data=self, subdomain_id=_INTERFACE)
+        return ufl.Measure("dx", domain=self.mesh, subdomain_data=self, subdomain_id=INTERFACE)
 
     @property
     def normal(self) -> ufl.core.expr.Expr:

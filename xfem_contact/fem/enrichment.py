@@ -136,8 +136,8 @@ class EnrichedSpace:
             raise ValueError("tip_radius: the cut has no crack (CutMesh(..., tangent=psi))")
         if tip_radius is not None and not (np.isfinite(tip_radius) and tip_radius > 0):
             raise ValueError(f"tip_radius must be a positive length (m), got {tip_radius!r}")
-        if cut.cracks is not None:  # several cracks: each tip zone within its crack's
-            cut.cracks.check_tip_radius(tip_radius)
+        if cut.crack is not None and cut.crack.union is not None:  # several cracks
+            cut.crack.union.check_tip_radius(tip_radius)  # each tip zone within its crack's
         self.tip_radius = tip_radius
         #: The ramp ``R`` of the branch functions (P1, set with the active dofs), or None
         self.ramp: dolfinx.fem.Function | None = None

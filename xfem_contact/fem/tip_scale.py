@@ -59,6 +59,7 @@ def default_tip_radius(cut: CutMesh) -> float:
     least the tip cells' size (on a mesh too coarse to hold that zone the tip cells'
     patch is the zone). Collective."""
     radius = TIP_RADIUS * float(tip_lengths(cut).min())
-    if cut.cracks is not None and len(cut.cracks.names) > 1:
-        radius = min(radius, cut.cracks.zone - cut.cracks.h)
+    union = cut.crack.union
+    if union is not None and len(union.names) > 1:
+        radius = min(radius, union.zone - union.h)
     return max(radius, tip_cells_size(cut))

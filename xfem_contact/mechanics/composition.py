@@ -42,7 +42,8 @@ def interface_laws(cut: CutMesh, interfaces) -> dict[str, InterfaceLaw]:
     if set(interfaces) != set(names):
         raise ValueError(f"Give a law for each interface {list(names)}; got {sorted(interfaces)}")
     laws = {}
-    closed = () if cut.cracks is None else cut.cracks.interfaces  # interfaces among cracks
+    union = None if cut.crack is None else cut.crack.union
+    closed = () if union is None else union.interfaces  # interfaces among cracks
     for name in names:
         law = interfaces[name]
         crack = cut.crack is not None and name not in closed

@@ -17,6 +17,7 @@ import numpy as np
 import ufl
 
 from xfem_contact._timers import phase, seconds
+from xfem_contact.fem.cut_state import CutState
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.forms import form
@@ -137,16 +138,18 @@ class Problem:
         self._last_report: SolveReport | None = None
         #: Pseudo-time of the rotations that the bodies of ``w`` have turned by
         self._rotated_at = 0.0
-        self._attach_cut()
+        #: Side of each cell on the cut the problem is attached to (DG0, see
+        #: :meth:`~xfem_contact.fem.cutmesh.CutMesh.side_indicator`); the same Function
+        #: on every cut, so that the forms keep their signature
+        self.side_indicator = cut.side_indicator()
+        self._attach(cut.state)
 
-    def _attach_cut(self) -> None:
-        """(Re)build what follows the current cut: side indicator, the laws' contexts
-        and couplings; the Newton solver is rebuilt at the next solve. Collective."""
-        side = self.cut.side_indicator()
-        if hasattr(self, "side_indicator"):  # kept, so that the forms keep their signature
-            self.side_indicator.x.array[:] = side.x.array
-        else:
-            self.side_indicator = side
+    def _attach(self, state: CutState) -> None:
+        """Build what follows the cut ``state`` (the current one of :attr:`cut`): side
+        indicator, the laws' contexts and couplings; the Newton solver is rebuilt at the
+        next solve. Collective."""
+        assert state is self.cut.state, "a problem attaches to its cut's current state"
+        self.side_indicator.x.array[:] = self.cut.side_indicator().x.array
         fields = {name: field for field, _, name in self.space.multiplier_fields}
         self.contexts = {
             name: interface_context(
@@ -172,7 +175,8 @@ class Problem:
             self._newton.destroy()
             self._newton = None
         self._checked_loads: int | None = None
-        self._cut_revision = self.cut.revision
+        #: The cut state the space, contexts and forms were built on
+        self.cut_state = state
 
     def update_interface(self, levelset, tangent=None) -> None:
         """Move the interfaces: cut the mesh with ``levelset`` (as
@@ -186,9 +190,9 @@ class Problem:
         history restarts at the new interface. Collective.
         """
         before = self.space.active.copy()
-        self.cut.update(levelset, tangent)
+        state = self.cut.update(levelset, tangent)
         self.space.refresh()
-        self._attach_cut()
+        self._attach(state)
         for w in (self.w, self.w_old):
             self.space.carry(w, before)
 
@@ -349,11 +353,11 @@ class Problem:
             self._options_changed |= kept != petsc_options
 
     def _solve(self) -> SolveReport:
-        if self.cut.revision != self._cut_revision:
+        if self.cut_state is not self.cut.state:
             raise ValueError(
                 "The cut changed (cut.update) after this problem was built: its enriched "
                 f"space, rules and forms follow the old interface (cut revision "
-                f"{self._cut_revision}, now {self.cut.revision}); move interfaces with "
+                f"{self.cut_state.revision}, now {self.cut.revision}); move interfaces with "
                 "problem.update_interface(levelset)"
             )
         if self._checked_loads != self.loads.revision:  # again only when the loads changed

@@ -182,8 +182,8 @@ def default_rings(problem) -> list[tuple[float, float]]:
     if len(tips) > 1:
         gaps = np.linalg.norm(tips[:, None] - tips[None], axis=2)
         room = min(room, float(gaps[~np.eye(len(tips), dtype=bool)].min()))
-    if problem.cut.cracks is not None:  # and to the other cracks
-        room = min(room, problem.cut.cracks.gap)
+    if problem.cut.crack.union is not None:  # and to the other cracks
+        room = min(room, problem.cut.crack.union.gap)
     rings = [(max(a * length, h), min(b * length, 0.9 * room)) for a, b in CRACK_RINGS]
     rings = [(r_inf, r_sup) for r_inf, r_sup in rings if r_sup - r_inf >= 0.5 * h]
     if not rings:

@@ -8,8 +8,10 @@ q-functions of the domain integrals, :mod:`~.interaction` the interaction integr
 problem, and :mod:`~.growth` quasi-static propagation.
 """
 
+import warnings
+
 from xfem_contact.mechanics.fracture.growth import (
-    CrackPath,
+    GrowthPath,
     GrowthStep,
     grow,
     kink_angle,
@@ -39,7 +41,7 @@ from xfem_contact.mechanics.fracture.williams import (
 )
 
 __all__ = [
-    "CrackPath",
+    "GrowthPath",
     "GrowthStep",
     "NUMPY",
     "UFL",
@@ -66,3 +68,17 @@ __all__ = [
     "tip_cell_size",
     "tip_frame",
 ]
+
+
+def __getattr__(name: str):
+    """``CrackPath``: the deprecated name of :class:`GrowthPath`."""
+    if name == "CrackPath":
+        warnings.warn(
+            "xfem_contact.mechanics.fracture.CrackPath is deprecated and will be removed in "
+            "the next release: it is GrowthPath (xfem_contact.geometry.crack_paths.CrackPath "
+            "is a scene's crack shape)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return GrowthPath
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,7 +1,7 @@
 """Quasi-static crack growth: the maximum hoop stress kink angle, a polyline crack's level
 sets, and the step that advances its tips and re-cuts the problem.
 
-A :class:`CrackPath` is a polyline (m) whose first and last points are its tips (or ends
+A :class:`GrowthPath` is a polyline (m) whose first and last points are its tips (or ends
 outside the body, for an edge crack: they do not move, see ``moving``). Its normal level
 set ``phi`` is the signed distance to the polyline with its end segments continued as
 rays (positive on the left of the path's direction), its tangential level set ``psi``
@@ -24,7 +24,7 @@ from mpi4py import MPI
 from xfem_contact.mechanics.fracture.rings import cells_at
 from xfem_contact.mechanics.fracture.tips import TipIntegrals
 
-__all__ = ["CrackPath", "GrowthStep", "grow", "kink_angle", "paris_increment"]
+__all__ = ["GrowthPath", "GrowthStep", "grow", "kink_angle", "paris_increment"]
 
 
 def kink_angle(K_I: float, K_II: float) -> float:
@@ -47,8 +47,10 @@ def paris_increment(delta_K: float, C: float, m: float, cycles: float) -> float:
 
 
 @dataclasses.dataclass
-class CrackPath:
-    """A polyline crack.
+class GrowthPath:
+    """The polyline of a growing crack: :func:`grow` appends a point at each moving tip
+    (a fixed crack shape of a scene is a
+    :class:`~xfem_contact.geometry.crack_paths.CrackPath`).
 
     Attributes:
         points: The vertices (m), ``(k, 2)``, ``k >= 2``, from one end to the other.
@@ -124,7 +126,7 @@ class GrowthStep:
     angles: list[float | None]
 
 
-def grow(problem, path: CrackPath, da: float, rings, solve: bool = True) -> GrowthStep:
+def grow(problem, path: GrowthPath, da: float, rings, solve: bool = True) -> GrowthStep:
     """One quasi-static step: K at the tips of the solved ``problem``, the kink angles,
     the tips advanced by ``da`` (m), the problem re-cut on the new path (and solved again
     when ``solve``). The problem's crack must be ``path`` (its tips in the cut's order

@@ -69,7 +69,7 @@ class TipIntegrals:
         cut = problem.cut
         pieces = [Piece(u[0], cut.dx(-1)), Piece(u[1], cut.dx(1))]
         material = problem.bulk.materials[1]
-        cracks = cut.cracks
+        cracks = cut.crack.union
         if cracks is not None and cracks.pair is not None:  # several: no ring holds two
             wide = max((r.r_sup if isinstance(r, Ring) else r[1] for r in rings), default=0.0)
             if wide >= cracks.gap:
