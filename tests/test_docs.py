@@ -2,6 +2,7 @@
 link of README.md and the docs pages resolves to a file of the checkout (and a heading of
 it, for a ``#anchor``), as it does on the site."""
 
+import ast
 import importlib.util
 import pathlib
 import re
@@ -94,3 +95,56 @@ def test_link_check_finds_a_broken_link(tmp_path):
 def test_generated_pages_current():
     """``docs/generated/`` is what ``python docs/reference.py`` writes (run it if not)."""
     assert _reference().stale_pages() == []
+
+
+#: An issue number ("issue 26", "issues 11", "(#26)"): history belongs to git
+ISSUE = re.compile(r"\bissues?\s+#?\d+|\(#\d+\)", re.IGNORECASE)
+#: A commit hash: 7 to 40 hex digits with a letter and a digit, not part of a number
+#: (``6.263744e-3``) or a word
+COMMIT = re.compile(r"(?<![.\w-])(?=[0-9a-f]*[a-f])(?=[0-9a-f]*\d)[0-9a-f]{7,40}(?![\w.-])")
+SOURCES = sorted(
+    p
+    for folder in ("xfem_contact", "bench", "tests", "docs")
+    for p in (ROOT / folder).rglob("*.py")
+    if p.name != "test_docs.py"
+)
+
+#: The nodes that carry a docstring besides the module
+DOCUMENTED = (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)
+
+
+def history(text: str) -> list[str]:
+    """The issue numbers and commit hashes in ``text``, each as ``line: match``."""
+    return [
+        f"{number}: {m.group(0)}"
+        for number, line in enumerate(text.splitlines(), start=1)
+        for m in [*ISSUE.finditer(line), *COMMIT.finditer(line)]
+    ]
+
+
+def docstrings(path: pathlib.Path) -> str:
+    """The docstrings of a Python file (module, classes, functions), one after another."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    nodes = [tree, *(n for n in ast.walk(tree) if isinstance(n, DOCUMENTED))]
+    return "\n".join(ast.get_docstring(n) or "" for n in nodes)
+
+
+@pytest.mark.parametrize("page", PAGES, ids=[str(p.relative_to(ROOT)) for p in PAGES])
+def test_page_has_no_history(page):
+    """Docs say what the code does today: no issue numbers, no commit hashes."""
+    assert history(page.read_text(encoding="utf-8")) == []
+
+
+def test_code_has_no_history():
+    """No issue number in any source or comment, no commit hash in a docstring."""
+    found = []
+    for path in SOURCES:
+        text = path.read_text(encoding="utf-8")
+        found += [f"{path.relative_to(ROOT)}:{m}" for m in history(text) if "issue" in m.lower()]
+        found += [f"{path.relative_to(ROOT)} (docstring) {m}" for m in history(docstrings(path))]
+    assert found == []
+
+
+def test_history_check_finds_issues_and_hashes():
+    text = "fixed in issue 26 (#12), at 79f8539, error 6.263744e-3, 1234567 dofs, cafe"
+    assert [m.split(": ", 1)[1] for m in history(text)] == ["issue 26", "(#12)", "79f8539"]

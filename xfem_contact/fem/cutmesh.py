@@ -66,7 +66,7 @@ class CutMesh:
             with the same names (``psi = None``: a closed interface), cut as one pair
             (:mod:`xfem_contact.geometry.crack_union`, :attr:`cracks`), each with its
             own measure.
-        tip_points: Gauss points per direction of a tip cell's Duffy rules (K: 12 too few).
+        tip_points: Gauss points per direction of a tip cell's Duffy rules.
 
     Example:
         >>> cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 0.5)
