@@ -5,7 +5,7 @@ field as one displacement per side, ``u = u_-`` on side -1 and ``u = u_+`` on
 side +1, each living on the cells its side touches. We use the latter: a mixed
 space ``(u_-, u_+[, lambda])`` whose dofs outside the support of their side (or,
 for the multiplier, outside the cut cells) are *inactive* and removed from every
-solve by the restriction operator of :mod:`xfem_contact.fem.restriction`: the
+solve by the prolongation of :mod:`xfem_contact.fem.prolongation`: the
 system has exactly standard + enriched dofs.
 """
 

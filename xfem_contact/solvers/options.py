@@ -5,8 +5,8 @@ entry maps a PETSc option name (without prefix) to its type, default value, a
 help string, the allowed values (``None``: whatever PETSc accepts) and the
 solvers it is a default of:
 
-- ``"linear"``: the KSP of :func:`xfem_contact.solvers.linear.solve_restricted`;
-- ``"newton"``: the SNES of :class:`xfem_contact.solvers.newton.RestrictedNewton`
+- ``"linear"``: the KSP of :func:`xfem_contact.solvers.linear.solve_reduced`;
+- ``"newton"``: the SNES of :class:`xfem_contact.solvers.newton.ReducedNewton`
   (its KSP options are those of the linear solve in every Newton step).
 
 :data:`PRESETS` holds every other set of options the package uses, one row each with
