@@ -5,7 +5,7 @@
   unknowns pair up) equals ``R^T A R`` by PtAP,
   bit for bit, and a prolongation in ``R`` takes the PtAP path;
 - the uncut cells assembled field by field on the fields' own spaces
-  (:func:`xfem_contact.fem.field_blocks.split_uncut`) give the same matrix, a term
+  (:func:`xfem_contact.fem.field_blocks.uncut_field_blocks`) give the same matrix, a term
   coupling two fields there included, and so do the Newton residuals where the
   Dirichlet data are not met (the lifting);
 - the residual assembled as its parts (standard and runtime integrals,
@@ -26,7 +26,7 @@ from petsc4py import PETSc
 from xfem_contact.cases.paper import inclusion_problem
 from xfem_contact.codegen import kernel_store
 from xfem_contact.fem import forms
-from xfem_contact.fem.field_blocks import split_uncut
+from xfem_contact.fem.field_blocks import uncut_field_blocks
 from xfem_contact.fem.forms import form, form_parts
 from xfem_contact.fem.subspaces import collapse
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
@@ -176,7 +176,7 @@ def test_uncut_cells_on_the_fields_own_spaces(law, cell, blocked, coupled):
     if coupled:  # u_- tested with v_+ on the uncut cells of side -1 (inactive dofs aside)
         u_minus, v_plus = ufl.split(ufl.TrialFunction(W))[0], ufl.split(ufl.TestFunction(W))[1]
         J = J + 1e6 * ufl.inner(u_minus, v_plus) * problem.cut.dx(-1)
-    split = split_uncut(J, problem.space.field_space)
+    split = uncut_field_blocks(J, problem.space.field_space)
     assert [b.field for b in split.blocks] == [0, 1]  # the multipliers have no bulk
     R = problem.prolongation()
     blocks = [(form(b.form), b.parent, True) for b in split.blocks]
@@ -201,7 +201,7 @@ def test_constant_blocks_are_added_from_their_copy(problem):
     state the matrix equals one assembled afresh there."""
     W = problem.space.W
     J = ufl.derivative(problem.residual(problem.w), problem.w, ufl.TrialFunction(W))
-    split = split_uncut(J, problem.space.field_space)
+    split = uncut_field_blocks(J, problem.space.field_space)
     blocks = [(form(b.form), b.parent, True) for b in split.blocks]
     R, rest = problem.prolongation(), form(split.rest)
     kept = ReducedMatrix(rest, problem.loads.bcs, R, field_blocks=blocks)

@@ -315,7 +315,7 @@ class CutMesh:
     def split_side_measure(self, subdomain_id: int) -> tuple[int, int] | None:
         """For the id of a side measure (:meth:`dx`): the ids of its two parts, the
         uncut cells (standard rule) and the cut cells (runtime rules), whose sum it is;
-        ``None`` for other ids. For :func:`xfem_contact.fem.field_blocks.split_uncut`."""
+        ``None`` for other ids. For :func:`xfem_contact.fem.field_blocks.uncut_field_blocks`."""
         return _SPLIT.get(subdomain_id)
 
     @property

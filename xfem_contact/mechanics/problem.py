@@ -38,7 +38,7 @@ from xfem_contact.solvers.options import (
     Facts,
     checked_prefix,
     problem_options,
-    splits_fields,
+    uses_fieldsplit,
 )
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 
@@ -400,7 +400,7 @@ class Problem:
             self._newton.destroy()  # loads or solver options changed since it was built
             self._newton = None
         if self._newton is None:
-            split = splits_fields(petsc_options)
+            split = uses_fieldsplit(petsc_options)
             self._newton = ReducedNewton(
                 self.residual(self.w),
                 self.w,

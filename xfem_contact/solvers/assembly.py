@@ -278,7 +278,7 @@ class ReducedMatrix:
         field_blocks: Forms on a field's own space to add, each with the parent dof
             in ``W`` of every local dof of that space and whether it is constant (no
             coefficient that changes in a solve, e.g. a linear bulk) (the uncut cells'
-            blocks of :func:`xfem_contact.fem.field_blocks.split_uncut`): the matrix is
+            blocks of :func:`xfem_contact.fem.field_blocks.uncut_field_blocks`): the matrix is
             ``R^T (A + sum_i P_i A_i P_i^T) R``. Only for an ``R`` that selects. After
             :meth:`keep_constant_blocks` the constant ones are assembled once more and
             then added from a copy.

@@ -99,7 +99,7 @@ class ReducedNewton:
             (:meth:`EnrichedSpace.field_space
             <xfem_contact.fem.enrichment.EnrichedSpace.field_space>`). With a selecting
             ``R`` the Jacobian's uncut cells and ghost penalty are then assembled field
-            by field on those spaces (:func:`xfem_contact.fem.field_blocks.split_uncut`).
+            by field on those spaces (:func:`xfem_contact.fem.field_blocks.uncut_field_blocks`).
         transform: ``transform(R, J_r)``: a change of unknowns ``Z`` made from the first
             unscaled reduced Jacobian (a crack's tip enrichment,
             :func:`~xfem_contact.solvers.block_scaling.tip_scaling`): each Newton step

@@ -109,7 +109,7 @@ REFACTOR_AFTER = 20
 SPLIT_PRECONDITIONERS = ("fieldsplit", "python")
 
 
-def splits_fields(options: dict) -> bool:
+def uses_fieldsplit(options: dict) -> bool:
     """Whether ``options`` choose a preconditioner of :data:`SPLIT_PRECONDITIONERS`.
     Not collective."""
     return options.get("pc_type") in SPLIT_PRECONDITIONERS
@@ -195,7 +195,7 @@ PRESETS: dict[str, Preset] = {
         "100 % more MUMPS workspace: the branch functions are then nearly dependent on the "
         "polynomials far from the tip and the delayed pivots outgrow the default workspace "
         "(INFO(1) = -9)",
-        lambda facts: facts.crack_tip and (splits_fields(facts.options) or facts.couplings),
+        lambda facts: facts.crack_tip and (uses_fieldsplit(facts.options) or facts.couplings),
     ),
     "reused_lu": Preset(
         {
