@@ -12,6 +12,8 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 PAGES += sorted((ROOT / "docs" / "generated").glob("*.md"))
+#: The hand-written pages of docs/
+DOCS = sorted((ROOT / "docs").glob("*.md"))
 #: ``[text](target)`` and ``![alt](target)`` of markdown, outside code
 LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")
 FENCE = re.compile(r"^(`{3,}|~{3,})")
@@ -148,3 +150,42 @@ def test_code_has_no_history():
 def test_history_check_finds_issues_and_hashes():
     text = "fixed in issue 26 (#12), at 79f8539, error 6.263744e-3, 1234567 dofs, cafe"
     assert [m.split(": ", 1)[1] for m in history(text)] == ["issue 26", "(#12)", "79f8539"]
+
+
+#: A measured figure in a table: a number in exponent form, or with a unit of time,
+#: memory or a percentage
+MEASURED = re.compile(r"\d(\.\d+)?e-?\d+|\d\s?(s|MB|GB|%)(?![\w])")
+
+
+def unmarked_tables(text: str) -> list[int]:
+    """The first lines of the tables of ``text`` that hold measured figures but are
+    neither marked as a static example nor pointed at a generated page in the text of
+    their section before them."""
+    lines, found, start = text.splitlines(), [], 0
+    for number, line in enumerate(lines):
+        if line.startswith("#"):
+            start = number
+        if line.startswith("|") and not (number and lines[number - 1].startswith("|")):
+            table = []
+            for row in lines[number:]:
+                if not row.startswith("|"):
+                    break
+                table.append(row)
+            before = "\n".join(lines[start:number])
+            marked = "static example" in before or "generated/" in before
+            if MEASURED.search("\n".join(table)) and not marked:
+                found.append(number + 1)
+    return found
+
+
+@pytest.mark.parametrize("page", DOCS, ids=[str(p.relative_to(ROOT)) for p in DOCS])
+def test_measured_tables_are_generated_or_marked(page):
+    """Every table of measured figures is a generated page's or marked as a static
+    example (with the command that printed it)."""
+    assert unmarked_tables(page.read_text(encoding="utf-8")) == []
+
+
+def test_table_check_finds_an_unmarked_table():
+    text = "# Page\n\n| n | time |\n|---|---|\n| 8 | 1.2 s |\n\n## Marked\n\n"
+    text += "A static example:\n\n| n | error |\n|---|---|\n| 8 | 1e-3 |\n"
+    assert unmarked_tables(text) == [3]
