@@ -52,7 +52,7 @@ from xfem_contact.cases.cracks import (
 from xfem_contact.fem.forms import form
 from xfem_contact.mechanics.fracture import TipIntegrals
 from xfem_contact.solvers.block_scaling import scaled, tip_transform
-from xfem_contact.solvers.linear import assemble_restricted
+from xfem_contact.solvers.linear import assemble_reduced
 from xfem_contact.solvers.scaling import saddle_point_scaling
 
 RESULTS = pathlib.Path(__file__).parent / "results"
@@ -337,9 +337,9 @@ def condition_number(problem, iterations: int = 60, tip_scaling: bool = True) ->
     smallest): ``Z^T A Z`` with a crack's tip enrichment
     (:mod:`xfem_contact.solvers.block_scaling`), else (or without ``tip_scaling``) the
     Jacobi-scaled ``D A D``. Collective."""
-    R = problem.restriction()
+    R = problem.prolongation()
     a, L = form(problem.bilinear_form()), form(problem.loads.linear_form())
-    A, b = assemble_restricted(a, L, problem.loads.bcs, R)
+    A, b = assemble_reduced(a, L, problem.loads.bcs, R)
     transform = tip_transform(problem.space, off=not tip_scaling)
     if transform is None:
         D = saddle_point_scaling(A)

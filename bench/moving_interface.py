@@ -58,7 +58,7 @@ MATERIALS = {-1: Material(300e6, 0.2), 1: Material(100e6, 0.0)}
 #: Laws and their options
 LAWS = {"sticking": {}, "coulomb": {"friction": 0.3}}
 POSITIONS = 10
-#: Goals of issue 25: per position / one solve, X-FEM / remeshing
+#: Goals: per position / one solve, X-FEM / remeshing
 GOALS = {"solve": 1.3, "remesh": 0.5}
 
 

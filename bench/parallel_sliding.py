@@ -1,4 +1,4 @@
-"""Parallel efficiency of large sliding against plain DOLFINx's on the same mesh (issue 27).
+"""Parallel efficiency of large sliding against plain DOLFINx's on the same mesh.
 
 Paper case 3 turned by 1 rad in 4 load steps (P2, ``n`` x ``4 n`` curved cells,
 :func:`~xfem_contact.cases.rotation.rotating_annulus_problem`), each run a process of

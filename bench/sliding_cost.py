@@ -1,4 +1,4 @@
-"""The CPU cost of a large-sliding Newton iteration against a small-sliding one (issue 27).
+"""The CPU cost of a large-sliding Newton iteration against a small-sliding one.
 
 Paper case 3 at 1 rad in 4 load steps (P2, n x 4n cells,
 :func:`~xfem_contact.cases.rotation.rotating_annulus_problem`, segment-to-segment

@@ -125,8 +125,7 @@ def main():
     )
 
     t0 = time.perf_counter()
-    u_minus, u_plus = solution.field(0), solution.field(1)
-    u_minus.name, u_plus.name = "u_minus", "u_plus"
+    u_minus, u_plus = solution.displacement(-1), solution.displacement(+1)
     write_fields(out, "displacement", [u_minus, u_plus])
     write_lips(out / "result.vtu", cut, u_minus, u_plus)
     write_cut_geometry(out, cut)

@@ -2,6 +2,7 @@
 (every table and key of :data:`xfem_contact.scenes.schema.FIELDS`: type, allowed
 values, default, meaning; the built-in boundary parts of each mesh kind; the functions
 of expressions), the solver options (:data:`xfem_contact.solvers.options.SOLVER_OPTIONS`),
+the problem defaults (:data:`xfem_contact.mechanics.defaults.DEFAULTS`),
 the demos, and one page per benchmark result (``bench/results/NAME.md``, with the
 bench script's docstring and its pictures).
 
@@ -217,6 +218,24 @@ def solver_options() -> str:
     return "\n".join(lines) + "\n"
 
 
+def problem_defaults() -> str:
+    from xfem_contact.mechanics.defaults import DEFAULTS
+
+    lines = [
+        "# Problem defaults",
+        "",
+        "Generated from `xfem_contact.mechanics.defaults.DEFAULTS`, which the constructors,",
+        "the scene schema and the documentation read.",
+        "",
+        "| option | default | meaning |",
+        "|---|---|---|",
+    ]
+    for name, default in DEFAULTS.items():
+        value = f"`{default.value!r}`" if default.value is not None else "None"
+        lines.append(f"| `{name}` | {value} | {_cell(default.doc)} |")
+    return "\n".join(lines) + "\n"
+
+
 #: Where the generated pages live: in the repository, so that links between pages
 #: resolve in a checkout as on the site (``python docs/reference.py`` rewrites them)
 FOLDER = pathlib.Path(__file__).resolve().parent / "generated"
@@ -224,7 +243,11 @@ FOLDER = pathlib.Path(__file__).resolve().parent / "generated"
 
 def pages(root: pathlib.Path) -> dict[str, str]:
     """The generated pages of the checkout at ``root``: file name to markdown text."""
-    found = {"scene_reference.md": scene_reference(), "solver_options.md": solver_options()}
+    found = {
+        "scene_reference.md": scene_reference(),
+        "solver_options.md": solver_options(),
+        "problem_defaults.md": problem_defaults(),
+    }
     for demo in sorted((root / "demos").glob("*.py")):
         found[f"demo_{demo.stem}.md"] = demo_page(demo)
     for result in sorted((root / "bench" / "results").glob("*.md")):

@@ -36,7 +36,7 @@ from xfem_contact.mechanics.fracture import (
     TipIntegrals,
 )
 from xfem_contact.mechanics.fracture.tips import lip_tractions
-from xfem_contact.solvers.linear import assemble_restricted
+from xfem_contact.solvers.linear import assemble_reduced
 from xfem_contact.solvers.scaling import saddle_point_scaling
 
 
@@ -75,7 +75,7 @@ def test_ties_and_dof_counts():
     ties = MPI.COMM_WORLD.allreduce(len(space.ties), op=MPI.SUM)
     assert ties > 0
     # every tied pair is one unknown: the reduced system has standard + enriched dofs
-    R = case.problem.restriction()
+    R = case.problem.prolongation()
     assert R.getSize()[1] == counts.total
     R.destroy()
 
@@ -107,9 +107,9 @@ def test_ramp_leaves_no_null_vector():
     and F_2 at one node removes them (smallest eigenvalue of the Jacobi-scaled reduced
     stiffness 5.5e-16 of the largest with all dofs)."""
     problem = williams_case(8, 1, tip_radius=0.4).problem
-    R = problem.restriction()
+    R = problem.prolongation()
     a, L = form(problem.bilinear_form()), form(problem.loads.linear_form())
-    A, b = assemble_restricted(a, L, problem.loads.bcs, R)
+    A, b = assemble_reduced(a, L, problem.loads.bcs, R)
     D = saddle_point_scaling(A)
     A.diagonalScale(D, D)
     eigenvalues = np.abs(np.linalg.eigvalsh(A.convert("dense").getDenseArray()))

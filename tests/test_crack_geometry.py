@@ -1,4 +1,4 @@
-"""Crack geometry and tip quadrature (issue 26): classification, tips, fan cuts, Duffy rules.
+"""Crack geometry and tip quadrature: classification, tips, fan cuts, Duffy rules.
 
 Pure numpy and Basix, no mesh: single cells mapped affinely to physical space.
 """

@@ -2,6 +2,7 @@
 link of README.md and the docs pages resolves to a file of the checkout (and a heading of
 it, for a ``#anchor``), as it does on the site."""
 
+import ast
 import importlib.util
 import pathlib
 import re
@@ -11,6 +12,8 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 PAGES += sorted((ROOT / "docs" / "generated").glob("*.md"))
+#: The hand-written pages of docs/
+DOCS = sorted((ROOT / "docs").glob("*.md"))
 #: ``[text](target)`` and ``![alt](target)`` of markdown, outside code
 LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")
 FENCE = re.compile(r"^(`{3,}|~{3,})")
@@ -94,3 +97,95 @@ def test_link_check_finds_a_broken_link(tmp_path):
 def test_generated_pages_current():
     """``docs/generated/`` is what ``python docs/reference.py`` writes (run it if not)."""
     assert _reference().stale_pages() == []
+
+
+#: An issue number ("issue 26", "issues 11", "(#26)"): history belongs to git
+ISSUE = re.compile(r"\bissues?\s+#?\d+|\(#\d+\)", re.IGNORECASE)
+#: A commit hash: 7 to 40 hex digits with a letter and a digit, not part of a number
+#: (``6.263744e-3``) or a word
+COMMIT = re.compile(r"(?<![.\w-])(?=[0-9a-f]*[a-f])(?=[0-9a-f]*\d)[0-9a-f]{7,40}(?![\w.-])")
+SOURCES = sorted(
+    p
+    for folder in ("xfem_contact", "bench", "tests", "docs")
+    for p in (ROOT / folder).rglob("*.py")
+    if p.name != "test_docs.py"
+)
+
+#: The nodes that carry a docstring besides the module
+DOCUMENTED = (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)
+
+
+def history(text: str) -> list[str]:
+    """The issue numbers and commit hashes in ``text``, each as ``line: match``."""
+    return [
+        f"{number}: {m.group(0)}"
+        for number, line in enumerate(text.splitlines(), start=1)
+        for m in [*ISSUE.finditer(line), *COMMIT.finditer(line)]
+    ]
+
+
+def docstrings(path: pathlib.Path) -> str:
+    """The docstrings of a Python file (module, classes, functions), one after another."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    nodes = [tree, *(n for n in ast.walk(tree) if isinstance(n, DOCUMENTED))]
+    return "\n".join(ast.get_docstring(n) or "" for n in nodes)
+
+
+@pytest.mark.parametrize("page", PAGES, ids=[str(p.relative_to(ROOT)) for p in PAGES])
+def test_page_has_no_history(page):
+    """Docs say what the code does today: no issue numbers, no commit hashes."""
+    assert history(page.read_text(encoding="utf-8")) == []
+
+
+def test_code_has_no_history():
+    """No issue number in any source or comment, no commit hash in a docstring."""
+    found = []
+    for path in SOURCES:
+        text = path.read_text(encoding="utf-8")
+        found += [f"{path.relative_to(ROOT)}:{m}" for m in history(text) if "issue" in m.lower()]
+        found += [f"{path.relative_to(ROOT)} (docstring) {m}" for m in history(docstrings(path))]
+    assert found == []
+
+
+def test_history_check_finds_issues_and_hashes():
+    text = "fixed in issue 26 (#12), at 79f8539, error 6.263744e-3, 1234567 dofs, cafe"
+    assert [m.split(": ", 1)[1] for m in history(text)] == ["issue 26", "(#12)", "79f8539"]
+
+
+#: A measured figure in a table: a number in exponent form, or with a unit of time,
+#: memory or a percentage
+MEASURED = re.compile(r"\d(\.\d+)?e-?\d+|\d\s?(s|MB|GB|%)(?![\w])")
+
+
+def unmarked_tables(text: str) -> list[int]:
+    """The first lines of the tables of ``text`` that hold measured figures but are
+    neither marked as a static example nor pointed at a generated page in the text of
+    their section before them."""
+    lines, found, start = text.splitlines(), [], 0
+    for number, line in enumerate(lines):
+        if line.startswith("#"):
+            start = number
+        if line.startswith("|") and not (number and lines[number - 1].startswith("|")):
+            table = []
+            for row in lines[number:]:
+                if not row.startswith("|"):
+                    break
+                table.append(row)
+            before = "\n".join(lines[start:number])
+            marked = "static example" in before or "generated/" in before
+            if MEASURED.search("\n".join(table)) and not marked:
+                found.append(number + 1)
+    return found
+
+
+@pytest.mark.parametrize("page", DOCS, ids=[str(p.relative_to(ROOT)) for p in DOCS])
+def test_measured_tables_are_generated_or_marked(page):
+    """Every table of measured figures is a generated page's or marked as a static
+    example (with the command that printed it)."""
+    assert unmarked_tables(page.read_text(encoding="utf-8")) == []
+
+
+def test_table_check_finds_an_unmarked_table():
+    text = "# Page\n\n| n | time |\n|---|---|\n| 8 | 1.2 s |\n\n## Marked\n\n"
+    text += "A static example:\n\n| n | error |\n|---|---|\n| 8 | 1e-3 |\n"
+    assert unmarked_tables(text) == [3]

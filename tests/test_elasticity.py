@@ -15,10 +15,10 @@ from xfem_contact.cases.paper import (
     straight_interface_exact,
     straight_interface_problem,
 )
-from xfem_contact.fem.restriction import restriction_matrix
+from xfem_contact.fem.prolongation import prolongation_matrix
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.presets import ElasticityProblem
-from xfem_contact.solvers.linear import assemble_restricted, solve_restricted
+from xfem_contact.solvers.linear import assemble_reduced, solve_reduced
 
 
 def integrate(expr):
@@ -118,8 +118,8 @@ def condition_number(eta, degree, n=6):
     cut = xfem_contact.CutMesh(mesh, lambda x: x[1] - y0, degree=1)
     problem = ElasticityProblem(cut, degree, Material(1.0, 0.3), "free")
     problem.loads.add_displacement(lambda x: np.isclose(x[1], 0.0) | np.isclose(x[1], 1.0), 0.0)
-    R = restriction_matrix(problem.space)
-    A, b = assemble_restricted(
+    R = prolongation_matrix(problem.space)
+    A, b = assemble_reduced(
         xfem_contact.form(problem.bilinear_form()),
         xfem_contact.form(problem.loads.linear_form()),
         problem.loads.bcs,
@@ -149,9 +149,9 @@ def test_solve_with_a_given_restriction_operator():
     problem.loads.add_displacement(lambda x: np.isclose(x[1], 1.0), 0.01)
     a = xfem_contact.form(problem.bilinear_form())
     L = xfem_contact.form(problem.loads.linear_form())
-    w, _ = solve_restricted(a, L, problem.loads.bcs, problem.space)
-    R = restriction_matrix(problem.space)
-    w_R, reason = solve_restricted(a, L, problem.loads.bcs, problem.space, R=R)
+    w, _ = solve_reduced(a, L, problem.loads.bcs, problem.space)
+    R = prolongation_matrix(problem.space)
+    w_R, reason = solve_reduced(a, L, problem.loads.bcs, problem.space, R=R)
     assert reason > 0
     scale = mesh.comm.allreduce(np.abs(w.x.array).max(), op=MPI.MAX)
     assert scale > 0.0

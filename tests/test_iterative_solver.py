@@ -3,7 +3,7 @@
 GMRES with the band multigrid (``LINEAR_PRESETS["iterative"]``): the band and the
 displacement split cover what they should, the interpolation from the vertices is
 exact on bilinear fields, the Krylov iterations are reported and do not grow with N,
-and a scene selects the preset with ``[solver] linear``.
+and a scene selects the preset with ``[solver] preset``.
 """
 
 import numpy as np
@@ -85,11 +85,11 @@ def test_krylov_iterations_do_not_grow(degree, bound):
 
 
 def test_scene_selects_the_preset():
-    scene = load_scene(base(law="sticking") | {"solver": {"linear": "iterative"}})
+    scene = load_scene(base(law="sticking") | {"solver": {"preset": "iterative"}})
     assert scene.petsc_options["pc_type"] == "python"
     assert load_scene(base(law="sticking")).petsc_options.get("pc_type") is None
-    with pytest.raises(SceneError, match=r"solver.linear.*direct"):
-        load_scene(base(law="sticking") | {"solver": {"linear": "multigrid"}})
+    with pytest.raises(SceneError, match=r"solver.preset.*direct"):
+        load_scene(base(law="sticking") | {"solver": {"preset": "multigrid"}})
     with pytest.raises(ValueError, match="Unknown solver preset 'cg'"):
         preset("cg")
     assert set(LINEAR_PRESETS) == {"direct", "iterative"}
@@ -127,7 +127,7 @@ def test_a_bonded_interface_beside_a_contact_one():
 
     path = pathlib.Path(xfem_contact.scenes.__file__).parent / "two_inclusions.toml"
     data = tomllib.loads(path.read_text())
-    data["solver"] = data.get("solver", {}) | {"linear": "iterative"}
+    data["solver"] = data.get("solver", {}) | {"preset": "iterative"}
     scene = load_scene(data)
     problem = build(scene)
     problem = problem[0] if isinstance(problem, tuple) else problem

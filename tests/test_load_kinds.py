@@ -16,7 +16,7 @@ METHODS = {
     "point_displacement": "add_point_displacement",
     "body_force": "add_body_force",
     "rotation": "add_rotation",
-    "tangential_support": "add_tangential_spring",
+    "tangential_spring": "add_tangential_spring",
 }
 
 
@@ -38,13 +38,13 @@ def test_each_row_adds_its_load(kind):
     loads = _Recorder()
     loads.calls = []
     spec = LoadSpec("top", kind, 1.0, component=0, point=(0.0, 0.0))
-    LOAD_KINDS[kind].add(loads, spec, 1.0, {"history": None})
+    LOAD_KINDS[kind].add(loads, spec, 1.0, {"path": None})
     assert loads.calls == [METHODS[kind]]
 
 
 @pytest.mark.parametrize(
     ("kind", "value"),
-    [("pressure", [1.0, 2.0]), ("traction", 1.0), ("rotation", "x"), ("tangential_support", 0.0)],
+    [("pressure", [1.0, 2.0]), ("traction", 1.0), ("rotation", "x"), ("tangential_spring", 0.0)],
 )
 def test_each_row_checks_the_form_of_its_value(kind, value):
     with pytest.raises(SceneError, match=r"^loads\[0\]\.value: "):

@@ -14,7 +14,7 @@ from test_scenes import base
 from xfem_contact.cases.paper import INCLUSION_CENTRE, inclusion_problem, integrate
 from xfem_contact.fem import forms
 from xfem_contact.io.meshes import annulus
-from xfem_contact.mechanics.loads import History, load_steps, named_parts
+from xfem_contact.mechanics.loads import LoadPath, load_steps, named_parts
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.plain import PlainElasticityProblem
 from xfem_contact.scenes.builder import build
@@ -61,8 +61,8 @@ def test_a_value_change_compiles_nothing_and_changes_the_solution(plain):
 def test_each_load_follows_its_path(plain):
     loads = plain.loads
     loads.add_stage("late", 1.0, 3.0)
-    ramp = loads.add_displacement("top", (0.0, 1e-3), history=[(0, 0), (1, 1), (2, 1)])
-    late = loads.add_displacement("left", 2e-3, component=0, history="late")
+    ramp = loads.add_displacement("top", (0.0, 1e-3), path=[(0, 0), (1, 1), (2, 1)])
+    late = loads.add_displacement("left", 2e-3, component=0, path="late")
     default = loads.add_point_displacement([1.0, 0.0], 1e-3, 1)
     for t, factors in ((0.5, (0.5, 0.0, 0.5)), (2.0, (1.0, 0.5, 2.0)), (4.0, (1.0, 1.0, 4.0))):
         loads.set_time(t)
@@ -74,7 +74,7 @@ def test_each_load_follows_its_path(plain):
             assert np.isclose(values.max(), factor * full, rtol=1e-12, atol=0)
     assert loads.end_time == 3.0
     assert np.allclose(load_steps(4, 2.0), [0.5, 1.0, 1.5, 2.0])
-    assert History([(0, 0), (1, 2)])(0.25) == 0.5 and History()(0.3) == 0.3
+    assert LoadPath([(0, 0), (1, 2)])(0.25) == 0.5 and LoadPath()(0.3) == 0.3
 
 
 @pytest.mark.parametrize(
@@ -94,8 +94,8 @@ def test_each_load_follows_its_path(plain):
         (lambda L: L.add_rotation("top", angle_deg=np.inf), "angle_deg must be a finite"),
         (lambda L: L.add_rotation("top"), "Give the rotation as angle= (rad) or angle_deg="),
         (lambda L: L.add_tangential_spring("top", -1.0), "a finite number > 0 Pa/m"),
-        (lambda L: L.add_pressure("top", 1.0, history=[(1, 0), (0, 1)]), "increase strictly"),
-        (lambda L: L.add_pressure("top", 1.0, history="never"), "Unknown load stage 'never'"),
+        (lambda L: L.add_pressure("top", 1.0, path=[(1, 0), (0, 1)]), "increase strictly"),
+        (lambda L: L.add_pressure("top", 1.0, path="never"), "Unknown load stage 'never'"),
         (lambda L: L.set_time(np.inf), "t must be a finite number"),
     ],
 )
@@ -136,7 +136,7 @@ def test_coulomb_inclusion_depends_on_the_load_path():
         loads.add_stage("compress", 0.0, 1.0)
         loads.add_stage("shear", 1.0, 2.0)
         shear = [
-            loads.add_traction(part, value, history="shear")
+            loads.add_traction(part, value, path="shear")
             for part, value in (
                 ("top", (tau, 0.0)),
                 ("bottom", (-tau, 0.0)),
@@ -144,12 +144,12 @@ def test_coulomb_inclusion_depends_on_the_load_path():
                 ("left", (0.0, -tau)),
             )
         ]
-        weight = loads.add_body_force((0.0, -5.0), side=-1, history="compress")
+        weight = loads.add_body_force((0.0, -5.0), side=-1, path="compress")
         for load in loads.items:
             if load.kind == "pressure":
-                load.history = History([(0.0, 0.0), (1.0, 1.0)])
+                load.path = LoadPath([(0.0, 0.0), (1.0, 1.0)])
             if path == "proportional" and load.kind != "point displacement":
-                load.history = History([(0.0, 0.0), (2.0, 1.0)])
+                load.path = LoadPath([(0.0, 0.0), (2.0, 1.0)])
         assert len(shear) == 4 and weight.value == (0.0, -5.0)
         for t in steps:
             problem.accept_step()  # the last step's state is checked before its accept
@@ -194,8 +194,8 @@ def test_a_scene_without_interfaces_takes_every_load_type():
     data = base()
     data["loads"] += [
         {"part": "right", "type": "rotation", "angle_deg": 1.0, "centre": [1.0, 0.5]},
-        {"part": "left", "type": "tangential_support", "value": 1e9},
-        {"type": "body_force", "value": [0.0, -1e3], "history": [[0, 0], [2, 1]]},
+        {"part": "left", "type": "tangential_spring", "value": 1e9},
+        {"type": "body_force", "value": [0.0, -1e3], "path": [[0, 0], [2, 1]]},
     ]
     scene = load_scene(data)
     problem, _ = build(scene)
@@ -212,8 +212,8 @@ def test_a_scene_without_interfaces_takes_every_load_type():
 def test_scene_load_paths_and_stages():
     data = base(law="bonded")
     data["stages"] = {"first": [0, 1], "second": [1, 2]}
-    data["loads"][1]["history"] = "first"
-    data["loads"].append({"part": "right", "type": "pressure", "value": 2.0, "history": "second"})
+    data["loads"][1]["path"] = "first"
+    data["loads"].append({"part": "right", "type": "pressure", "value": 2.0, "path": "second"})
     data["solver"] = {"load_steps": 2, "end_time": 2.0}
     scene = load_scene(data)
     assert scene.stages == {"first": (0.0, 1.0), "second": (1.0, 2.0)} and scene.end_time == 2.0
@@ -228,10 +228,10 @@ def test_scene_load_paths_and_stages():
 @pytest.mark.parametrize(
     "change, key, message",
     [
-        ({"history": "third"}, "loads[1].history", "'third': no such stage; known: ['first']"),
-        ({"history": [[1, 0], [0, 1]]}, "loads[1].history", "times must increase strictly"),
-        ({"history": [[0, 0, 1]]}, "loads[1].history[0]", "expected a list of 2 entries"),
-        ({"history": 3}, "loads[1].history", "expected a stage name or a list of [time, factor]"),
+        ({"path": "third"}, "loads[1].path", "'third': no such stage; known: ['first']"),
+        ({"path": [[1, 0], [0, 1]]}, "loads[1].path", "times must increase strictly"),
+        ({"path": [[0, 0, 1]]}, "loads[1].path[0]", "expected a list of 2 entries"),
+        ({"path": 3}, "loads[1].path", "expected a stage name or a list of [time, factor]"),
         ({"part": "top", "type": "rotation"}, "loads[1].value", "value (rad) or angle_deg"),
     ],
 )

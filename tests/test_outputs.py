@@ -106,7 +106,7 @@ def test_forces_at_a_state_are_those_of_the_problem_solved_to_it(law, options):
     """The balance at a state ``w`` other than the problem's solution is that of the
     problem solved to ``w``: every term (bulk, laws, springs) is evaluated at ``w``."""
     data = plate(law, **options)
-    data["loads"].append({"part": "left", "type": "tangential_support", "value": 1e9})
+    data["loads"].append({"part": "left", "type": "tangential_spring", "value": 1e9})
     problem = solved(data)
     half = problem.w.copy()
     at_half = balance(problem, problem.w)
@@ -127,11 +127,11 @@ def test_forces_at_a_state_are_those_of_the_problem_solved_to_it(law, options):
 
 def test_spring_supports_are_reactions():
     data = plate("sticking")
-    data["loads"].append({"part": "left", "type": "tangential_support", "value": 1e9})
+    data["loads"].append({"part": "left", "type": "tangential_spring", "value": 1e9})
     problem = solved(data)
     forces = balance(problem, problem.w)
-    assert set(forces["reactions"]) == {"bottom", "tangential_supports"}
-    assert np.abs(forces["reactions"]["tangential_supports"]).max() > 1e3  # it carries load
+    assert set(forces["reactions"]) == {"bottom", "tangential_springs"}
+    assert np.abs(forces["reactions"]["tangential_springs"]).max() > 1e3  # it carries load
     assert forces["balance_relative"] < BALANCE, forces
 
 

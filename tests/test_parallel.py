@@ -37,7 +37,7 @@ CASES = {
     "case3 turned, large sliding P2": lambda comm: rotating_annulus_problem(6, 2, 0.3, comm=comm),
     "case3 turned, large sliding P1": lambda comm: rotating_annulus_problem(6, 1, 0.3, comm=comm),
     "case3 turned, large sliding Coulomb": lambda comm: rotating_annulus_problem(
-        6, 2, 0.3, law="coulomb", friction=0.3, outer="tangential", comm=comm
+        6, 2, 0.3, law="coulomb", friction=0.3, outer="tangential_spring", comm=comm
     ),
 }
 

@@ -5,7 +5,7 @@
   unknowns pair up) equals ``R^T A R`` by PtAP,
   bit for bit, and a prolongation in ``R`` takes the PtAP path;
 - the uncut cells assembled field by field on the fields' own spaces
-  (:func:`xfem_contact.fem.field_blocks.split_uncut`) give the same matrix, a term
+  (:func:`xfem_contact.fem.field_blocks.uncut_field_blocks`) give the same matrix, a term
   coupling two fields there included, and so do the Newton residuals where the
   Dirichlet data are not met (the lifting);
 - the residual assembled as its parts (standard and runtime integrals,
@@ -26,11 +26,11 @@ from petsc4py import PETSc
 from xfem_contact.cases.paper import inclusion_problem
 from xfem_contact.codegen import kernel_store
 from xfem_contact.fem import forms
-from xfem_contact.fem.field_blocks import split_uncut
+from xfem_contact.fem.field_blocks import uncut_field_blocks
 from xfem_contact.fem.forms import form, form_parts
 from xfem_contact.fem.subspaces import collapse
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
-from xfem_contact.solvers.newton import RestrictedNewton
+from xfem_contact.solvers.newton import ReducedNewton
 
 
 @pytest.fixture(scope="module", params=["quadrilateral", "triangle"])
@@ -91,7 +91,7 @@ def test_collapse_matches_dolfinx(problem, field):
 
 def test_direct_assembly_equals_ptap(problem):
     """R^T J R straight into the reduced numbering: the same matrix as PtAP."""
-    J, R = _jacobian(problem), problem.restriction()
+    J, R = _jacobian(problem), problem.prolongation()
     reduced = ReducedMatrix(J, problem.loads.bcs, R)
     assert reduced.direct
     A = reduced.assemble()
@@ -113,7 +113,7 @@ def test_pattern_on_pairs_only_where_the_unknowns_pair_up(law, block_size):
     with the blocks switched off, the matrix is PtAP's."""
     options = {"friction": 0.3} if law == "coulomb" else {}
     problem = inclusion_problem(8, 2, law, **options)
-    J, R = _jacobian(problem), problem.restriction()
+    J, R = _jacobian(problem), problem.prolongation()
     full = dolfinx.fem.petsc.assemble_matrix(J, bcs=problem.loads.bcs)
     full.assemble()
     reference = full.PtAP(R)
@@ -139,7 +139,7 @@ def test_a_facet_term_coupling_two_fields_is_kept():
     v_plus = ufl.split(ufl.TestFunction(W))[1]
     extra = 1e6 * ufl.inner(ufl.avg(u_minus), ufl.avg(v_plus)) * ufl.dS
     J = form(ufl.derivative(problem.residual(problem.w), problem.w, ufl.TrialFunction(W)) + extra)
-    R = problem.restriction()
+    R = problem.prolongation()
     reduced = ReducedMatrix(J, problem.loads.bcs, R)
     A = reduced.assemble()
     without = ReducedMatrix(
@@ -176,9 +176,9 @@ def test_uncut_cells_on_the_fields_own_spaces(law, cell, blocked, coupled):
     if coupled:  # u_- tested with v_+ on the uncut cells of side -1 (inactive dofs aside)
         u_minus, v_plus = ufl.split(ufl.TrialFunction(W))[0], ufl.split(ufl.TestFunction(W))[1]
         J = J + 1e6 * ufl.inner(u_minus, v_plus) * problem.cut.dx(-1)
-    split = split_uncut(J, problem.space.field_space)
+    split = uncut_field_blocks(J, problem.space.field_space)
     assert [b.field for b in split.blocks] == [0, 1]  # the multipliers have no bulk
-    R = problem.restriction()
+    R = problem.prolongation()
     blocks = [(form(b.form), b.parent, True) for b in split.blocks]
     reduced = ReducedMatrix(form(split.rest), problem.loads.bcs, R, field_blocks=blocks)
     assert [b[2] for b in reduced._blocks] == [blocked, blocked]
@@ -201,9 +201,9 @@ def test_constant_blocks_are_added_from_their_copy(problem):
     state the matrix equals one assembled afresh there."""
     W = problem.space.W
     J = ufl.derivative(problem.residual(problem.w), problem.w, ufl.TrialFunction(W))
-    split = split_uncut(J, problem.space.field_space)
+    split = uncut_field_blocks(J, problem.space.field_space)
     blocks = [(form(b.form), b.parent, True) for b in split.blocks]
-    R, rest = problem.restriction(), form(split.rest)
+    R, rest = problem.prolongation(), form(split.rest)
     kept = ReducedMatrix(rest, problem.loads.bcs, R, field_blocks=blocks)
     kept.keep_constant_blocks()
     kept.assemble()  # keeps the copy
@@ -226,12 +226,12 @@ def test_split_newton_lifts_unmet_dirichlet_data():
     one without the split."""
     problem = inclusion_problem(8, 2, "sticking")
     problem.loads.add_displacement(lambda x: np.isclose(x[1], 0.0), 1e-4)  # not met by w = 0
-    R, bcs = problem.restriction(), problem.loads.bcs
+    R, bcs = problem.prolongation(), problem.loads.bcs
     solutions = []
     for field_space in (problem.space.field_space, None):
         problem.w.x.array[:] = 0.0
         F = problem.residual(problem.w)
-        newton = RestrictedNewton(F, problem.w, bcs, R, field_space=field_space)
+        newton = ReducedNewton(F, problem.w, bcs, R, field_space=field_space)
         assert (newton.jacobian_forms._whole is None) == (field_space is not None)
         newton._residual(None, newton.y, newton.F_r)  # at w = R y = 0
         x = problem.w.x.petsc_vec
@@ -269,7 +269,7 @@ def test_the_jacobian_keeps_its_structure_through_newton():
 def test_prolongation_takes_the_ptap_path():
     """lbb = restriction combines multiplier dofs: R is no selection."""
     problem = inclusion_problem(8, 2, "sticking", lbb="restriction")
-    R = problem.restriction()
+    R = problem.prolongation()
     assert selection(R, problem.space.W) is None
     J = _jacobian(problem)
     reduced = ReducedMatrix(J, problem.loads.bcs, R)
@@ -308,7 +308,7 @@ def test_first_jacobian_reused_only_at_its_state(monkeypatch):
     """Assembled once for the scaling: the first iterate at that state reuses it; a
     solver started from another state assembles again, and both give one answer."""
     from xfem_contact.solvers import assembly
-    from xfem_contact.solvers.newton import RestrictedNewton
+    from xfem_contact.solvers.newton import ReducedNewton
 
     calls = []
     original = assembly.ReducedMatrix.assemble
@@ -325,8 +325,8 @@ def test_first_jacobian_reused_only_at_its_state(monkeypatch):
     solution = problem.w.x.array.copy()
 
     problem.w.x.array[:] = 0.0
-    newton = RestrictedNewton(
-        problem.residual(problem.w), problem.w, problem.loads.bcs, problem.restriction()
+    newton = ReducedNewton(
+        problem.residual(problem.w), problem.w, problem.loads.bcs, problem.prolongation()
     )
     problem.w.x.array[:] = 0.5 * solution  # moved after the set-up assembly
     calls.clear()

@@ -194,7 +194,7 @@ BAD_SCENES = {
     "body force on a part": (
         add_load(part="top", type="body_force", value=[0, 1]),
         "loads[2].part",
-        "is not a key of a 'body_force' load (its keys: value, side, history)",
+        "is not a key of a 'body_force' load (its keys: value, side, path)",
     ),
     "side of a displacement": (
         set_in("loads", 0, "side", value=1),

@@ -16,7 +16,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from xfem_contact.cases.paper import inclusion_errors, inclusion_problem
-from xfem_contact.solvers.newton import RestrictedNewton
+from xfem_contact.solvers.newton import ReducedNewton
 from xfem_contact.solvers.symmetry import mark_symmetric
 
 
@@ -50,11 +50,11 @@ def test_coulomb_keeps_lu_and_its_jacobian_fails_the_guard():
     with pytest.raises(ValueError, match="needs a symmetric Jacobian"):
         problem.petsc_options = {"pc_type": "cholesky"}
         problem.solve()
-    newton = RestrictedNewton(
+    newton = ReducedNewton(
         problem.residual(problem.w),
         problem.w,
         problem.loads.bcs,
-        problem.restriction(),
+        problem.prolongation(),
         {"pc_type": "cholesky"},
         field_space=problem.space.field_space,
     )

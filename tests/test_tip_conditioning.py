@@ -25,7 +25,7 @@ import xfem_contact.mechanics.problem as problem_module
 from xfem_contact.cases.cracks import frictional_crack_case, williams_case
 from xfem_contact.fem.forms import form
 from xfem_contact.solvers.block_scaling import scaled, tip_transform
-from xfem_contact.solvers.linear import assemble_restricted, solve_restricted
+from xfem_contact.solvers.linear import assemble_reduced, solve_reduced
 
 BOUND = 1e6
 
@@ -33,9 +33,9 @@ BOUND = 1e6
 def factored_condition(problem) -> tuple[float, int]:
     """2-norm condition number of ``Z^T A Z``, the matrix the linear solve factors,
     without its null modes (eigenvalues below 1e-12 of the largest), and their number."""
-    R = problem.restriction()
+    R = problem.prolongation()
     a, L = form(problem.bilinear_form()), form(problem.loads.linear_form())
-    A, b = assemble_restricted(a, L, problem.loads.bcs, R)
+    A, b = assemble_reduced(a, L, problem.loads.bcs, R)
     Z = tip_transform(problem.space)(R, A)
     J = scaled(A, Z)
     eigenvalues = np.abs(np.linalg.eigvalsh(J.convert("dense").getDenseArray()))
@@ -81,7 +81,7 @@ def test_tip_scaling_keeps_the_linear_solution():
     problem = williams_case(8, 2, tip_radius=0.4).problem
     a, L = form(problem.bilinear_form()), form(problem.loads.linear_form())
     w = [
-        solve_restricted(a, L, problem.loads.bcs, problem.space, tip_scaling=on)[0]
+        solve_reduced(a, L, problem.loads.bcs, problem.space, tip_scaling=on)[0]
         for on in (True, False)
     ]
     assert relative_difference(problem, *w) < 1e-9

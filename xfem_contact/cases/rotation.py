@@ -14,6 +14,7 @@ model comes from the axisymmetric problem, a radial ODE integrated to round-off
 from __future__ import annotations
 
 import functools
+import warnings
 
 import numpy as np
 from mpi4py import MPI
@@ -30,7 +31,7 @@ from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.problem import Problem
 
 #: Ways of removing the outer ring's spin
-OUTER_SUPPORTS = ("point", "tangential")
+OUTER_SUPPORTS = ("point", "tangential_spring")
 
 
 def _radial_stress(e_r, e_t, mu, lmbda):
@@ -131,8 +132,9 @@ def rotating_annulus_problem(
         alpha: Rotation of ``r = 3`` (rad), ramped with the load factor together with
             the pressure.
         law: ``frictionless`` (or ``coulomb`` with ``friction``) in large sliding.
-        outer: ``"point"`` (``u_y = 0`` at (20, 0)) or ``"tangential"`` (``u_t = 0``
-            along ``r = 20``, a spring of 1000 E / h).
+        outer: ``"point"`` (``u_y = 0`` at (20, 0)) or ``"tangential_spring"``
+            (``u_t = 0`` along ``r = 20``, a spring of 1000 E / h); ``"tangential"`` is
+            its deprecated name.
         quadrature_degree: Of the cut's rules (the cut's default 6), i.e. of each
             slave (sub-)segment's Gauss rule.
         segments: Segment-to-segment integration of the hybrid elements (the slave
@@ -145,6 +147,14 @@ def rotating_annulus_problem(
     """
     from xfem_contact.io.meshes import annulus
 
+    if outer == "tangential":
+        warnings.warn(
+            'outer="tangential" is deprecated and will be removed in the next release: '
+            'use outer="tangential_spring"',
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        outer = "tangential_spring"
     if outer not in OUTER_SUPPORTS:
         raise ValueError(f"Unknown outer support {outer!r}; valid: {OUTER_SUPPORTS}")
     problem_keys = ("pairing", "slave", "ghost_penalty", "min_support_fraction")

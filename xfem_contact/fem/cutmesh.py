@@ -62,7 +62,7 @@ class CutMesh:
             with the same names (``psi = None``: a closed interface), cut as one pair
             (:mod:`xfem_contact.geometry.crack_union`, ``crack.union``), each with its
             own measure.
-        tip_points: Gauss points per direction of a tip cell's Duffy rules (K: 12 too few).
+        tip_points: Gauss points per direction of a tip cell's Duffy rules.
 
     Example:
         >>> cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 0.5)
@@ -324,7 +324,7 @@ class CutMesh:
     def split_side_measure(self, subdomain_id: int) -> tuple[int, int] | None:
         """For the id of a side measure (:meth:`dx`): the ids of its two parts, the
         uncut cells (standard rule) and the cut cells (runtime rules), whose sum it is;
-        ``None`` for other ids. For :func:`xfem_contact.fem.field_blocks.split_uncut`."""
+        ``None`` for other ids. For :func:`xfem_contact.fem.field_blocks.uncut_field_blocks`."""
         return _SPLIT.get(subdomain_id)
 
     @property

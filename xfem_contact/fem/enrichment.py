@@ -5,7 +5,7 @@ field as one displacement per side, ``u = u_-`` on side -1 and ``u = u_+`` on
 side +1, each living on the cells its side touches. We use the latter: a mixed
 space ``(u_-, u_+[, lambda])`` whose dofs outside the support of their side (or,
 for the multiplier, outside the cut cells) are *inactive* and removed from every
-solve by the restriction operator of :mod:`xfem_contact.fem.restriction`: the
+solve by the prolongation of :mod:`xfem_contact.fem.prolongation`: the
 system has exactly standard + enriched dofs.
 """
 
@@ -72,8 +72,8 @@ class EnrichedSpace:
             logged warning.
 
     A crack's multipliers live on the vertices of the cells it crosses (none on a tip
-    cell's own: the lips' traction there oscillated, K_I of a closed crack 0.23 instead
-    of 0.07 K_II). A crack (see :mod:`xfem_contact.fem.crack_cut`) adds a last field, the branch
+    cell's own: the lips' traction there oscillates, ``docs/crack_enrichment.md``). A crack
+    (see :mod:`xfem_contact.fem.crack_cut`) adds a last field, the branch
     dofs ``b`` (Lagrange ``degree``, ``4 gdim`` components), and ties the two sides'
     dofs of every node whose support the crack does not cut completely (it holds a tip
     or the crack's extension): one unknown for both in the reduced system
@@ -84,7 +84,7 @@ class EnrichedSpace:
     distances). With a ``tip_radius``, ``R`` is the :attr:`ramp` (corrected X-FEM, Fries
     2008): the P1 function 1 on the vertices within the radius, 0 on the others; every
     node of the cells where ``R > 0`` has branch dofs, so ``R F_k`` is in the space and
-    no cell blends (Griffith, P2, h = a/8: K_I error 5.7e-5 -> 1.4e-5). ``R = 1``
+    no cell blends. ``R = 1``
     without a radius (topological).
     """
 

@@ -3,13 +3,13 @@
 On the uncut cells of side ``s`` a Jacobian on ``W = (u_-, u_+, lambda, ...)`` is the
 bulk of side ``s`` alone, yet assembled on ``W`` every one of those cells' element
 matrices spans all the fields around a much smaller nonzero block, each entry sent
-through the mixed space's dof map. :func:`split_uncut` takes the uncut-cell integrals
+through the mixed space's dof map. :func:`uncut_field_blocks` takes the uncut-cell integrals
 of the side measures (:meth:`CutMesh.dx <xfem_contact.fem.cutmesh.CutMesh.dx>`) out of
 the form: the diagonal block of each field, ``a(P_i u, P_i v)``, becomes a form on that
 field's own space ``V_i``, which DOLFINx assembles as a plain vector form (2 x 2 blocks
 inserted at once); what couples two fields on those cells (nothing, for the bulk models
 here) stays on ``W`` with the cut cells. Interior-facet integrals (the ghost penalty)
-are split the same way. The sum of the pieces is the form.
+are separated the same way. The sum of the pieces is the form.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ class FieldBlock(typing.NamedTuple):
     parent: npt.NDArray[np.int32]
 
 
-class Split(typing.NamedTuple):
+class FieldBlocks(typing.NamedTuple):
     """``a`` as ``rest`` (UFL, bilinear on ``W``: cut cells, interface, facets and any
     cross-field term of the uncut cells) plus the :class:`FieldBlock` forms."""
 
@@ -83,11 +83,11 @@ def _empty(form: ufl.Form) -> bool:
     return expand_derivatives(form).empty()
 
 
-def split_uncut(
+def uncut_field_blocks(
     a: ufl.Form,
     field_space: Callable[[int], tuple[dolfinx.fem.FunctionSpace, npt.NDArray[np.int32]]],
-) -> Split | None:
-    """Split the bilinear form ``a`` (test and trial on one mixed space ``W``) into the
+) -> FieldBlocks | None:
+    """Separate the bilinear form ``a`` (test and trial on one mixed space ``W``) into the
     diagonal field blocks of its uncut-cell and interior-facet integrals (the ghost
     penalty) and the rest (see the module docstring).
 
@@ -100,7 +100,7 @@ def split_uncut(
             (collectively) for the fields that have a block.
 
     Returns:
-        The :class:`Split`, or ``None`` when there is nothing to split (``W`` is not
+        The :class:`FieldBlocks`, or ``None`` when there is no field block (``W`` is not
         mixed, or ``a`` integrates no side measure). Collective when
         ``field_space`` is.
     """
@@ -145,4 +145,4 @@ def split_uncut(
         cross = block(i, j, trial, test)
         if not _empty(cross):
             rest += cross
-    return Split(rest, blocks)
+    return FieldBlocks(rest, blocks)

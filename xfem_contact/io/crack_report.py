@@ -109,7 +109,7 @@ def load_words(loads, t: float | None = None) -> str:
         unit = LOAD_UNITS.get(load.kind)
         if unit is None:
             continue
-        factor, value = load.history(t), load.value
+        factor, value = load.path(t), load.value
         if callable(value) or isinstance(value, dict):
             shown = "an expression" if callable(value) else "a value per side"
             shown += f" x {factor:.4g}"

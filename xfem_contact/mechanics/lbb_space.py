@@ -8,7 +8,7 @@ import numpy as np
 from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
-from xfem_contact.fem.restriction import MultiplierProlongation
+from xfem_contact.fem.prolongation import MultiplierProlongation
 from xfem_contact.geometry.crack import NONE
 from xfem_contact.mechanics import lbb as lbb_module
 

@@ -4,8 +4,8 @@
 field per law that needs one), the bulk model of each side, the loads and the
 Dirichlet data, and composes the interface laws (:mod:`xfem_contact.mechanics.laws`):
 the residual is the bulk's plus each law's terms minus the loads. Linear laws: one KSP
-solve; contact laws: generalized Newton (SNES), on the active dofs of the restriction
-``R`` (:mod:`xfem_contact.fem.restriction`). SI units (Pa, m)."""
+solve; contact laws: generalized Newton (SNES), on the active dofs of the prolongation
+``R`` (:mod:`xfem_contact.fem.prolongation`). SI units (Pa, m)."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ from xfem_contact.fem.cut_state import CutState
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.forms import form
-from xfem_contact.fem.restriction import restriction_matrix
+from xfem_contact.fem.prolongation import prolongation_matrix
 from xfem_contact.mechanics.bulk import BULK_MODELS, KINEMATICS, cell_size, check_ghosts
 from xfem_contact.mechanics.composition import Materials, interface_laws, side_and_law_materials
 from xfem_contact.mechanics.contexts import interface_context, samples, status_counts
@@ -32,14 +32,14 @@ from xfem_contact.mechanics.loads import Loads, SideFields
 from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
 from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
-from xfem_contact.solvers.linear import solve_restricted, tip_transform
+from xfem_contact.solvers.linear import solve_reduced, tip_transform
 from xfem_contact.solvers.log_lines import lines_to
-from xfem_contact.solvers.newton import NewtonFailure, RestrictedNewton, weak_method
+from xfem_contact.solvers.newton import NewtonFailure, ReducedNewton, weak_method
 from xfem_contact.solvers.options import (
     Facts,
     checked_prefix,
     problem_options,
-    splits_fields,
+    uses_fieldsplit,
 )
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 
@@ -132,7 +132,7 @@ class Problem:
         #: The last accepted load step (its jump is the origin of incremental slips)
         self.w_old = dolfinx.fem.Function(self.space.W, name="w_old")
         self._law_materials = side_materials.laws
-        self._newton: RestrictedNewton | None = None
+        self._newton: ReducedNewton | None = None
         self._newton_loads: int | None = None
         self._options_changed = False
         self._last_report: SolveReport | None = None
@@ -292,15 +292,25 @@ class Problem:
         return self.laws[name].multipliers(self.contexts[name].fields(fields))
 
     # -- solve -----------------------------------------------------------------------
-    def restriction(self):
-        """The restriction operator ``R`` (full x reduced) of the active dofs and the
+    def prolongation(self):
+        """The prolongation ``R`` (full x reduced, ``x = R y``) of the active dofs and the
         laws' multiplier prolongations. Collective."""
         prolongations = [
             p
             for name, law in self.laws.items()
             if (p := law.prolongation(self.contexts[name], self.space)) is not None
         ]
-        return restriction_matrix(self.space, combine_prolongations(prolongations, self.mesh.comm))
+        return prolongation_matrix(self.space, combine_prolongations(prolongations, self.mesh.comm))
+
+    def restriction(self):
+        """Deprecated name of :meth:`prolongation` (it returns ``R`` with ``x = R y``)."""
+        warnings.warn(
+            "Problem.restriction() is deprecated and will be removed in the next release: "
+            "use Problem.prolongation() (the same matrix R, x = R y)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return self.prolongation()
 
     def solve(
         self, petsc_options: dict | None = None, log: Callable[[str], None] | None = None
@@ -368,7 +378,7 @@ class Problem:
             a, L = form(self.bilinear_form()), form(self.loads.linear_form())
             timer, residuals = phase("linear solve"), []
             try:
-                w, reason = solve_restricted(
+                w, reason = solve_reduced(
                     a,
                     L,
                     self.loads.bcs,
@@ -394,12 +404,12 @@ class Problem:
             self._newton.destroy()  # loads or solver options changed since it was built
             self._newton = None
         if self._newton is None:
-            split = splits_fields(petsc_options)
-            self._newton = RestrictedNewton(
+            split = uses_fieldsplit(petsc_options)
+            self._newton = ReducedNewton(
                 self.residual(self.w),
                 self.w,
                 self.loads.bcs,
-                self.restriction(),
+                self.prolongation(),
                 petsc_options,
                 self.petsc_options_prefix,
                 status=weak_method(self.interface_status),
@@ -436,7 +446,7 @@ class Problem:
         return {} if self._newton is None else dict(self._newton.timings)
 
     @property
-    def newton(self) -> RestrictedNewton | None:
+    def newton(self) -> ReducedNewton | None:
         """The Newton solver of the contact solves (its ``snes``, the reduced Jacobian
         ``J_r``, ``options``), kept between solves; None before the first or after the
         cut changed (it is rebuilt at the next solve after the loads or the options)."""

@@ -205,7 +205,7 @@ def balance(problem, w: dolfinx.fem.Function) -> dict:
     vec.destroy()
     springs = spring_reactions(problem, w)
     if springs is not None:
-        held["tangential_supports"] = springs
+        held["tangential_springs"] = springs
     loads, size = applied_loads(problem)
     total = sum(held.values(), np.zeros(2)) + loads
     scale = max([size, *(np.abs(r).max() for r in held.values()), 0.0])

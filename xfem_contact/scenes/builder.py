@@ -216,4 +216,4 @@ def _apply(loads, load) -> None:
     """Add one scene load to a problem's :class:`~xfem_contact.mechanics.loads.Loads`
     (its type's row of :data:`~xfem_contact.scenes.load_kinds.LOAD_KINDS`)."""
     value = None if load.value is None else _value(load.value)
-    LOAD_KINDS[load.type].add(loads, load, value, {"history": load.history})
+    LOAD_KINDS[load.type].add(loads, load, value, {"path": load.path})

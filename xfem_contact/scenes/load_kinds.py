@@ -57,7 +57,7 @@ class LoadKind(typing.NamedTuple):
         add: ``add(loads, spec, value, path)``: adds the load of the checked ``spec``
             (:class:`~xfem_contact.scenes.records.LoadSpec`) to ``loads``; ``value`` is
             the spec's value made a number, tuple or callable, ``path`` the keyword
-            arguments of its load path (``{"history": ...}``).
+            arguments of its load path (``{"path": ...}``).
     """
 
     required: tuple[str, ...]
@@ -70,19 +70,19 @@ class LoadKind(typing.NamedTuple):
 LOAD_KINDS: dict[str, LoadKind] = {
     "pressure": LoadKind(
         ("part", "value"),
-        ("side", "history"),
+        ("side", "path"),
         _scalar_load,
         lambda loads, load, value, path: loads.add_pressure(load.part, value, load.side, **path),
     ),
     "traction": LoadKind(
         ("part", "value"),
-        ("side", "history"),
+        ("side", "path"),
         _vector_load,
         lambda loads, load, value, path: loads.add_traction(load.part, value, load.side, **path),
     ),
     "displacement": LoadKind(
         ("part", "value"),
-        ("component", "history"),
+        ("component", "path"),
         _displacement,
         lambda loads, load, value, path: loads.add_displacement(
             load.part, value, load.component, **path
@@ -90,7 +90,7 @@ LOAD_KINDS: dict[str, LoadKind] = {
     ),
     "point_displacement": LoadKind(
         ("point", "component", "value"),
-        ("history",),
+        ("path",),
         _number,
         lambda loads, load, value, path: loads.add_point_displacement(
             load.point, float(load.value), int(load.component), **path
@@ -98,14 +98,12 @@ LOAD_KINDS: dict[str, LoadKind] = {
     ),
     "body_force": LoadKind(
         ("value",),
-        ("side", "history"),
+        ("side", "path"),
         _vector_load,
         lambda loads, load, value, path: loads.add_body_force(value, load.side, **path),
     ),
-    "rotation": LoadKind(
-        ("part",), ("value", "angle_deg", "centre", "history"), _number, _rotation
-    ),
-    "tangential_support": LoadKind(
+    "rotation": LoadKind(("part",), ("value", "angle_deg", "centre", "path"), _number, _rotation),
+    "tangential_spring": LoadKind(
         ("part", "value"),
         (),
         _stiffness,

@@ -1,15 +1,24 @@
 """The [[loads]] of a scene: each table checked against its type's keys, its part, the
-form of its value and the stage its history names (:func:`load_spec`)."""
+form of its value and the stage its load path names (:func:`load_spec`). Deprecated keys
+and types are read under their new names (:func:`~xfem_contact.scenes.schema.renamed`)."""
 
 from __future__ import annotations
 
 from xfem_contact.scenes.load_kinds import LOAD_KINDS
-from xfem_contact.scenes.schema import FIELDS, LOAD_KEYS, LoadSpec, SceneError, check_table
+from xfem_contact.scenes.schema import (
+    FIELDS,
+    LOAD_KEYS,
+    LoadSpec,
+    SceneError,
+    check_table,
+    renamed,
+)
 
 
 def load_spec(table, where: str, known_parts: set, stages: dict) -> LoadSpec:
     """A load from its checked table: the keys of its type, its part, the form of its
-    value, the stage its history names."""
+    value, the stage its load path names."""
+    table = renamed(table, "load", where)
     check_table(table, FIELDS["load"], where)
     kind = table["type"]
     required, optional = LOAD_KEYS[kind]
@@ -29,10 +38,10 @@ def load_spec(table, where: str, known_parts: set, stages: dict) -> LoadSpec:
         raise SceneError(f"{where}.value", "give the angle once: value (rad) or angle_deg")
     if "value" in table:
         LOAD_KINDS[kind].check(table["value"], "component" in table, f"{where}.value")
-    history = table.get("history")
-    if isinstance(history, str) and history not in stages:
-        message = f"{history!r}: no such stage; known: {sorted(stages)}"
-        raise SceneError(f"{where}.history", message)
+    path = table.get("path")
+    if isinstance(path, str) and path not in stages:
+        message = f"{path!r}: no such stage; known: {sorted(stages)}"
+        raise SceneError(f"{where}.path", message)
     return LoadSpec(
         part,
         kind,
@@ -41,6 +50,6 @@ def load_spec(table, where: str, known_parts: set, stages: dict) -> LoadSpec:
         table.get("component"),
         tuple(table["point"]) if "point" in table else None,
         tuple(table.get("centre", (0.0, 0.0))),
-        history if isinstance(history, str | None) else tuple(map(tuple, history)),
+        path if isinstance(path, str | None) else tuple(map(tuple, path)),
         table.get("angle_deg"),
     )

@@ -59,7 +59,7 @@ class LoadSpec:
     point: tuple | None = None
     centre: tuple = (0.0, 0.0)
     #: Load path: None (factor = t), ((t, factor), ...) or a stage name
-    history: object = None
+    path: object = None
     #: A rotation's angle in degrees (``value`` holds radians otherwise)
     angle_deg: float | None = None
 

@@ -70,6 +70,7 @@ from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
     check_table,
     describe,
     join,
+    renamed,
     stages_table,
 )
 from xfem_contact.scenes.table_keys import law_options, shape_parameters
@@ -170,7 +171,8 @@ def load_scene(
         for where, _, table in _tables(data.get("loads", []), "loads", listed=True)
     ]
 
-    solver = check_table(data.get("solver", {}), FIELDS["solver"], "solver")
+    solver = renamed(data.get("solver", {}), "solver", "solver")
+    solver = check_table(solver, FIELDS["solver"], "solver")
     outputs = check_table(data.get("outputs", {}), FIELDS["outputs"], "outputs")
     return Scene(
         name=head.get("name", "scene"),
@@ -318,7 +320,7 @@ def _gmsh_source(mesh: dict, kind: str, folder: pathlib.Path):
 def _petsc_options(solver: dict) -> dict:
     """PETSc options of the checked [solver] table: the linear-solver preset, the Newton
     tolerances and the raw options, later ones winning."""
-    options = preset(solver.get("linear", "direct")) | {
+    options = preset(solver.get("preset", "direct")) | {
         option: solver[key]
         for key, option in (
             ("max_iterations", "snes_max_it"),

@@ -10,6 +10,8 @@ returns.
 
 from __future__ import annotations
 
+import warnings
+
 from xfem_contact.mechanics.laws import CONTACT_LAWS, LBB_OPTIONS, LINEAR_LAWS
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
 from xfem_contact.scenes.checks import (  # noqa: F401  (re-exported)
@@ -82,6 +84,40 @@ LOAD_KEYS = {name: (kind.required, kind.optional) for name, kind in LOAD_KINDS.i
 _POSITIVE = Number(0.0, open=True)
 _POINT = Vector(2, Number())
 _DEGREE = Choice((1, 2))
+
+
+#: Old key -> its name today, per table (read for one more release, with a warning)
+RENAMED_KEYS = {"load": {"history": "path"}, "solver": {"linear": "preset"}}
+#: Old load type -> its name today (read for one more release, with a warning)
+RENAMED_LOAD_TYPES = {"tangential_support": "tangential_spring"}
+
+
+def renamed(table, kind: str, where: str):
+    """``table`` (a ``kind`` table, e.g. ``"load"``) with its deprecated keys (and load
+    type) under their new names, each with a DeprecationWarning naming the old and the
+    new name; both names given is refused."""
+    if not isinstance(table, dict):
+        return table
+    table = dict(table)
+    for old, new in RENAMED_KEYS.get(kind, {}).items():
+        if old in table:
+            if new in table:
+                raise SceneError(f"{where}.{old}", f"give it once, as {new!r} (its old name)")
+            _deprecated(f"{where}.{old}", f"the key {old!r} is now {new!r}")
+            table[new] = table.pop(old)
+    if kind == "load" and table.get("type") in RENAMED_LOAD_TYPES:
+        old, new = table["type"], RENAMED_LOAD_TYPES[table["type"]]
+        _deprecated(f"{where}.type", f"the load type {old!r} is now {new!r}")
+        table["type"] = new
+    return table
+
+
+def _deprecated(key: str, what: str) -> None:
+    warnings.warn(
+        f"{key}: {what}; the old name is read until the next release",
+        DeprecationWarning,
+        stacklevel=4,
+    )
 
 
 def point_list(value, key: str) -> tuple:
@@ -227,7 +263,7 @@ FIELDS = {
         "end_time": Field(
             _POSITIVE,
             "pseudo-time of the last step (steps at k end_time / load_steps; default: the "
-            "last time of any history or stage, at least 1)",
+            "last time of any load path or stage, at least 1)",
         ),
         "max_iterations": Field(
             Number(1, 10_000, integer=True),
@@ -235,7 +271,7 @@ FIELDS = {
         ),
         "rtol": Field(_POSITIVE, f"relative Newton tolerance (default {_NEWTON['snes_rtol']})"),
         "atol": Field(_POSITIVE, f"absolute Newton tolerance (default {_NEWTON['snes_atol']})"),
-        "linear": Field(
+        "preset": Field(
             Choice(tuple(LINEAR_PRESETS)),
             f"linear solver of the Newton steps: one of {tuple(LINEAR_PRESETS)} (default direct)",
         ),
@@ -253,14 +289,14 @@ FIELDS = {
             lambda value, key: value,
             "number, [vx, vy], or expression(s) of x, y (m): Pa for a pressure (positive "
             "pushes) or traction, N/m^3 for a body force, m for a displacement, rad for a "
-            "rotation (or angle_deg), Pa/m for a tangential_support's stiffness",
+            "rotation (or angle_deg), Pa/m for a tangential_spring's stiffness",
         ),
         "side": Field(Choice((-1, 1)), "-1 or +1 (default both)"),
         "component": Field(Choice((0, 1)), "0 (x) or 1 (y): the one prescribed (displacement)"),
         "point": Field(_POINT, "[x, y] (m), the node held (point_displacement)"),
         "centre": Field(_POINT, "[x, y] (m), centre of a rotation (default [0, 0])"),
         "angle_deg": Field(Number(), "rotation angle in degrees (instead of value, in rad)"),
-        "history": Field(
+        "path": Field(
             load_path,
             "load path: [[t, factor], ...] (piecewise linear in pseudo-time t) or a stage "
             "name (default: factor = t)",

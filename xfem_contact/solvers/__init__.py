@@ -2,7 +2,7 @@
 
 Owns the assembly and solution of systems restricted to the active dofs of an
 enriched space, ``x = R y`` with ``R`` from
-:func:`xfem_contact.fem.restriction.restriction_matrix`: one KSP solve of
+:func:`xfem_contact.fem.prolongation.prolongation_matrix`: one KSP solve of
 ``R^T A R y = R^T b`` (:mod:`~xfem_contact.solvers.linear`), generalized Newton on
 ``R^T F(R y) = 0`` with its report and failure (:mod:`~xfem_contact.solvers.newton`),
 the assembly of ``R^T A R`` straight into the reduced numbering

@@ -1,10 +1,10 @@
-"""Bilinear forms assembled on the reduced space ``R^T A R`` of a restriction ``R``.
+"""Bilinear forms assembled on the reduced space ``R^T A R`` of a prolongation ``R``.
 
 A form on the mixed space ``W = (u_-, u_+, lambda, ...)`` couples every field on
 every cell it integrates, and more than half of ``W``'s dofs are inactive, so a
 matrix assembled in full and reduced by ``PtAP`` stores several times the entries of
 the reduced one. When ``R`` only *selects* dofs (identity columns: every LBB treatment but the
-restriction), :class:`ReducedMatrix` builds the sparsity of the active dofs alone and
+vital-vertex restriction), :class:`ReducedMatrix` builds the sparsity of the active dofs alone and
 assembles straight into it through a local-to-global map that sends each dof of
 ``W`` to its reduced column and each inactive dof to -1, which PETSc drops. With a
 multiplier prolongation in ``R`` it assembles the full matrix and reduces it by
@@ -49,7 +49,7 @@ def selection(R: PETSc.Mat, W: dolfinx.fem.FunctionSpace) -> Selection | None:
     ``None``. Collective.
 
     Args:
-        R: Restriction operator, global shape ``(dim W, n_reduced)``, rows laid out as
+        R: Prolongation, global shape ``(dim W, n_reduced)``, rows laid out as
             ``W``'s owned dofs.
         W: The mixed space of the rows of ``R``.
     """
@@ -271,14 +271,14 @@ class ReducedMatrix:
         a: Bilinear form on the mixed space ``W`` (test and trial).
         bcs: Dirichlet conditions on ``W`` (zero rows and columns, unit diagonal,
             as :func:`dolfinx.fem.petsc.assemble_matrix` applies them).
-        R: Restriction operator, global shape ``(dim W, n_reduced)``. Not modified;
+        R: Prolongation, global shape ``(dim W, n_reduced)``. Not modified;
             kept for the ``PtAP`` path.
         blocks: Allow a pattern (and matrix) of 2 x 2 blocks (:func:`reduced_matrix`);
             off for matrices that others add to with a scalar pattern (``MatAXPY``).
         field_blocks: Forms on a field's own space to add, each with the parent dof
             in ``W`` of every local dof of that space and whether it is constant (no
             coefficient that changes in a solve, e.g. a linear bulk) (the uncut cells'
-            blocks of :func:`xfem_contact.fem.field_blocks.split_uncut`): the matrix is
+            blocks of :func:`xfem_contact.fem.field_blocks.uncut_field_blocks`): the matrix is
             ``R^T (A + sum_i P_i A_i P_i^T) R``. Only for an ``R`` that selects. After
             :meth:`keep_constant_blocks` the constant ones are assembled once more and
             then added from a copy.
@@ -303,7 +303,7 @@ class ReducedMatrix:
         self.direct = chosen is not None
         self.R = None if self.direct else R  # only PtAP reads it again
         if field_blocks and not self.direct:
-            raise ValueError("field blocks need a restriction that selects dofs")
+            raise ValueError("field blocks need a prolongation that selects dofs")
         #: The reduced column of every dof (:class:`Selection`; None for ``PtAP``)
         self.selection = chosen
         self._full = None if self.direct else dolfinx.fem.petsc.create_matrix(a)

@@ -46,7 +46,7 @@ class BandMultigrid:
     PETSc creates it from ``pc_python_type``; :meth:`configure` then gives it the
     index sets, the near null space and the interpolation, in the unknowns of the
     operator (the reduced, scaled numbering of
-    :class:`~xfem_contact.solvers.newton.RestrictedNewton`). Collective methods.
+    :class:`~xfem_contact.solvers.newton.ReducedNewton`). Collective methods.
     """
 
     def __init__(self):

@@ -308,7 +308,7 @@ class TipFactor:
     factored by an inner KSP under SNES's options prefix (its ``ksp_type``, ``pc_type``
     and MUMPS options). SNES's unknowns and residual norms stay those of ``D``: in
     ``Z``'s the residual's round-off is amplified where the shifted branch functions are
-    small (P2, h = 1/16: 2.6e-10 against 1e-13), above ``snes_atol``. Construction
+    small, above ``snes_atol`` (``docs/crack_enrichment.md``). Construction
     (within the options' scope) is collective; it takes over ``Z``.
 
     Args:

@@ -3,7 +3,7 @@
 :class:`JacobianForms` compiles ``dF/dw``: with the fields' own spaces (and a
 restriction that selects dofs) the field blocks of the uncut cells and interior
 facets apart from the rest
-(:func:`xfem_contact.fem.field_blocks.split_uncut`), for
+(:func:`xfem_contact.fem.field_blocks.uncut_field_blocks`), for
 :class:`~xfem_contact.solvers.assembly.ReducedMatrix`; and lifts a residual with the
 whole Jacobian where the iterate misses its Dirichlet data, compiling the whole
 form only then.
@@ -18,7 +18,7 @@ import dolfinx.fem.petsc
 import ufl
 from petsc4py import PETSc
 
-from xfem_contact.fem.field_blocks import split_uncut
+from xfem_contact.fem.field_blocks import uncut_field_blocks
 from xfem_contact.fem.forms import form
 
 
@@ -29,30 +29,30 @@ class JacobianForms:
         residual: UFL residual on the mixed space of ``w``.
         w: The unknown.
         field_space: ``field_space(i)``: field ``i``'s own space and parent dofs, to
-            split the field blocks of the uncut cells and interior facets off;
-            ``None``: no split.
+            take the field blocks of the uncut cells and interior facets apart;
+            ``None``: no field blocks.
 
     Attributes:
         rest: The form :class:`~xfem_contact.solvers.assembly.ReducedMatrix` assembles
-            on ``W`` (the whole Jacobian without a split).
+            on ``W`` (the whole Jacobian without field blocks).
         blocks: ``(form, parent, constant)`` of each field block, on the field's own
             space; ``constant`` when it does not depend on ``w`` (a linear bulk).
     """
 
     def __init__(self, residual: ufl.Form, w: dolfinx.fem.Function, field_space: Callable | None):
         jacobian = ufl.derivative(residual, w, ufl.TrialFunction(w.function_space))
-        split = None if field_space is None else split_uncut(jacobian, field_space)
-        self.rest = form(jacobian if split is None else split.rest)
+        parts = None if field_space is None else uncut_field_blocks(jacobian, field_space)
+        self.rest = form(jacobian if parts is None else parts.rest)
         self.blocks = [
             (form(b.form), b.parent, w not in b.form.coefficients())
-            for b in ([] if split is None else split.blocks)
+            for b in ([] if parts is None else parts.blocks)
         ]
-        self._ufl, self._whole = (None, self.rest) if split is None else (jacobian, None)
+        self._ufl, self._whole = (None, self.rest) if parts is None else (jacobian, None)
         self._gap: PETSc.Vec | None = None
 
     @property
     def whole(self) -> dolfinx.fem.Form:
-        """The whole Jacobian on ``W`` (compiled on first use when split). Collective."""
+        """The whole Jacobian on ``W`` (compiled on first use with field blocks). Collective."""
         if self._whole is None:
             self._whole = form(self._ufl)
         return self._whole

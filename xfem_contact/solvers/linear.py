@@ -1,8 +1,8 @@
 """Linear solves on the reduced space ``y`` with ``x = R y`` (PETSc KSP).
 
-The same restriction as :class:`~xfem_contact.solvers.newton.RestrictedNewton`:
+The same prolongation as :class:`~xfem_contact.solvers.newton.ReducedNewton`:
 ``a`` and ``L`` are assembled with Dirichlet conditions and reduced with the operator
-``R`` of :mod:`xfem_contact.fem.restriction`, ``A_r = R^T A R`` (straight into the
+``R`` of :mod:`xfem_contact.fem.prolongation`, ``A_r = R^T A R`` (straight into the
 reduced numbering, :mod:`xfem_contact.solvers.assembly`) and ``b_r = R^T b``; the
 solution is ``x = R y``.
 The solver factors the symmetrically scaled ``D A_r D`` (:mod:`xfem_contact.solvers.scaling`),
@@ -12,12 +12,14 @@ unknowns ``Z`` of :mod:`xfem_contact.solvers.block_scaling`.
 
 from __future__ import annotations
 
+import warnings
+
 import dolfinx.fem
 import dolfinx.fem.petsc
 from petsc4py import PETSc
 
 from xfem_contact.fem.enrichment import EnrichedSpace
-from xfem_contact.fem.restriction import restriction_matrix
+from xfem_contact.fem.prolongation import prolongation_matrix
 from xfem_contact.solvers.assembly import ReducedMatrix
 from xfem_contact.solvers.block_scaling import refined, scaled, tip_transform
 from xfem_contact.solvers.options import applied_options, checked_prefix, merged_options
@@ -26,7 +28,7 @@ from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.symmetry import mark_symmetric
 
 
-def assemble_restricted(
+def assemble_reduced(
     a: dolfinx.fem.Form,
     L: dolfinx.fem.Form,
     bcs: list[dolfinx.fem.DirichletBC],
@@ -42,8 +44,8 @@ def assemble_restricted(
         bcs: Dirichlet conditions on ``W``, applied as
             :func:`dolfinx.fem.petsc.assemble_matrix` (unit diagonal) and
             :func:`dolfinx.fem.petsc.set_bc` do.
-        R: Restriction operator, global shape ``(dim W, n_reduced)``, see
-            :func:`xfem_contact.fem.restriction.restriction_matrix`. Not modified.
+        R: Prolongation, global shape ``(dim W, n_reduced)``, see
+            :func:`xfem_contact.fem.prolongation.prolongation_matrix`. Not modified.
 
     Returns:
         The reduced matrix ``R^T A R``, global shape ``(n_reduced, n_reduced)``,
@@ -63,7 +65,7 @@ def assemble_restricted(
     return A_r, b_r
 
 
-def solve_restricted(
+def solve_reduced(
     a: dolfinx.fem.Form,
     L: dolfinx.fem.Form,
     bcs: list[dolfinx.fem.DirichletBC],
@@ -87,8 +89,8 @@ def solve_restricted(
             defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
         petsc_options_prefix: The KSP's options prefix; ``None``: a unique one. The
             options are in the PETSc database only during the solve.
-        R: Restriction operator, global shape ``(dim W, n_reduced)``; by default
-            ``restriction_matrix(space)`` (the active dofs), built and destroyed
+        R: Prolongation, global shape ``(dim W, n_reduced)``; by default
+            ``prolongation_matrix(space)`` (the active dofs), built and destroyed
             here. A given ``R`` is not destroyed.
         residuals: If given, the norms of the scaled reduced residual before and
             after the solve are appended to it (``|D b|``, ``|D b - D A D y_s|``).
@@ -112,9 +114,9 @@ def solve_restricted(
     owned = []  # every PETSc object made here, destroyed on every path
     try:
         if R is None:
-            R = restriction_matrix(space)
+            R = prolongation_matrix(space)
             owned.append(R)
-        A, b = assemble_restricted(a, L, bcs, R)
+        A, b = assemble_reduced(a, L, bcs, R)
         owned += [A, b]
         transform = tip_transform(space, off=not tip_scaling)
         if transform is None:
@@ -169,3 +171,19 @@ def solve_restricted(
     finally:
         for obj in {id(o): o for o in owned}.values():
             obj.destroy()
+
+
+#: Deprecated names of this module's functions: old name -> new name
+_RENAMED = {"solve_restricted": "solve_reduced", "assemble_restricted": "assemble_reduced"}
+
+
+def __getattr__(name: str):
+    """The deprecated names of :data:`_RENAMED` (each warns at each use)."""
+    if name in _RENAMED:
+        warnings.warn(
+            f"{name} is deprecated and will be removed in the next release: use {_RENAMED[name]}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return globals()[_RENAMED[name]]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -3,7 +3,7 @@
 Residual and Jacobian are assembled with Dirichlet conditions (as
 :class:`dolfinx.fem.petsc.NonlinearProblem` does) and reduced: ``F_r = R^T F(R y)``,
 ``J_r = R^T J R`` (straight into the reduced numbering,
-:mod:`xfem_contact.solvers.assembly`), the same restriction as the linear solves of
+:mod:`xfem_contact.solvers.assembly`), the same prolongation as the linear solves of
 :mod:`xfem_contact.solvers.linear`. Every iterate is logged (INFO on this module's
 logger: residual norm and, through a callback, e.g. the contact status); failure raises
 with the whole history. Default options: :mod:`xfem_contact.solvers.options`.
@@ -12,6 +12,7 @@ with the whole history. Default options: :mod:`xfem_contact.solvers.options`.
 from __future__ import annotations
 
 import logging
+import warnings
 import weakref
 from collections.abc import Callable
 
@@ -41,7 +42,7 @@ from xfem_contact.solvers.symmetry import mark_symmetric
 logger = logging.getLogger(__name__)
 
 
-class RestrictedNewton:
+class ReducedNewton:
     """Solve ``F(w; v) = 0`` for ``w = R y`` on the reduced space of ``R``.
 
     Construction is collective (it compiles the forms, builds the sparsity of
@@ -67,8 +68,8 @@ class RestrictedNewton:
             mixed space ``W`` of ``w``.
         w: The unknown on ``W``; set to ``R y`` at every iterate and after the solve.
         bcs: Dirichlet conditions on ``W``.
-        R: Restriction operator, global shape ``(dim W, n_reduced)``, see
-            :func:`xfem_contact.fem.restriction.restriction_matrix`. Not modified:
+        R: Prolongation, global shape ``(dim W, n_reduced)``, see
+            :func:`xfem_contact.fem.prolongation.prolongation_matrix`. Not modified:
             the solver keeps its own scaled copy ``R D`` (:attr:`R`).
         petsc_options: PETSc options (without prefix) overriding the ``"newton"``
             defaults of :data:`xfem_contact.solvers.options.SOLVER_OPTIONS`.
@@ -98,7 +99,7 @@ class RestrictedNewton:
             (:meth:`EnrichedSpace.field_space
             <xfem_contact.fem.enrichment.EnrichedSpace.field_space>`). With a selecting
             ``R`` the Jacobian's uncut cells and ghost penalty are then assembled field
-            by field on those spaces (:func:`xfem_contact.fem.field_blocks.split_uncut`).
+            by field on those spaces (:func:`xfem_contact.fem.field_blocks.uncut_field_blocks`).
         transform: ``transform(R, J_r)``: a change of unknowns ``Z`` made from the first
             unscaled reduced Jacobian (a crack's tip enrichment,
             :func:`~xfem_contact.solvers.block_scaling.tip_scaling`): each Newton step
@@ -152,7 +153,7 @@ class RestrictedNewton:
         self.timings["sparsity"] = seconds(timer) + selecting
         if self.couplings and not self.jacobian.direct:
             raise ValueError(
-                "Couplings assembled outside UFL (large sliding) need a restriction that "
+                "Couplings assembled outside UFL (large sliding) need a prolongation that "
                 "selects dofs: no multiplier prolongation (lbb = 'restriction')"
             )
         for coupling in self.couplings:
@@ -400,3 +401,16 @@ def weak_method(method: Callable) -> Callable:
     about 120 problems on 2 ranks)."""
     ref = weakref.WeakMethod(method)
     return lambda *args: ref()(*args)
+
+
+def __getattr__(name: str):
+    """The deprecated name ``RestrictedNewton`` of :func:`ReducedNewton` (warns at each use)."""
+    if name == "RestrictedNewton":
+        warnings.warn(
+            "RestrictedNewton is deprecated and will be removed in the next release: "
+            "use ReducedNewton",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return ReducedNewton
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

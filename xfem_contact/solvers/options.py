@@ -5,8 +5,8 @@ entry maps a PETSc option name (without prefix) to its type, default value, a
 help string, the allowed values (``None``: whatever PETSc accepts) and the
 solvers it is a default of:
 
-- ``"linear"``: the KSP of :func:`xfem_contact.solvers.linear.solve_restricted`;
-- ``"newton"``: the SNES of :class:`xfem_contact.solvers.newton.RestrictedNewton`
+- ``"linear"``: the KSP of :func:`xfem_contact.solvers.linear.solve_reduced`;
+- ``"newton"``: the SNES of :class:`xfem_contact.solvers.newton.ReducedNewton`
   (its KSP options are those of the linear solve in every Newton step).
 
 :data:`PRESETS` holds every other set of options the package uses, one row each with
@@ -109,7 +109,7 @@ REFACTOR_AFTER = 20
 SPLIT_PRECONDITIONERS = ("fieldsplit", "python")
 
 
-def splits_fields(options: dict) -> bool:
+def uses_fieldsplit(options: dict) -> bool:
     """Whether ``options`` choose a preconditioner of :data:`SPLIT_PRECONDITIONERS`.
     Not collective."""
     return options.get("pc_type") in SPLIT_PRECONDITIONERS
@@ -157,7 +157,7 @@ def _reuses_lu(facts: Facts) -> bool:
 
 
 #: Every preset of the package's solvers: the linear-solver choices (``--solver`` of the
-#: demo, ``[solver] linear`` of a scene), the rows a problem adds under the user's options
+#: demo, ``[solver] preset`` of a scene), the rows a problem adds under the user's options
 #: (``applies``), the plain problems' and the band multigrid's sub-solvers'. No other
 #: module writes PETSc options of its own.
 PRESETS: dict[str, Preset] = {
@@ -195,7 +195,7 @@ PRESETS: dict[str, Preset] = {
         "100 % more MUMPS workspace: the branch functions are then nearly dependent on the "
         "polynomials far from the tip and the delayed pivots outgrow the default workspace "
         "(INFO(1) = -9)",
-        lambda facts: facts.crack_tip and (splits_fields(facts.options) or facts.couplings),
+        lambda facts: facts.crack_tip and (uses_fieldsplit(facts.options) or facts.couplings),
     ),
     "reused_lu": Preset(
         {
@@ -260,7 +260,7 @@ PRESETS: dict[str, Preset] = {
     ),
 }
 
-#: The presets a user chooses by name (``--solver``, ``[solver] linear``)
+#: The presets a user chooses by name (``--solver``, ``[solver] preset``)
 LINEAR_PRESETS = ("direct", "iterative")
 
 

@@ -49,8 +49,17 @@ class SolveReport:
 
     def field(self, i: int):
         """Collapsed copy of field ``i`` of :attr:`w`: 0 side -1, 1 side +1, 2..
-        multipliers."""
+        multipliers (:meth:`displacement` takes the side itself)."""
         return self.space.field(self.w, i)
+
+    def displacement(self, side: int):
+        """Collapsed copy of the displacement field of ``side`` (-1 or +1) of :attr:`w`
+        (its standard part; m)."""
+        sides = {s: (i, label) for i, (label, s) in enumerate(self.space.displacement_sides())}
+        if side not in sides:
+            raise ValueError(f"side must be one of {sorted(sides)}, got {side!r}")
+        field, label = sides[side]
+        return self.space.field(self.w, field, name=f"u_{label}" if label else "u")
 
     @property
     def linear_solve_time(self) -> float:

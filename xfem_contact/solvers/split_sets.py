@@ -1,5 +1,5 @@
 """The index sets, near null space and interpolation a split preconditioner of the
-Newton steps reads (:class:`~xfem_contact.solvers.newton.RestrictedNewton`): PETSc's
+Newton steps reads (:class:`~xfem_contact.solvers.newton.ReducedNewton`): PETSc's
 ``fieldsplit`` or the band multigrid of
 :class:`~xfem_contact.solvers.band_multigrid.BandMultigrid`, in the reduced, scaled
 unknowns ``y`` (``x = R D y``)."""
@@ -38,7 +38,7 @@ def split_sets(
         chosen: The dof selection of a selecting ``R``
             (:func:`~xfem_contact.solvers.assembly.selection`), or ``None``.
         splits: Split name to the local dofs of ``W`` it holds, as for
-            :class:`~xfem_contact.solvers.newton.RestrictedNewton`.
+            :class:`~xfem_contact.solvers.newton.ReducedNewton`.
         near_nullspace: Functions on ``W`` (any iterable) for the near null space of split ``"u"``.
         interpolation: ``(rows, cols, weights)`` on local dofs of ``W``, or ``None``.
 

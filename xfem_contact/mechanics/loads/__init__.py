@@ -3,9 +3,11 @@
 A problem holds one :class:`Loads` (``problem.loads``). Parts are named
 (:mod:`~xfem_contact.mechanics.loads.parts`), magnitudes given as numbers are
 Constants (:mod:`~xfem_contact.mechanics.loads.values`), each load follows its own
-path in pseudo-time (:mod:`~xfem_contact.mechanics.loads.history`), and each
+path in pseudo-time (:mod:`~xfem_contact.mechanics.loads.load_path`), and each
 ``add_*`` returns a handle (:mod:`~xfem_contact.mechanics.loads.handles`).
 """
+
+import warnings
 
 from xfem_contact.mechanics.loads.fields import PlainFields, SideFields
 from xfem_contact.mechanics.loads.handles import (
@@ -13,9 +15,9 @@ from xfem_contact.mechanics.loads.handles import (
     FormLoad,
     Load,
     RotationLoad,
-    SpringSupport,
+    TangentialSpring,
 )
-from xfem_contact.mechanics.loads.history import History, load_steps
+from xfem_contact.mechanics.loads.load_path import LoadPath, load_steps
 from xfem_contact.mechanics.loads.loads import Loads
 from xfem_contact.mechanics.loads.parts import (
     Part,
@@ -28,17 +30,32 @@ from xfem_contact.mechanics.loads.parts import (
 __all__ = [
     "DirichletLoad",
     "FormLoad",
-    "History",
     "Load",
+    "LoadPath",
     "Loads",
     "Part",
     "PlainFields",
     "RotationLoad",
     "SideFields",
-    "SpringSupport",
+    "TangentialSpring",
     "annulus_parts",
     "boundary_facets",
     "load_steps",
     "named_parts",
     "rectangle_parts",
 ]
+
+#: Deprecated names of this package's classes: old name -> new name
+_RENAMED = {"History": "LoadPath", "SpringSupport": "TangentialSpring"}
+
+
+def __getattr__(name: str):
+    """The deprecated names of :data:`_RENAMED` (each warns at each use)."""
+    if name in _RENAMED:
+        warnings.warn(
+            f"{name} is deprecated and will be removed in the next release: use {_RENAMED[name]}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return globals()[_RENAMED[name]]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

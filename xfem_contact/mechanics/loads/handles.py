@@ -1,7 +1,7 @@
 """Handles of the loads of a :class:`~xfem_contact.mechanics.loads.Loads`.
 
 Each ``add_*`` returns one: its ``value`` (the magnitude at factor 1) can be read and
-set, and ``apply(t)`` sets its factor ``history(t)``. Setting a value changes data
+set, and ``apply(t)`` sets its factor ``path(t)``. Setting a value changes data
 (a Constant, the arrays of Dirichlet functions), never a form: nothing compiles.
 """
 
@@ -13,7 +13,7 @@ from collections.abc import Mapping
 import dolfinx.fem
 import numpy as np
 
-from xfem_contact.mechanics.loads.history import History
+from xfem_contact.mechanics.loads.load_path import LoadPath
 from xfem_contact.mechanics.loads.values import finite_number, nodal_values, set_constant
 from xfem_contact.mechanics.parameters import Parameter
 
@@ -34,12 +34,16 @@ def rotation_angle(angle, name: str = "angle") -> float:
     return angle
 
 
+#: The deprecation of a load's ``history``
+_HISTORY = "Load.history is deprecated and will be removed in the next release: use Load.path"
+
+
 class Load:
     """A load or support: its ``kind``, ``part`` (name, or None when given otherwise)
-    and :class:`History`."""
+    and :class:`LoadPath`."""
 
-    def __init__(self, kind: str, part, history: History):
-        self.kind, self.history = kind, history
+    def __init__(self, kind: str, part, path: LoadPath):
+        self.kind, self.path = kind, path
         self.part = part if isinstance(part, str) else None
         self._t = 1.0
 
@@ -49,17 +53,28 @@ class Load:
 
     def __repr__(self) -> str:
         part = f" on {self.part!r}" if self.part else ""
-        return f"<{self.kind}{part}: value {self.value!r}, {self.history!r}>"
+        return f"<{self.kind}{part}: value {self.value!r}, {self.path!r}>"
+
+    @property
+    def history(self) -> LoadPath:
+        """Deprecated name of :attr:`path`."""
+        warnings.warn(_HISTORY, DeprecationWarning, stacklevel=2)
+        return self.path
+
+    @history.setter
+    def history(self, path: LoadPath) -> None:
+        warnings.warn(_HISTORY, DeprecationWarning, stacklevel=2)
+        self.path = path
 
 
 class FormLoad(Load):
     """A load of the residual (traction, pressure, body force): ``factor * magnitude``,
     both UFL Constants when the magnitude was given as numbers."""
 
-    def __init__(self, kind, part, history, magnitude, constant, mesh):
-        super().__init__(kind, part, history)
+    def __init__(self, kind, part, path, magnitude, constant, mesh):
+        super().__init__(kind, part, path)
         self.magnitude, self._constant = magnitude, constant
-        #: The factor ``history(t)`` (dimensionless) multiplying the magnitude in the form
+        #: The factor ``path(t)`` (dimensionless) multiplying the magnitude in the form
         self.factor = dolfinx.fem.Constant(mesh, dolfinx.default_scalar_type(1.0))
 
     @property
@@ -81,18 +96,18 @@ class FormLoad(Load):
 
     def apply(self, t: float) -> None:
         super().apply(t)
-        self.factor.value = self.history(t)
+        self.factor.value = self.path(t)
 
 
 class DirichletLoad(Load):
-    """A prescribed displacement: functions ``g`` (one per side) set to ``history(t)``
+    """A prescribed displacement: functions ``g`` (one per side) set to ``path(t)``
     times their full values (m), the values interpolated from ``value`` on each
     function's space."""
 
     def __init__(
-        self, kind, part, history, functions: list[dolfinx.fem.Function], value, sides=(None,)
+        self, kind, part, path, functions: list[dolfinx.fem.Function], value, sides=(None,)
     ):
-        super().__init__(kind, part, history)
+        super().__init__(kind, part, path)
         self.functions, self.sides = functions, tuple(sides)
         self.value = value
 
@@ -123,18 +138,18 @@ class DirichletLoad(Load):
 
     def apply(self, t: float) -> None:
         super().apply(t)
-        f = self.history(t)
+        f = self.path(t)
         for g, full in zip(self.functions, self._full, strict=True):
             g.x.array[:] = f * full
 
 
 class RotationLoad(Load):
-    """A rigid rotation of a boundary part by ``history(t)`` times ``value`` (rad,
+    """A rigid rotation of a boundary part by ``path(t)`` times ``value`` (rad,
     counter-clockwise) about ``centre`` (m): ``u = (Q - I)(X - c)`` (the angle ramps,
     so each step is an exact rotation)."""
 
-    def __init__(self, part, history, functions, arms, angle: float, centre, nodes):
-        super().__init__("rotation", part, history)
+    def __init__(self, part, path, functions, arms, angle: float, centre, nodes):
+        super().__init__("rotation", part, path)
         self.functions, self.arms, self.centre = functions, arms, centre
         #: ``(dofs (k, 2), reference nodes (k, 2))`` of the rotated bodies (predictor)
         self.nodes = nodes
@@ -153,7 +168,7 @@ class RotationLoad(Load):
 
     def apply(self, t: float) -> None:
         super().apply(t)
-        a = self.history(t) * self._angle
+        a = self.path(t) * self._angle
         c, s = np.cos(a), np.sin(a)
         for g, arm in zip(self.functions, self.arms, strict=True):
             g.x.array[:] = np.column_stack(
@@ -163,7 +178,7 @@ class RotationLoad(Load):
     def rotate(self, w: dolfinx.fem.Function, t_from: float, t_to: float) -> None:
         """Turn the deformed configuration of the rotated bodies in ``w`` by the angle
         between ``t_from`` and ``t_to`` (a predictor: exact for a rigidly turning body)."""
-        delta = (self.history(t_to) - self.history(t_from)) * self._angle
+        delta = (self.path(t_to) - self.path(t_from)) * self._angle
         if self.nodes is None or delta == 0.0:
             return
         dofs, X = self.nodes
@@ -172,11 +187,11 @@ class RotationLoad(Load):
         w.x.array[dofs] = (x - self.centre) @ Q.T + self.centre - X
 
 
-class SpringSupport(Load):
+class TangentialSpring(Load):
     """A tangential spring (Pa/m): its stiffness a Constant; not ramped (a support)."""
 
     def __init__(self, part, facets: np.ndarray, stiffness: dolfinx.fem.Constant):
-        super().__init__("tangential spring", part, History([(0.0, 1.0)]))
+        super().__init__("tangential spring", part, LoadPath([(0.0, 1.0)]))
         self.facets, self.stiffness = facets, stiffness
 
     @property

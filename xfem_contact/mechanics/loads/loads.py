@@ -2,13 +2,14 @@
 
 :class:`Loads` holds the Dirichlet conditions (:attr:`Loads.bcs`), the load terms of
 the residual, the tangential springs and the rotations, each with its own load path
-(:mod:`~xfem_contact.mechanics.loads.history`), and the pseudo-time ``t``
+(:mod:`~xfem_contact.mechanics.loads.load_path`), and the pseudo-time ``t``
 (:meth:`Loads.set_time`). It works on both sides of a cut mesh or on one plain field
 (:mod:`~xfem_contact.mechanics.loads.fields`). SI units (Pa, N/m^3, m, rad).
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 
 import dolfinx.fem
@@ -22,10 +23,10 @@ from xfem_contact.mechanics.loads.handles import (
     FormLoad,
     Load,
     RotationLoad,
-    SpringSupport,
+    TangentialSpring,
     rotation_angle,
 )
-from xfem_contact.mechanics.loads.history import History, check_stage, stage_history
+from xfem_contact.mechanics.loads.load_path import LoadPath, check_stage, stage_path
 from xfem_contact.mechanics.loads.parts import Part, boundary_facets, named_parts
 from xfem_contact.mechanics.loads.values import finite_number, form_magnitude
 from xfem_contact.mechanics.parameters import Parameter
@@ -48,7 +49,9 @@ class Loads:
 
     Every ``add_*`` is collective, takes a part by name, facet indices or locator,
     and returns a :class:`~xfem_contact.mechanics.loads.handles.Load` handle whose
-    ``value`` can be set later without compiling anything.
+    ``value`` can be set later without compiling anything. Every ``add_*`` but the
+    tangential spring takes ``path=``, its load path (None: factor ``t``;
+    ``[(t, f), ...]``; a stage name); ``history=`` is its deprecated name.
     """
 
     def __init__(self, fields, parts: Mapping[str, Part] | None = None):
@@ -84,7 +87,7 @@ class Loads:
         return boundary_facets(self.mesh, part, self.parts if isinstance(part, str) else None)
 
     def add_stage(self, name: str, start: float, end: float) -> None:
-        """Name the pseudo-time interval ``[start, end]``: a load with ``history=name``
+        """Name the pseudo-time interval ``[start, end]``: a load with ``path=name``
         ramps from 0 at ``start`` to 1 at ``end`` (0 before, 1 after)."""
         self.stages[name] = check_stage(name, start, end)
 
@@ -95,7 +98,7 @@ class Loads:
 
     def set_time(self, t: float) -> None:
         """Set the pseudo-time ``t`` (>= 0; the unloaded state is ``t = 0``): every load
-        takes its value ``history(t)`` times its magnitude. Not collective (sets local
+        takes its value ``path(t)`` times its magnitude. Not collective (sets local
         data)."""
         t = TIME.check(t, "pseudo-time t")
         self._time = t
@@ -105,15 +108,26 @@ class Loads:
     @property
     def end_time(self) -> float:
         """The last time of every load's path and stage (at least 1)."""
-        ends = [load.history.end for load in self.items if load.kind != "tangential spring"]
+        ends = [load.path.end for load in self.items if load.kind != "tangential spring"]
         return max([1.0, *ends, *(end for _, end in self.stages.values())])
 
-    def _history(self, history: Path) -> History:
-        if isinstance(history, str):
-            return stage_history(history, self.stages)
-        if isinstance(history, History):
-            return history
-        return History(history)
+    def _load_path(self, path: Path, history: Path = None) -> LoadPath:
+        """The :class:`LoadPath` of ``path`` (or of ``history``, its deprecated name)."""
+        if history is not None:
+            warnings.warn(
+                "history= is deprecated and will be removed in the next release: "
+                "use path= (the load path)",
+                DeprecationWarning,
+                stacklevel=3,
+            )
+            if path is not None:
+                raise ValueError("give the load path once: path= (history= is its old name)")
+            path = history
+        if isinstance(path, str):
+            return stage_path(path, self.stages)
+        if isinstance(path, LoadPath):
+            return path
+        return LoadPath(path)
 
     def _add(self, load: Load) -> Load:
         load.apply(self._time)
@@ -152,7 +166,13 @@ class Loads:
         return sub.sub(component)
 
     def add_displacement(
-        self, part: Part, value, component: int | None = None, *, history: Path = None
+        self,
+        part: Part,
+        value,
+        component: int | None = None,
+        *,
+        path: Path = None,
+        history: Path = None,
     ) -> DirichletLoad:
         """Prescribe the displacement (m) on a boundary part, on every side's field.
 
@@ -162,10 +182,11 @@ class Loads:
                 of ``x`` (shape (3, n)) returning (n,) for one component, (gdim, n) else;
                 or ``{-1: value, 1: value}``, each side's own.
             component: The one component prescribed (None: all).
-            history: The load path (None: factor ``t``; ``[(t, f), ...]``; a stage name).
+            path: The load path (None: factor ``t``; ``[(t, f), ...]``; a stage name).
+            history: Deprecated name of ``path``.
         """
         fdim, facets = self.mesh.topology.dim - 1, self.facets(part)
-        path = self._history(history)
+        path = self._load_path(path, history)
         functions = [
             self._dirichlet(
                 self._subspace(side, component),
@@ -177,7 +198,7 @@ class Loads:
         return self._add(load)
 
     def add_point_displacement(
-        self, point, value: float, component: int, *, history: Path = None
+        self, point, value: float, component: int, *, path: Path = None, history: Path = None
     ) -> DirichletLoad:
         """Prescribe one displacement component (m) at a mesh node (e.g. to remove
         rigid modes), on every side's field."""
@@ -191,7 +212,7 @@ class Loads:
         def at_point(x):
             return np.isclose(x[0], point[0]) & np.isclose(x[1], point[1])
 
-        path = self._history(history)
+        path = self._load_path(path, history)
         functions, found = [], 0
         for side in self.fields.sides:
             sub = self._subspace(side, component)
@@ -212,10 +233,11 @@ class Loads:
         angle: float | None = None,
         angle_deg: float | None = None,
         centre=(0.0, 0.0),
+        path: Path = None,
         history: Path = None,
     ) -> RotationLoad:
         """Rotate a boundary part rigidly by ``angle`` (rad) or ``angle_deg`` (degrees),
-        counter-clockwise about ``centre`` (m), times the factor ``history(t)``:
+        counter-clockwise about ``centre`` (m), times the factor ``path(t)``:
         ``u = (Q - I)(X - c)`` on every side's field. Warns for ``angle`` outside
         [-2 pi, 2 pi] (degrees given as radians?)."""
         if (angle is None) == (angle_deg is None):
@@ -241,7 +263,7 @@ class Loads:
             functions.append(g)
             arms.append(g.function_space.tabulate_dof_coordinates()[:, :2] - centre)
         nodes = self.fields.rotated_nodes(facets)
-        path = self._history(history)
+        path = self._load_path(path, history)
         return self._add(RotationLoad(part, path, functions, arms, angle, centre, nodes))
 
     def rotate_bodies(self, w: dolfinx.fem.Function, t_from: float, t_to: float) -> None:
@@ -253,13 +275,21 @@ class Loads:
         w.x.scatter_forward()
 
     # -- loads of the residual -------------------------------------------------------
-    def _form_load(self, kind, part, magnitude, constant, history, terms) -> FormLoad:
-        load = FormLoad(kind, part, self._history(history), magnitude, constant, self.mesh)
+    def _form_load(self, kind, part, magnitude, constant, path, terms) -> FormLoad:
+        load = FormLoad(kind, part, path, magnitude, constant, self.mesh)
         for term in terms(load.factor):
             self._terms.append(term)
         return self._add(load)
 
-    def add_traction(self, part: Part, traction, side: int | None = None, *, history: Path = None):
+    def add_traction(
+        self,
+        part: Part,
+        traction,
+        side: int | None = None,
+        *,
+        path: Path = None,
+        history: Path = None,
+    ):
         """Surface traction (Pa, a vector: tuple, UFL or callable of the UFL ``x``) on a
         boundary part, on every side or ``side``. Returns its handle."""
         facets, sides = self.facets(part), self._sides(side)
@@ -270,13 +300,21 @@ class Loads:
             part,
             t,
             constant,
-            history,
+            self._load_path(path, history),
             lambda f: [
                 ufl.inner(f * t, self.fields.test(s)) * self.fields.ds(s, facets) for s in sides
             ],
         )
 
-    def add_pressure(self, part: Part, pressure, side: int | None = None, *, history: Path = None):
+    def add_pressure(
+        self,
+        part: Part,
+        pressure,
+        side: int | None = None,
+        *,
+        path: Path = None,
+        history: Path = None,
+    ):
         """Pressure (Pa; positive pushes into the body: ``t = -p n``) on a boundary part:
         a number, UFL or a callable of the UFL ``x``. Returns its handle."""
         facets, sides = self.facets(part), self._sides(side)
@@ -287,14 +325,16 @@ class Loads:
             part,
             p,
             constant,
-            history,
+            self._load_path(path, history),
             lambda f: [
                 ufl.inner(-f * p * n, self.fields.test(s)) * self.fields.ds(s, facets)
                 for s in sides
             ],
         )
 
-    def add_body_force(self, force, side: int | None = None, *, history: Path = None):
+    def add_body_force(
+        self, force, side: int | None = None, *, path: Path = None, history: Path = None
+    ):
         """Body force density (N/m^3, a vector) on every side or ``side``."""
         sides = self._sides(side)
         gdim = self.mesh.geometry.dim
@@ -304,7 +344,7 @@ class Loads:
             None,
             b,
             constant,
-            history,
+            self._load_path(path, history),
             lambda f: [ufl.inner(f * b, self.fields.test(s)) * self.fields.dx(s) for s in sides],
         )
 
@@ -320,14 +360,14 @@ class Loads:
         return bool(self._terms)
 
     # -- supports --------------------------------------------------------------------
-    def add_tangential_spring(self, part: Part, stiffness: float) -> SpringSupport:
+    def add_tangential_spring(self, part: Part, stiffness: float) -> TangentialSpring:
         """Hold the tangential displacement of a boundary part by a spring of stiffness
         ``k`` (Pa/m): ``int k (u . t)(v . t) ds`` on every side's field (``t`` the
         boundary's tangent): ``u_t = 0`` along a curved boundary while the normal
         motion stays free. Not ramped (a support)."""
         facets = self.facets(part)
         k = dolfinx.fem.Constant(self.mesh, dolfinx.default_scalar_type(1.0))
-        spring = SpringSupport(part, facets, k)
+        spring = TangentialSpring(part, facets, k)
         spring.value = stiffness
         return self._add(spring)
 
@@ -339,7 +379,7 @@ class Loads:
         terms = [
             s.stiffness * ufl.dot(u[i], t) * ufl.dot(v[i], t) * self.fields.ds(side, s.facets)
             for s in self.items
-            if isinstance(s, SpringSupport)
+            if isinstance(s, TangentialSpring)
             for i, side in enumerate(self.fields.sides)
         ]
         return sum(terms[1:], terms[0]) if terms else None

@@ -2,7 +2,7 @@
 
 Every load and prescribed displacement is its full value times a factor ``f(t)``.
 The default factor is ``f(t) = t`` (one load factor for all loads); a
-:class:`History` is a piecewise-linear ramp through ``(time, factor)`` points, held
+:class:`LoadPath` is a piecewise-linear ramp through ``(time, factor)`` points, held
 constant before the first point and after the last; a *stage* ``(start, end)`` is
 the ramp from 0 at ``start`` to 1 at ``end``.
 """
@@ -16,11 +16,11 @@ import numpy as np
 from xfem_contact.mechanics.parameters import is_number
 
 
-class History:
+class LoadPath:
     """A piecewise-linear factor of pseudo-time through ``points`` ``[(t, f), ...]``
     (dimensionless; times strictly increasing; constant outside); ``None``: ``f = t``."""
 
-    def __init__(self, points: Sequence[Sequence[float]] | None = None, name: str = "history"):
+    def __init__(self, points: Sequence[Sequence[float]] | None = None, name: str = "path"):
         self.points = None
         if points is None:
             return
@@ -52,15 +52,15 @@ class History:
         return 1.0 if self.points is None else float(self.points[-1, 0])
 
     def __repr__(self) -> str:
-        return "History(f = t)" if self.points is None else f"History({self.points.tolist()})"
+        return "LoadPath(f = t)" if self.points is None else f"LoadPath({self.points.tolist()})"
 
 
-def stage_history(name: str, stages: Mapping[str, tuple[float, float]]) -> History:
+def stage_path(name: str, stages: Mapping[str, tuple[float, float]]) -> LoadPath:
     """The ramp of stage ``name``: 0 up to its start, 1 from its end on."""
     if name not in stages:
         raise ValueError(f"Unknown load stage {name!r}; valid: {sorted(stages)}")
     start, end = stages[name]
-    return History([(start, 0.0), (end, 1.0)], name=f"stage {name!r}")
+    return LoadPath([(start, 0.0), (end, 1.0)], name=f"stage {name!r}")
 
 
 def check_stage(name, start, end) -> tuple[float, float]:

@@ -1,0 +1,109 @@
+"""The prolongation ``R`` from a reduced space to the full mixed space.
+
+Full dofs ``x = R y``: ``R`` selects the active dofs of an
+:class:`~xfem_contact.fem.enrichment.EnrichedSpace` (identity columns; a crack's tied
+dofs share their column) and, where a
+multiplier prolongation is given (LBB restriction, :mod:`xfem_contact.mechanics.lbb`),
+expresses multiplier dofs as combinations of fewer reduced unknowns. Both solvers
+use it: the linear solves (:mod:`xfem_contact.solvers.linear`) solve
+``R^T A R y = R^T b``, Newton (:mod:`xfem_contact.solvers.newton`) solves
+``R^T J R dy = -R^T F``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from xfem_contact.fem.enrichment import EnrichedSpace
+
+
+class MultiplierProlongation:
+    """Multiplier dofs as combinations of reduced unknowns (local rows, global columns).
+
+    The process-local part of a sparse ``(m, n_mult)`` matrix in coordinate form:
+    row ``k`` expresses the multiplier dof ``dofs[k]`` of ``W`` in the
+    ``n_mult`` (global) reduced multiplier unknowns, of which this process owns
+    ``num_owned`` (consecutive, in rank order). Not collective.
+
+    Attributes:
+        dofs: Local (owned) multiplier dofs of ``W`` the prolongation replaces, ``(m,)``.
+        rows: Index into ``dofs`` of each entry, ``(nnz,)``.
+        cols: Global reduced-unknown index (0-based among the multiplier unknowns), ``(nnz,)``.
+        vals: Entries, ``(nnz,)``.
+        num_owned: Reduced multiplier unknowns owned by this process.
+    """
+
+    def __init__(self, dofs, rows, cols, vals, num_owned: int):
+        self.dofs = np.asarray(dofs, dtype=np.int64)
+        self.rows = np.asarray(rows, dtype=np.int64)
+        self.cols = np.asarray(cols, dtype=np.int64)
+        self.vals = np.asarray(vals, dtype=np.float64)
+        self.num_owned = int(num_owned)
+
+
+def prolongation_matrix(
+    space: EnrichedSpace, prolongation: MultiplierProlongation | None = None
+) -> PETSc.Mat:
+    """Build the prolongation ``R`` with ``x = R y``. Collective.
+
+    Columns (reduced unknowns) are numbered process by process: on each, first
+    its owned active dofs in increasing order (an identity column each), then
+    its ``prolongation.num_owned`` multiplier unknowns.
+
+    Args:
+        space: The enriched space; its active owned dofs are kept.
+        prolongation: Optional multiplier prolongation; its dofs are removed
+            from the identity part and replaced by its entries.
+
+    Returns:
+        ``R`` as a PETSc AIJ matrix of global shape ``(dim W, n_reduced)``;
+        its rows are laid out as the dofs of ``space.W`` (owned dofs of each
+        process), its columns as the reduced unknowns above. The caller
+        destroys it.
+    """
+    imap, bs = space.W.dofmap.index_map, space.W.dofmap.index_map_bs
+    comm = imap.comm
+    n_owned = imap.size_local * bs
+    active = space.active[:n_owned].copy()
+    ties = space.ties
+    active[ties[:, 1]] = False  # a follower is its kept dof's column
+    if prolongation is not None:
+        active[prolongation.dofs] = False
+    selected = np.flatnonzero(active)
+    n_sel = selected.size
+    n_mult = 0 if prolongation is None else prolongation.num_owned
+    n_red = n_sel + n_mult
+    offset = comm.exscan(n_red, op=MPI.SUM) or 0
+    sel_offset = offset
+    mult_offset = offset + n_sel
+    # Global column of multiplier unknown j: its owner's mult_offset + local position.
+    owners_offsets = comm.allgather((mult_offset, n_mult))
+    entries_rows = [selected]
+    entries_cols = [np.arange(n_sel) + sel_offset]
+    entries_vals = [np.ones(n_sel)]
+    if ties.size:
+        entries_rows.append(ties[:, 1])
+        entries_cols.append(np.searchsorted(selected, ties[:, 0]) + sel_offset)
+        entries_vals.append(np.ones(len(ties)))
+    if prolongation is not None and prolongation.vals.size:
+        starts = np.cumsum([0] + [n for _, n in owners_offsets])
+        global_mult = np.array([o for o, _ in owners_offsets])
+        owner = np.searchsorted(starts, prolongation.cols, side="right") - 1
+        entries_rows.append(prolongation.dofs[prolongation.rows])
+        entries_cols.append(global_mult[owner] + prolongation.cols - starts[owner])
+        entries_vals.append(prolongation.vals)
+    rows = np.concatenate(entries_rows)
+    cols = np.concatenate(entries_cols)
+    vals = np.concatenate(entries_vals)
+    n_cols = comm.allreduce(n_red, op=MPI.SUM)  # on every process (ties may be on some)
+    if len(entries_rows) > 1:  # sum repeated (row, column) pairs; sort by row, column
+        keys, inverse = np.unique(rows * n_cols + cols, return_inverse=True)
+        rows, cols = np.divmod(keys, n_cols)
+        vals = np.bincount(inverse, weights=vals, minlength=keys.size)
+    indptr = np.searchsorted(rows, np.arange(n_owned + 1)).astype(PETSc.IntType)
+    R = PETSc.Mat().createAIJ(((n_owned, PETSc.DETERMINE), (n_red, PETSc.DETERMINE)), comm=comm)
+    R.setPreallocationCSR((indptr, cols.astype(PETSc.IntType), vals))
+    R.assemble()
+    return R
