@@ -237,10 +237,10 @@ def test_a_pin_and_a_roller_hold_a_plate_with_a_short_crack():
     problem = cracked_plate(0.07)
     assert check(problem) == []
     assert problem.solve().converged
-    result = balance(problem)
+    result = balance(problem, problem.w)
     assert result["balance_relative"] < 1e-10
     assert result["reactions"]["point displacement"] == pytest.approx([0.0, 4.0], abs=1e-9)
-    vec = residual_vector(problem)
+    vec = residual_vector(problem, problem.w)
     dofs, owned = problem.loads.bcs[2].dof_indices()  # the roller's
     roller = vec.array_r[dofs[:owned]] @ unit_vectors(problem)[1][dofs[:owned]]
     vec.destroy()

@@ -51,7 +51,7 @@ def crack_total_variation(N: int, degree: int, lbb) -> float:
 
     case = frictional_crack_case(N, degree, friction=0.3, tip_radius=0.5, lbb=lbb)
     assert case.problem.solve().converged
-    samples = case.problem.interface_samples()
+    samples = case.problem.interface_samples(case.problem.w)
     crack = case.problem.cut.crack
     x = np.stack([samples["x"], samples["y"]], axis=1) - crack.tips[0]
     lam = np.asarray(samples["lambda_n"])[np.argsort(x @ crack.directions[0])]
