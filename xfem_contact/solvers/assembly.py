@@ -14,6 +14,7 @@ multiplier prolongation in ``R`` it assembles the full matrix and reduces it by
 from __future__ import annotations
 
 import itertools
+import typing
 
 import dolfinx.cpp
 import dolfinx.fem
@@ -264,6 +265,20 @@ def _assemble_unrolled(A: PETSc.Mat, a: dolfinx.fem.Form, bcs: list) -> None:
     dolfinx.cpp.fem.petsc.insert_diagonal(A, a.function_spaces[0], cpp_bcs, 1.0)
 
 
+class _Block(typing.NamedTuple):
+    """A field block of :class:`ReducedMatrix`, ready to assemble into the reduced matrix."""
+
+    form: dolfinx.fem.Form
+    #: Local-to-global map of its rows and columns in the reduced numbering
+    lgmap: PETSc.LGMap
+    #: Whether ``lgmap`` is blocked (a vector field's block size)
+    blocked: bool
+    #: 1 on its Dirichlet dofs, 0 elsewhere (int8, per dof of the field's space)
+    fixed: np.ndarray
+    #: Whether the block is constant over the Newton iterates
+    constant: bool
+
+
 class ReducedMatrix:
     """``R^T A R`` of a bilinear form on ``W``, assembled again on demand.
 
@@ -322,7 +337,7 @@ class ReducedMatrix:
             bs, comm = self.mat.getBlockSize(), a.mesh.comm
             for form, parent, constant in field_blocks:
                 lgmap, blocked = _block_lgmap(chosen.columns, parent, bs, comm)
-                self._blocks.append((form, lgmap, blocked, fixed[parent], constant))
+                self._blocks.append(_Block(form, lgmap, blocked, fixed[parent], constant))
             self._lgmap = self.mat.getLGMap()[0]
 
     def keep_constant_blocks(self) -> None:
@@ -333,7 +348,7 @@ class ReducedMatrix:
         if self._kept is not None:
             self._kept.destroy()
             self._kept = None
-        self._keep = any(b[4] for b in self._blocks)
+        self._keep = any(block.constant for block in self._blocks)
 
     def _assemble_blocks(self, constant: bool) -> None:
         for form, lgmap, blocked, fixed, is_constant in self._blocks:
