@@ -12,12 +12,11 @@ unknowns ``Z`` of :mod:`xfem_contact.solvers.block_scaling`.
 
 from __future__ import annotations
 
-import warnings
-
 import dolfinx.fem
 import dolfinx.fem.petsc
 from petsc4py import PETSc
 
+from xfem_contact._deprecation import renamed
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.prolongation import prolongation_matrix
 from xfem_contact.solvers.assembly import ReducedMatrix
@@ -177,13 +176,4 @@ def solve_reduced(
 _RENAMED = {"solve_restricted": "solve_reduced", "assemble_restricted": "assemble_reduced"}
 
 
-def __getattr__(name: str):
-    """The deprecated names of :data:`_RENAMED` (each warns at each use)."""
-    if name in _RENAMED:
-        warnings.warn(
-            f"{name} is deprecated and will be removed in the next release: use {_RENAMED[name]}",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return globals()[_RENAMED[name]]
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = renamed(__name__, _RENAMED, globals())

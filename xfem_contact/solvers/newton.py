@@ -12,7 +12,6 @@ with the whole history. Default options: :mod:`xfem_contact.solvers.options`.
 from __future__ import annotations
 
 import logging
-import warnings
 import weakref
 from collections.abc import Callable
 
@@ -23,6 +22,7 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from xfem_contact._deprecation import renamed
 from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.forms import form_parts
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
@@ -403,14 +403,4 @@ def weak_method(method: Callable) -> Callable:
     return lambda *args: ref()(*args)
 
 
-def __getattr__(name: str):
-    """The deprecated name ``RestrictedNewton`` of :func:`ReducedNewton` (warns at each use)."""
-    if name == "RestrictedNewton":
-        warnings.warn(
-            "RestrictedNewton is deprecated and will be removed in the next release: "
-            "use ReducedNewton",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return ReducedNewton
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = renamed(__name__, {"RestrictedNewton": "ReducedNewton"}, globals())

@@ -8,8 +8,7 @@ q-functions of the domain integrals, :mod:`~.interaction` the interaction integr
 problem, and :mod:`~.growth` quasi-static propagation.
 """
 
-import warnings
-
+from xfem_contact._deprecation import renamed
 from xfem_contact.mechanics.fracture.growth import (
     GrowthPath,
     GrowthStep,
@@ -70,15 +69,5 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str):
-    """``CrackPath``: the deprecated name of :class:`GrowthPath`."""
-    if name == "CrackPath":
-        warnings.warn(
-            "xfem_contact.mechanics.fracture.CrackPath is deprecated and will be removed in "
-            "the next release: it is GrowthPath (xfem_contact.geometry.crack_paths.CrackPath "
-            "is a scene's crack shape)",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return GrowthPath
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+#: ``CrackPath`` is GrowthPath here (``geometry.crack_paths.CrackPath`` is a scene's crack shape)
+__getattr__ = renamed(__name__, {"CrackPath": "GrowthPath"}, globals())

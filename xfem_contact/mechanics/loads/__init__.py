@@ -7,8 +7,7 @@ path in pseudo-time (:mod:`~xfem_contact.mechanics.loads.load_path`), and each
 ``add_*`` returns a handle (:mod:`~xfem_contact.mechanics.loads.handles`).
 """
 
-import warnings
-
+from xfem_contact._deprecation import renamed
 from xfem_contact.mechanics.loads.fields import PlainFields, SideFields
 from xfem_contact.mechanics.loads.handles import (
     DirichletLoad,
@@ -49,13 +48,4 @@ __all__ = [
 _RENAMED = {"History": "LoadPath", "SpringSupport": "TangentialSpring"}
 
 
-def __getattr__(name: str):
-    """The deprecated names of :data:`_RENAMED` (each warns at each use)."""
-    if name in _RENAMED:
-        warnings.warn(
-            f"{name} is deprecated and will be removed in the next release: use {_RENAMED[name]}",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return globals()[_RENAMED[name]]
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = renamed(__name__, _RENAMED, globals())

@@ -1,0 +1,26 @@
+"""Names kept for one release after a rename: a module ``__getattr__`` that warns.
+
+Every step may use it (a private root module, below every step)."""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable, Mapping
+
+
+def renamed(module: str, names: Mapping[str, str], namespace: dict) -> Callable[[str], object]:
+    """A module-level ``__getattr__`` for ``module`` (its ``__name__``) that serves each old
+    name of ``names`` (old -> new) as ``namespace[new]`` (the module's ``globals()``),
+    with a ``DeprecationWarning`` at each use naming the new one."""
+
+    def __getattr__(name: str):
+        if name in names:
+            warnings.warn(
+                f"{name} is deprecated and will be removed in the next release: use {names[name]}",
+                DeprecationWarning,
+                stacklevel=2,
+            )
+            return namespace[names[name]]
+        raise AttributeError(f"module {module!r} has no attribute {name!r}")
+
+    return __getattr__
