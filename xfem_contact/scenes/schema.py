@@ -105,7 +105,11 @@ def renamed(table, kind: str, where: str):
                 raise SceneError(f"{where}.{old}", f"give it once, as {new!r} (its old name)")
             _deprecated(f"{where}.{old}", f"the key {old!r} is now {new!r}")
             table[new] = table.pop(old)
-    if kind == "load" and table.get("type") in RENAMED_LOAD_TYPES:
+    if (
+        kind == "load"
+        and isinstance(table.get("type"), str)
+        and table["type"] in RENAMED_LOAD_TYPES
+    ):
         old, new = table["type"], RENAMED_LOAD_TYPES[table["type"]]
         _deprecated(f"{where}.type", f"the load type {old!r} is now {new!r}")
         table["type"] = new
