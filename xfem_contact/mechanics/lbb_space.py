@@ -21,10 +21,7 @@ def vital_vertex_prolongation(
     Cut edges (end vertices on opposite sides of the interpolated level set) of
     the cut cells (a crack's: those it crosses and its tip cells, so that the tip
     cells' own vertices carry the multiplier too; not the cells cut ahead of its tips,
-    where it would act on nothing, nor a tip cell's edge that only the extension of
-    the crack crosses: a vital vertex there would be fixed by the tip cell's piece of
-    the crack alone, a sliver when the tip lies just past a mesh edge) are gathered
-    globally, vital vertices chosen
+    where it would act on nothing) are gathered globally, vital vertices chosen
     identically on every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`), and
     each multiplier dof of a vertex on a cut edge expressed by
     :func:`xfem_contact.mechanics.lbb.prolongation`.
@@ -61,8 +58,6 @@ def vital_vertex_prolongation(
     ends = e2v.array.reshape(-1, 2)[edges]
     crossing = vertex_side[ends[:, 0]] != vertex_side[ends[:, 1]]
     ends = ends[crossing]
-    if cut.crack is not None:  # not the edges the crack's extension cuts ahead of a tip
-        ends = ends[_behind_tips(cut, ends, vertex_phi, cell_vertices)]
     global_ends = vmap.local_to_global(ends.ravel()).reshape(-1, 2)
     all_ends = np.concatenate(comm.allgather(global_ends))
     all_sides = np.concatenate(comm.allgather(vertex_side[ends]))
@@ -160,15 +155,3 @@ def combine_prolongations(
         np.concatenate(vals),
         num_owned=int(owned[:, comm.rank].sum()),
     )
-
-
-def _behind_tips(cut: CutMesh, ends: np.ndarray, vertex_phi: np.ndarray, cells: np.ndarray):
-    """Mask of the cut edges ``ends`` (local vertex pairs, ``(m, 2)``) whose crossing of
-    ``phi = 0`` lies on the crack (``psi <= 0``, ``psi`` the crack's tangential level set
-    interpolated linearly along the edge), not on its extension. Not collective."""
-    psi = cut.crack.tangent.function
-    vertex_psi = np.zeros_like(vertex_phi)
-    vertex_psi[cells] = psi.x.array[psi.function_space.dofmap.list[:, : cells.shape[1]]]
-    p, s = vertex_phi[ends], vertex_psi[ends]
-    t = p[:, 0] / (p[:, 0] - p[:, 1])
-    return s[:, 0] + t * (s[:, 1] - s[:, 0]) <= 0.0
