@@ -145,3 +145,24 @@ def test_every_law_answers_the_protocol(name):
     assert law.transmits in ("none", "normal", "full")
     assert isinstance(law.options(), dict)
     assert law.lbb in ("stabilized", "restriction", "none")
+
+
+@pytest.mark.parametrize(
+    "law, name, value",
+    [
+        (Coulomb(0.3), "lbb", "none"),
+        (Bonded(), "lbb", "restriction"),
+        (large_sliding(Frictionless(lbb="none")), "slave", 1),
+        (large_sliding(Frictionless(lbb="none")), "pairing", "step"),
+        (large_sliding(Coulomb(0.1, lbb="none")), "radius", 0.5),
+    ],
+)
+def test_options_that_shape_the_forms_are_fixed_at_construction(law, name, value):
+    """Setting them later would be ignored by the forms and pairing built on them: refused
+    in one line naming the option, the value kept."""
+    before = getattr(law, name)
+    with pytest.raises(ValueError, match=f"^{name} is fixed when the law is built") as error:
+        setattr(law, name, value)
+    assert "\n" not in str(error.value)
+    assert getattr(law, name) == before
+    assert law.options()[name] == before

@@ -267,6 +267,28 @@ class InterfaceLaw(abc.ABC):
         return {"law": self.name}
 
 
+class FixedAtConstruction:
+    """A law option that shapes the forms or the pairing (the LBB treatment, the slave
+    side, ...): set once by the constructor, then read-only, so that a new value is
+    refused in one line instead of being silently ignored by what was built on it."""
+
+    def __set_name__(self, owner, name: str):
+        self.name, self.private = name, f"_{name}"
+
+    def __get__(self, law, owner=None):
+        if law is None:
+            return self
+        return getattr(law, self.private)
+
+    def __set__(self, law, value) -> None:
+        if hasattr(law, self.private):
+            raise ValueError(
+                f"{self.name} is fixed when the law is built (its forms and pairing follow "
+                f"it): build a new law with {self.name}={value!r} instead"
+            )
+        setattr(law, self.private, value)
+
+
 def law_options(law: type[InterfaceLaw]) -> tuple[str, ...]:
     """The options a law class takes (the named arguments of its constructors)."""
     names: list[str] = []

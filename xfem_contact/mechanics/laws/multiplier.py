@@ -20,7 +20,12 @@ from __future__ import annotations
 import ufl
 
 from xfem_contact.mechanics.defaults import DEFAULT
-from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw
+from xfem_contact.mechanics.laws.base import (
+    Fields,
+    FixedAtConstruction,
+    InterfaceContext,
+    InterfaceLaw,
+)
 from xfem_contact.mechanics.lbb_space import vital_vertex_prolongation
 from xfem_contact.mechanics.parameters import Parameter, constant
 
@@ -43,6 +48,7 @@ class MultiplierLaw(InterfaceLaw):
 
     multiplier_stabilization = Parameter(minimum=0.0)
     multiplier_extension = Parameter(minimum=0.0)
+    lbb = FixedAtConstruction()
 
     def __init__(
         self,

@@ -21,7 +21,12 @@ import ufl
 from ufl.algorithms import extract_arguments, extract_coefficients
 
 from xfem_contact.mechanics.defaults import DEFAULT
-from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw
+from xfem_contact.mechanics.laws.base import (
+    Fields,
+    FixedAtConstruction,
+    InterfaceContext,
+    InterfaceLaw,
+)
 from xfem_contact.mechanics.laws.contact import ContactLaw, CoulombFriction
 from xfem_contact.mechanics.parameters import Parameter, constant
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES, SlidingCoupling
@@ -53,6 +58,9 @@ class SlidingContact(ContactLaw):
 
     #: Large sliding
     sliding = True
+    slave = FixedAtConstruction()
+    pairing = FixedAtConstruction()
+    radius = FixedAtConstruction()
 
     def __init__(
         self,
