@@ -33,6 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from xfem_contact.geometry.cut_topology import nodal_values
+
 __all__ = ["REFERENCE_TET", "TetCut", "classify_tets", "cut_tets"]
 
 REFERENCE_TET = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
@@ -125,15 +127,7 @@ _FIELDS = {
 
 def _check(phi: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """``phi`` as float64 ``(ncells, 4)``; raises naming the first bad cell."""
-    phi = np.asarray(phi, dtype=np.float64)
-    if phi.ndim != 2 or phi.shape[1] != 4:
-        raise ValueError(f"phi must have shape (ncells, 4) for a P1 tetrahedron, got {phi.shape}")
-    bad = np.flatnonzero(~np.isfinite(phi).all(axis=1))
-    if bad.size:
-        raise ValueError(
-            f"level-set values of tetrahedron {bad[0]} are not finite ({phi[bad[0]].tolist()}); "
-            f"{bad.size} cell(s) affected"
-        )
+    phi = nodal_values(phi, 4, "P1 tetrahedron", "tetrahedron")
     flat = np.flatnonzero((phi == 0.0).all(axis=1))
     if flat.size:
         raise ValueError(

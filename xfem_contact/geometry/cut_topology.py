@@ -190,22 +190,26 @@ def seg3_basis(s: np.ndarray) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.f
     return N, dN
 
 
-def check_values(data: CellData, phi: npt.ArrayLike) -> npt.NDArray[np.float64]:
-    """``phi`` as a float64 array of shape ``(ncells, ndofs)``; raises on bad shape or
-    non-finite values (naming the first offending cell)."""
+def nodal_values(phi: npt.ArrayLike, ndofs: int, element: str, cell: str = "cell"):
+    """``phi`` as a float64 array of shape ``(ncells, ndofs)``; raises on a bad shape
+    (naming the ``element``, e.g. ``"P1 tetrahedron"``) or non-finite values (naming the
+    first offending ``cell`` by its row). Any cell kind and degree."""
     phi = np.asarray(phi, dtype=np.float64)
-    if phi.ndim != 2 or phi.shape[1] != data.ndofs:
-        raise ValueError(
-            f"phi must have shape (ncells, {data.ndofs}) for a degree-{data.degree} "
-            f"{data.cell_type}, got {phi.shape}"
-        )
+    if phi.ndim != 2 or phi.shape[1] != ndofs:
+        raise ValueError(f"phi must have shape (ncells, {ndofs}) for a {element}, got {phi.shape}")
     bad = np.flatnonzero(~np.isfinite(phi).all(axis=1))
     if bad.size:
         raise ValueError(
-            f"level-set nodal values of cell {bad[0]} are not finite ({phi[bad[0]].tolist()}); "
+            f"level-set nodal values of {cell} {bad[0]} are not finite ({phi[bad[0]].tolist()}); "
             f"{bad.size} cell(s) affected: check the level-set function"
         )
     return phi
+
+
+def check_values(data: CellData, phi: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """``phi`` as a float64 array of shape ``(ncells, ndofs)`` of ``data``'s cells
+    (:func:`nodal_values`)."""
+    return nodal_values(phi, data.ndofs, f"degree-{data.degree} {data.cell_type}")
 
 
 def edge_coefficients(

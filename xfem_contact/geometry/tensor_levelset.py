@@ -19,6 +19,8 @@ import basix
 import numpy as np
 import numpy.typing as npt
 
+from xfem_contact.geometry.cut_topology import nodal_values
+
 __all__ = [
     "bernstein",
     "coefficients",
@@ -60,16 +62,7 @@ def coefficients(phi: npt.ArrayLike, degree: int) -> npt.NDArray[np.float64]:
     if degree not in (1, 2):
         raise ValueError(f"degree must be 1 or 2 for a hexahedron level set, got {degree!r}")
     n = (degree + 1) ** 3
-    phi = np.asarray(phi, dtype=np.float64)
-    if phi.ndim != 2 or phi.shape[1] != n:
-        raise ValueError(
-            f"phi must have shape (ncells, {n}) for a Q{degree} hexahedron, got {phi.shape}"
-        )
-    bad = np.flatnonzero(~np.isfinite(phi).all(axis=1))
-    if bad.size:
-        raise ValueError(
-            f"level-set values of hexahedron {bad[0]} are not finite; {bad.size} cell(s) affected"
-        )
+    phi = nodal_values(phi, n, f"Q{degree} hexahedron", "hexahedron")
     return (phi @ _from_nodal(degree).T).reshape(-1, degree + 1, degree + 1, degree + 1)
 
 

@@ -27,6 +27,7 @@ import basix
 import numpy as np
 import numpy.typing as npt
 
+from xfem_contact.geometry.cut_topology import nodal_values
 from xfem_contact.geometry.tensor_levelset import coefficients
 from xfem_contact.quadrature.saye import (
     MAX_DEPTH,
@@ -98,14 +99,7 @@ def _to_cubes() -> np.ndarray:
 
 
 def _cube_coefficients(phi: npt.ArrayLike) -> np.ndarray:
-    phi = np.asarray(phi, dtype=np.float64)
-    if phi.ndim != 2 or phi.shape[1] != 10:
-        raise ValueError(f"phi must have shape (ncells, 10) for a P2 tetrahedron, got {phi.shape}")
-    bad = np.flatnonzero(~np.isfinite(phi).all(axis=1))
-    if bad.size:
-        raise ValueError(
-            f"level-set values of tetrahedron {bad[0]} are not finite; {bad.size} cell(s) affected"
-        )
+    phi = nodal_values(phi, 10, "P2 tetrahedron", "tetrahedron")
     values = (phi @ _to_cubes().T).reshape(-1, 27)  # row 4 c + k: hexahedron k of cell c
     return coefficients(values, 2)
 
