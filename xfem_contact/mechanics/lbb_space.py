@@ -9,7 +9,7 @@ from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.prolongation import MultiplierProlongation
-from xfem_contact.geometry.crack import NONE
+from xfem_contact.geometry.crack import NONE, TIP
 from xfem_contact.mechanics import lbb as lbb_module
 
 
@@ -57,7 +57,9 @@ def vital_vertex_prolongation(
     edges = np.unique(c2e.array.reshape(-1, ne_cell)[cut_cells].ravel())
     ends = e2v.array.reshape(-1, 2)[edges]
     crossing = vertex_side[ends[:, 0]] != vertex_side[ends[:, 1]]
-    ends = ends[crossing]
+    edges, ends = edges[crossing], ends[crossing]
+    if cut.crack is not None:
+        ends = ends[~_sliver_extension_edges(cut, edges, ends, vertex_phi, cell_vertices, c2e)]
     global_ends = vmap.local_to_global(ends.ravel()).reshape(-1, 2)
     all_ends = np.concatenate(comm.allgather(global_ends))
     all_sides = np.concatenate(comm.allgather(vertex_side[ends]))
@@ -155,3 +157,43 @@ def combine_prolongations(
         np.concatenate(vals),
         num_owned=int(owned[:, comm.rank].sum()),
     )
+
+
+#: A tip cell whose piece of the crack is shorter than this share of its longest edge
+#: gives the edges that only the crack's extension crosses no vital vertex
+SLIVER_SHARE = 0.25
+
+
+def _sliver_extension_edges(
+    cut: CutMesh, edges, ends, vertex_phi, cell_vertices, c2e
+) -> np.ndarray:
+    """Mask of the cut ``edges`` (local indices, ``(m,)``; their end vertices ``ends``,
+    ``(m, 2)``) to leave out of the vital-vertex choice: those a tip cell's zero line
+    crosses ahead of the tip (``psi > 0`` at the crossing, ``psi`` the crack's tangential
+    level set, a signed distance along the crack, interpolated linearly along the edge)
+    when the tip cell's piece of the crack (``-psi`` at its crossing behind the tip) is
+    shorter than :data:`SLIVER_SHARE` of the cell's longest edge. A vital vertex there
+    would be fixed by a sliver of the crack alone (the tip just past a mesh edge, or the
+    crack clipping a corner of the tip cell); an edge the crack itself crosses keeps its
+    vertex. Not collective."""
+    psi = cut.crack.tangent.function
+    vertex_psi = np.zeros_like(vertex_phi)
+    vertex_psi[cell_vertices] = psi.x.array[
+        psi.function_space.dofmap.list[:, : cell_vertices.shape[1]]
+    ]
+    p, s = vertex_phi[ends], vertex_psi[ends]
+    t = p[:, 0] / (p[:, 0] - p[:, 1])
+    crossing_psi = s[:, 0] + t * (s[:, 1] - s[:, 0])
+    num_edges = int(c2e.array.max(initial=-1)) + 1
+    edge_psi = np.full(num_edges, np.nan)
+    edge_psi[edges] = crossing_psi
+    ne_cell = c2e.offsets[1] - c2e.offsets[0]
+    tips = cut.cut_cells[cut.crack.kind == TIP]
+    tip_edges = c2e.array.reshape(-1, ne_cell)[tips]
+    tip_psi = edge_psi[tip_edges]  # (tip cells, edges of a cell); NaN: not cut
+    piece = -np.where(tip_psi <= 0.0, tip_psi, 0.0).min(axis=1, initial=0.0)
+    corners = cut.mesh.geometry.x[cut.mesh.geometry.dofmaps[0][tips][:, : cell_vertices.shape[1]]]
+    longest = np.linalg.norm(corners[:, :, None] - corners[:, None], axis=-1).max(axis=(1, 2))
+    drop = np.zeros(num_edges, dtype=bool)
+    drop[tip_edges[piece < SLIVER_SHARE * longest].ravel()] = True
+    return drop[edges] & (crossing_psi > 0.0)
