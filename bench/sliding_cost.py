@@ -8,7 +8,7 @@ integration) and, in the same run on the same mesh, the small-sliding solve of c
 sensitive to the other loads of a shared machine than wall time) per Newton
 iteration, the first load step left out (it sets up and compiles), split into the
 hybrid elements' residual and Jacobian (:class:`~xfem_contact.mechanics.sliding.
-coupling.SlidingCoupling`: split, pairing, element, blocks) and the rest (bulk
+coupling.SlidingCoupling`: breakpoints, pairing, element, blocks) and the rest (bulk
 assembly, factorisation, solve). Also the CPU time of the whole large-sliding run
 (set-up, 4 steps, pressure errors), and with ``--profile`` its top cProfile entries.
 

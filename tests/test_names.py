@@ -9,7 +9,9 @@ from test_scenes import base
 
 import xfem_contact.mechanics.loads as loads_package
 from xfem_contact.cases.paper import inclusion_problem
+from xfem_contact.cases.rotation import rotating_annulus_problem
 from xfem_contact.mechanics.fieldsplit_data import fieldsplit_dofs
+from xfem_contact.mechanics.sliding import segments
 from xfem_contact.scenes.scene import SceneError, load_scene
 from xfem_contact.solvers import linear, newton, options
 
@@ -145,3 +147,22 @@ def test_fieldsplit_dofs_keyword_and_its_old_name():
 def test_old_fieldsplit_preconditioners_name_warns():
     with pytest.warns(DeprecationWarning, match="FIELDSPLIT_PRECONDITIONERS"):
         assert options.SPLIT_PRECONDITIONERS is options.FIELDSPLIT_PRECONDITIONERS
+
+
+@pytest.mark.parametrize(
+    "old, new", [("split", "break_pieces"), ("split_gradient", "breakpoint_gradient")]
+)
+def test_old_breakpoint_function_names_warn(old, new):
+    with pytest.warns(DeprecationWarning, match=new):
+        assert getattr(segments, old) is getattr(segments, new)
+
+
+def test_breakpoint_linearisation_and_its_old_name():
+    coupling = rotating_annulus_problem(4, 1, 0.3).couplings["interface"]
+    assert coupling.breakpoint_linearisation is True
+    with pytest.warns(DeprecationWarning, match="SlidingCoupling.breakpoint_linearisation"):
+        coupling.split_linearisation = False
+    assert coupling.breakpoint_linearisation is False
+    with pytest.warns(DeprecationWarning, match="SlidingCoupling.breakpoint_linearisation"):
+        assert coupling.split_linearisation is False
+
