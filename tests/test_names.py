@@ -166,3 +166,12 @@ def test_breakpoint_linearisation_and_its_old_name():
     with pytest.warns(DeprecationWarning, match="SlidingCoupling.breakpoint_linearisation"):
         assert coupling.split_linearisation is False
 
+
+def test_side_measure_ids_and_its_old_name():
+    cut = inclusion_problem(4, 1, "sticking", "triangle").cut
+    for side in (-1, 1):
+        measure = cut.dx(side).subdomain_id()
+        with pytest.warns(DeprecationWarning, match="CutMesh.side_measure_ids"):
+            assert cut.split_side_measure(measure) == cut.side_measure_ids(measure)
+        assert len(set(cut.side_measure_ids(measure)) | {measure}) == 3
+    assert cut.side_measure_ids(cut.dGamma.subdomain_id()) is None
