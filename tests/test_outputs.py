@@ -125,7 +125,7 @@ def test_forces_at_a_state_are_those_of_the_problem_solved_to_it(law, options):
     assert again["balance_relative"] < BALANCE, again
 
 
-def test_spring_supports_are_reactions():
+def test_tangential_springs_are_reactions():
     data = plate("sticking")
     data["loads"].append({"part": "left", "type": "tangential_spring", "value": 1e9})
     problem = solved(data)
