@@ -488,7 +488,7 @@ def test_circle_through_one_vertex():
 
 def grid_cells(cell: str, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Affine cells of an n x n grid of [0, 1]^2 as origin ``(m, 2)`` and
-    Jacobian ``(m, 2, 2)`` (triangles: each square split in two)."""
+    Jacobian ``(m, 2, 2)`` (triangles: each square cut in two)."""
     h = 1.0 / n
     corners = np.array([[i * h, j * h] for i in range(n) for j in range(n)])
     if cell == "quadrilateral":

@@ -115,7 +115,7 @@ def _reduced(interpolation, chosen, D):
 
 def _orthonormalise(vectors: list[PETSc.Vec]) -> list[PETSc.Vec]:
     """Modified Gram-Schmidt (a near null space must be orthonormal): the orthonormal
-    vectors kept, the ones that vanish on the split (e.g. the rigid modes of a body
+    vectors kept, the ones that vanish on the fieldsplit (e.g. the rigid modes of a body
     that lies in the interface layer) destroyed. Collective."""
     kept = []
     for v in vectors:
