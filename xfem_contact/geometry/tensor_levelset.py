@@ -63,11 +63,7 @@ def coefficients(phi: npt.ArrayLike, degree: int) -> npt.NDArray[np.float64]:
         raise ValueError(f"degree must be 1 or 2 for a hexahedron level set, got {degree!r}")
     n = (degree + 1) ** 3
     phi = nodal_values(phi, n, f"Q{degree} hexahedron", "hexahedron")
-    # einsum, not BLAS: a cell's coefficients must not depend on the other cells of the
-    # batch (BLAS rounds differently by matrix size, so the partition, i.e. the number of
-    # processes, would change the ties that Saye's choice of axes breaks)
-    C = np.einsum("nd,cd->nc", phi, _from_nodal(degree))
-    return C.reshape(-1, degree + 1, degree + 1, degree + 1)
+    return (phi @ _from_nodal(degree).T).reshape(-1, degree + 1, degree + 1, degree + 1)
 
 
 def _powers(x: np.ndarray, p: int) -> np.ndarray:
