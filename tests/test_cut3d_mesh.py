@@ -245,3 +245,21 @@ def test_level_set_dof_points_do_not_depend_on_the_cell():
         by_dof = np.zeros((V.dofmap.index_map.size_local, 3))
         by_dof[V.dofmap.list] = points
         assert np.array_equal(by_dof[V.dofmap.list], points), cell  # the same bits in all cells
+
+
+def test_picture_of_a_3d_cut(tmp_path):
+    """plot_cut_3d writes a PNG that shows side -1, side +1 and the interface."""
+    import pyvista
+
+    from xfem_contact.io.cut3d_pictures import INTERFACE_COLOUR, plot_cut_3d
+    from xfem_contact.io.pictures import SIDE_COLOURS
+
+    mesh = cube(4, "hexahedron", MPI.COMM_SELF)
+    cut = CutMesh(mesh, lambda x: np.sqrt(((x - 0.5) ** 2).sum(axis=0)) - R, degree=2)
+    path = plot_cut_3d(cut, tmp_path / "cut.png", window_size=(400, 300))
+    png = pyvista.read(str(path))
+    image = png.point_data[png.point_data.keys()[0]][:, :3].astype(float)
+    for colour in (INTERFACE_COLOUR, SIDE_COLOURS[-1][1]):
+        rgb = np.array(pyvista.Color(colour).int_rgb, dtype=float)
+        near = np.linalg.norm(image - rgb, axis=1) < 60  # shaded, not the exact colour
+        assert near.mean() > 0.005, colour
