@@ -86,9 +86,11 @@ def test_plane_cut_of_the_unit_cube_is_exact(cell):
 
 @pytest.mark.parametrize("cell", list(CELLS_3D))
 def test_cut_boundary_faces_are_exact(cell):
-    """``cut.ds(side, facets)`` on each face of the cube: the areas of its two sides."""
+    """``cut.ds(side, facets)`` on each face of the cube: the areas of its two sides, as
+    the integral of ``FacetNormal . e`` with ``e`` the face's outward normal."""
     mesh = cube(3, cell)
     cut = CutMesh(mesh, plane, degree=1)
+    outward = dolfinx.fem.Constant(mesh, np.zeros(3))
     forms = {}
     for axis in range(3):
         u, v = np.delete(NORMAL, axis)
@@ -97,10 +99,12 @@ def test_cut_boundary_faces_are_exact(cell):
                 mesh, 2, lambda x, a=axis, c=value: np.isclose(x[a], c)
             )
             minus = square_side_area(u, v, OFFSET - NORMAL[axis] * value)
+            outward.value[:] = np.eye(3)[axis] * (1.0 if value else -1.0)
             for side, exact in ((-1, minus), (1, 1.0 - minus)):
                 measure = cut.ds(side, facets)
                 key = (side, measure.subdomain_id())
-                forms.setdefault(key, xfem_contact.form(1.0 * measure))
+                integrand = ufl.dot(ufl.FacetNormal(mesh), outward)
+                forms.setdefault(key, xfem_contact.form(integrand * measure))
                 area = mesh.comm.allreduce(dolfinx.fem.assemble_scalar(forms[key]))
                 assert abs(area - exact) <= 1e-13, (axis, value, side, area, exact)
 
@@ -217,6 +221,11 @@ def test_bad_input_is_refused_in_one_line():
             cube(2, "hexahedron"),
             lambda x: ((x - np.array([[0.5], [0.5]])) ** 2).sum(axis=0) - 0.1,
             r"failed on points x of shape \(3, \d+\) \(a 3D mesh: x\[0\], x\[1\], x\[2\]",
+        ),
+        (
+            cube(2, "tetrahedron"),
+            lambda x: np.where(x[0] > 0.9, np.nan, x[2] - 0.3),
+            r"NaN or inf at 9 node\(s\), e.g. at x = \(1, 0, 0\): give one",
         ),
     ]
     for mesh, levelset, message in cases:

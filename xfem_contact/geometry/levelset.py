@@ -146,9 +146,14 @@ def interpolate(
         local = np.round(V.tabulate_dof_coordinates()[bad, :2], 12) + 0.0  # no 1e-18 or -0
         points = np.concatenate(comm.allgather(local[np.lexsort(local.T)[:1]]))
         x, y = points[np.lexsort(points.T)[0]]
+        where = f"({x:.6g}, {y:.6g})"
+        if mesh.geometry.dim == 3:  # the same choice of node, with its z
+            local = np.round(V.tabulate_dof_coordinates()[bad], 12) + 0.0
+            first = np.concatenate(comm.allgather(local[np.lexsort(local[:, :2].T)[:1]]))
+            where = "({:.6g}, {:.6g}, {:.6g})".format(*first[np.lexsort(first[:, :2].T)[0]])
         raise ValueError(
-            f"The level set is NaN or inf at {count} node(s), e.g. at x = ({x:.6g}, "
-            f"{y:.6g}): give one that is finite on the whole mesh"
+            f"The level set is NaN or inf at {count} node(s), e.g. at x = {where}: give one "
+            "that is finite on the whole mesh"
         )
     lo = comm.allreduce(values.min(initial=np.inf), op=MPI.MIN)
     hi = comm.allreduce(values.max(initial=-np.inf), op=MPI.MAX)
