@@ -92,6 +92,15 @@ def physical_parts(path: str | Path) -> dict[str, int]:
         return _parts(gmsh, meshed=path.suffix.lower() == ".msh", dim=_dimension(gmsh))
 
 
+def dimension(path: str | Path) -> int:
+    """3 for a .geo or .msh file with volumes, else 2. No meshing; serial, for validation.
+    Raises as :func:`physical_parts`."""
+    path = _check_path(path)
+    with _gmsh_session() as gmsh:
+        _load(gmsh, path)
+        return _dimension(gmsh)
+
+
 def read_gmsh(
     path: str | Path,
     comm: MPI.Comm,
