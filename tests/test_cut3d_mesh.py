@@ -232,6 +232,16 @@ def test_bad_input_is_refused_in_one_line():
         with pytest.raises(ValueError, match=message) as error:
             CutMesh(mesh, levelset, degree=1)
         assert "\n" not in str(error.value)
+
+    def cone(x):  # apex at (0.3, 0.3, 0.3): a singular point of the zero set
+        return ((x - 0.3) ** 2 * np.array([[1.0], [1.0], [-1.0]])).sum(axis=0)
+
+    for cell, where in (
+        ("hexahedron", r"\(0\.25, 0\.25, 0\.25\) \(local cell \d+\)"),
+        ("tetrahedron", r"\(.*\) \(local cell \d+\)"),
+    ):
+        with pytest.raises(ValueError, match=f"^{cell} at {where}: the level set has a singular"):
+            CutMesh(cube(2, cell, MPI.COMM_SELF), cone, degree=2)
     mesh = cube(2, "tetrahedron")
     with pytest.raises(ValueError, match="^tangent: cracks are cut on triangle") as error:
         CutMesh(mesh, plane, tangent=plane)
@@ -272,3 +282,14 @@ def test_picture_of_a_3d_cut(tmp_path):
         rgb = np.array(pyvista.Color(colour).int_rgb, dtype=float)
         near = np.linalg.norm(image - rgb, axis=1) < 60  # shaded, not the exact colour
         assert near.mean() > 0.005, colour
+
+
+@pytest.mark.mpi
+def test_a_refusal_on_one_process_is_raised_on_all():
+    """The cone's apex lies in one cell, owned by one process: all raise, none waits."""
+
+    def cone(x):
+        return ((x - 0.3) ** 2 * np.array([[1.0], [1.0], [-1.0]])).sum(axis=0)
+
+    with pytest.raises(ValueError, match=r"^hexahedron at \(0\.375, 0\.375, 0\.375\)"):
+        CutMesh(cube(4, "hexahedron"), cone, degree=2)

@@ -55,19 +55,23 @@ def cut_state_3d(
     phi = interpolate_named(mesh, levelset, degree, names, previous)
     maps = CellMaps(mesh, phi)
     owned = np.arange(mesh.topology.index_map(tdim).size_local, dtype=np.int32)
-    side = classify_3d(cell, degree, maps.nodal_values(owned))
+    side = _collective(mesh, lambda: classify_3d(cell, degree, maps.nodal_values(owned)))
     cut_cells = owned[side == 0]
     cut_time, timer = seconds(timer), phase("cut rules")
-    try:
-        cut = cut_rules_3d(
-            cell,
-            degree,
-            maps.nodal_values(cut_cells),
-            quadrature_degree,
-            lambda rows, X: maps.jacobian(cut_cells[rows], X),
-        )
-    except ValueError as error:  # a row of the cut cells -> the cell's position
-        raise ValueError(_located(str(error), cell, degree, maps, cut_cells)) from None
+
+    def rules_of_cut_cells():
+        try:
+            return cut_rules_3d(
+                cell,
+                degree,
+                maps.nodal_values(cut_cells),
+                quadrature_degree,
+                lambda rows, X: maps.jacobian(cut_cells[rows], X),
+            )
+        except ValueError as error:  # a row of the cut cells -> the cell's position
+            raise ValueError(_located(str(error), cell, degree, maps, cut_cells)) from None
+
+    cut = _collective(mesh, rules_of_cut_cells)
     rules = {
         SIDE_MINUS: cut.minus,
         SIDE_PLUS: cut.plus,
@@ -93,8 +97,22 @@ def cut_state_3d(
     )
 
 
+def _collective(mesh: dolfinx.mesh.Mesh, step):
+    """``step()`` on every process; a ``ValueError`` on any of them is raised on all (the
+    first rank's message), so that no process waits for the others. Collective."""
+    try:
+        result, message = step(), None
+    except ValueError as error:
+        result, message = None, str(error)
+    messages = [m for m in mesh.comm.allgather(message) if m is not None]
+    if messages:
+        raise ValueError(messages[0])
+    return result
+
+
 def _located(message: str, cell: str, degree: int, maps: CellMaps, cut_cells) -> str:
-    """A kernel's refusal naming a row of the cut cells, with that cell's centroid (m)."""
+    """A kernel's refusal naming a row of the cut cells, naming the cell by its vertices'
+    centroid (m) and its local index instead."""
     found = re.match(r"(tetrahedron|hexahedron) (\d+):", message)
     if found is None:
         return message
@@ -103,4 +121,5 @@ def _located(message: str, cell: str, degree: int, maps: CellMaps, cut_cells) ->
         row //= 4
     centre = maps.cell_nodes(cut_cells[row : row + 1])[0].mean(axis=0)
     where = ", ".join(f"{v:.6g}" for v in centre)
-    return f"{cell} cut at ({where}) (local cell {cut_cells[row]}): {message}"
+    reason = message[found.end() :].strip()  # the kernel's row is not the mesh's cell
+    return f"{cell} at ({where}) (local cell {cut_cells[row]}): {reason}"
