@@ -73,6 +73,7 @@ def square_side_area(u: float, v: float, c: float) -> float:
     return sum(sign * max(c - u * s - v * t, 0.0) ** 2 for s, t, sign in corners) / (2 * u * v)
 
 
+@pytest.mark.mpi
 @pytest.mark.parametrize("cell", list(CELLS_3D))
 def test_plane_cut_of_the_unit_cube_is_exact(cell):
     mesh = cube(3, cell)
@@ -84,6 +85,7 @@ def test_plane_cut_of_the_unit_cube_is_exact(cell):
     assert total(mesh, ufl.inner(cut.normal - n, cut.normal - n) * cut.dGamma) <= 1e-26
 
 
+@pytest.mark.mpi
 @pytest.mark.parametrize("cell", list(CELLS_3D))
 def test_cut_boundary_faces_are_exact(cell):
     """``cut.ds(side, facets)`` on each face of the cube: the areas of its two sides, as
@@ -128,6 +130,7 @@ def test_sphere_from_a_degree_2_function_converges(cell):
     assert v8 < v4 / 2.5 and a8 < a4 / 2.5, errors
 
 
+@pytest.mark.mpi
 def test_named_interfaces_and_update():
     """Two planes as named interfaces: each one's area, both sides' volumes; an update
     moves them and the same compiled forms integrate on the new cut."""
