@@ -6,7 +6,8 @@ term, assembled through the runtime rules (``cut.dx(-1) + cut.dx(+1)`` and
 ``cut.dGamma``), against stock DOLFINx's assembly of the Laplacian on the uncut mesh with
 ``ufl.dx``. Both forms are compiled first; the times are the best of ``--repeat``
 assemblies into an existing matrix. Also printed: the cut (level set, classification and
-rules) and the number of cut cells::
+rules), the number of cut cells, the points per cut cell, and the relative errors of the
+sphere's volume and area (how much the rules' degree buys)::
 
     python bench/cut3d_assembly.py --sizes 16 --degrees 1 2 --quadrature-degrees 2 6
 
@@ -48,8 +49,8 @@ def best_time(assemble, repeat: int) -> float:
 
 
 def run(cell: str, n: int, degree: int, q: int, repeat: int) -> dict[str, float]:
-    """Times (s) of the cut, of the cut and the stock assembly, and their ratio, for a
-    level set of ``degree`` and rules of ``quadrature_degree=q``."""
+    """Times (s) of the cut, of the cut and the stock assembly, their ratio and the
+    sphere's errors, for a level set of ``degree`` and rules of ``quadrature_degree=q``."""
     comm = MPI.COMM_WORLD
     mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
     start = time.perf_counter()
@@ -75,6 +76,11 @@ def run(cell: str, n: int, degree: int, q: int, repeat: int) -> dict[str, float]
 
         times[name] = best_time(assemble, repeat)
     dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+    one = dolfinx.fem.Constant(mesh, 1.0)
+    volume, area = (
+        comm.allreduce(dolfinx.fem.assemble_scalar(xfem_contact.form(one * m)))
+        for m in (cut.dx(-1), cut.dGamma)
+    )
     return {
         "cells": mesh.topology.index_map(3).size_global,
         "cut cells": cut.num_cut_cells_global,
@@ -84,6 +90,8 @@ def run(cell: str, n: int, degree: int, q: int, repeat: int) -> dict[str, float]
         "cut assembly (s)": times["cut"],
         "stock assembly (s)": times["stock"],
         "ratio": times["cut"] / times["stock"],
+        "volume error": abs(volume / (4 / 3 * np.pi * R**3) - 1),
+        "area error": abs(area / (4 * np.pi * R**2) - 1),
     }
 
 
