@@ -296,3 +296,15 @@ def test_a_refusal_on_one_process_is_raised_on_all():
 
     with pytest.raises(ValueError, match=r"^hexahedron at \(0\.375, 0\.375, 0\.375\)"):
         CutMesh(cube(4, "hexahedron"), cone, degree=2)
+
+
+@pytest.mark.parametrize("cell", list(CELLS_3D))
+def test_cut_boundary_faces_of_a_curved_interface(cell):
+    """A sphere centred on the face z = 0 (P2/Q2 level set): the face's side -1 is a disc
+    (the 2D cutter on the face's restricted level set), and the two sides make the face."""
+    mesh = cube(8, cell)
+    cut = CutMesh(mesh, lambda x: np.sqrt((x[0] - 0.5) ** 2 + (x[1] - 0.5) ** 2 + x[2] ** 2) - R)
+    facets = dolfinx.mesh.locate_entities_boundary(mesh, 2, lambda x: np.isclose(x[2], 0.0))
+    disc, rest = (total(mesh, 1.0 * cut.ds(side, facets)) for side in (-1, 1))
+    assert abs(disc / (np.pi * R**2) - 1) < 5e-4
+    assert abs(disc + rest - 1) < 1e-14
