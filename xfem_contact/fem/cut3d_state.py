@@ -59,17 +59,20 @@ def cut_state_3d(
     cut_cells = owned[side == 0]
     cut_time, timer = seconds(timer), phase("cut rules")
 
+    def rules_of(rows: np.ndarray):
+        return cut_rules_3d(
+            cell,
+            degree,
+            maps.nodal_values(cut_cells[rows]),
+            quadrature_degree,
+            lambda r, X: maps.jacobian(cut_cells[rows][r], X),
+        )
+
     def rules_of_cut_cells():
         try:
-            return cut_rules_3d(
-                cell,
-                degree,
-                maps.nodal_values(cut_cells),
-                quadrature_degree,
-                lambda rows, X: maps.jacobian(cut_cells[rows], X),
-            )
-        except ValueError as error:  # a row of the cut cells -> the cell's position
-            raise ValueError(_located(str(error), cell, degree, maps, cut_cells)) from None
+            return rules_of(np.arange(cut_cells.size))
+        except ValueError as error:
+            raise ValueError(_located(str(error), rules_of, maps, cut_cells)) from None
 
     cut = _collective(mesh, rules_of_cut_cells)
     rules = {
@@ -110,16 +113,22 @@ def _collective(mesh: dolfinx.mesh.Mesh, step):
     return result
 
 
-def _located(message: str, cell: str, degree: int, maps: CellMaps, cut_cells) -> str:
-    """A kernel's refusal naming a row of the cut cells, naming the cell by its vertices'
-    centroid (m) and its local index instead."""
-    found = re.match(r"(tetrahedron|hexahedron) (\d+):", message)
-    if found is None:
-        return message
-    row = int(found[2])
-    if cell == "tetrahedron" and degree == 2:  # rows of the four hexahedra of each cell
-        row //= 4
-    centre = maps.cell_nodes(cut_cells[row : row + 1])[0].mean(axis=0)
+def _located(message: str, rules_of, maps: CellMaps, cut_cells: np.ndarray) -> str:
+    """A refusal of the rules of the cut cells, naming the first refused cell by its local
+    index and its vertices' centroid (m), found by bisection (the kernels number the cells
+    of their own batch; a P2 tetrahedron is four of them). ``rules_of(rows)`` makes the
+    rules of ``cut_cells[rows]``."""
+    lo, hi = 0, cut_cells.size  # a refused cell lies in rows lo .. hi - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        try:
+            rules_of(np.arange(lo, mid))
+            lo = mid
+        except ValueError:
+            hi = mid
+    centre = maps.cell_nodes(cut_cells[lo : lo + 1])[0].mean(axis=0)
     where = ", ".join(f"{v:.6g}" for v in centre)
-    reason = message[found.end() :].strip()  # the kernel's row is not the mesh's cell
-    return f"{cell} at ({where}) (local cell {cut_cells[row]}): {reason}"
+    found = re.match(r"(tetrahedron|hexahedron) \d+: ", message)  # the kernel's own row
+    reason = message[found.end() :] if found else message
+    cell = maps.mesh.topology.cell_name()
+    return f"{cell} at ({where}) (local cell {cut_cells[lo]}): {reason}"
