@@ -500,7 +500,7 @@ def test_cli_scenes_show_prints_a_bundled_scene(capsys):
     assert cli.main(["scenes", "--show", "case2_sticking_inclusion"]) == 0
     out = capsys.readouterr().out
     path = bundled_scenes()["case2_sticking_inclusion"]
-    assert out == path.read_text(encoding="utf-8") and "law = \"sticking\"" in out
+    assert out == path.read_text(encoding="utf-8") and 'law = "sticking"' in out
     assert cli.main(["scenes", "--show", "case9"]) == 2
     captured = capsys.readouterr()
     err = captured.err.splitlines()
@@ -893,6 +893,15 @@ def test_gmsh_scene_errors(mesh, load, key, fragment):
     if load:
         data["loads"].append(load)
     one_line_error(data, key, fragment, folder=SCENES)
+
+
+def test_gmsh_scene_refuses_a_3d_file(tmp_path):
+    ball = tmp_path / "ball.geo"
+    ball.write_text(
+        'SetFactory("OpenCASCADE");\nSphere(1) = {0, 0, 0, 0.5};\n'
+        'Physical Volume("ball", 7) = {1};\nPhysical Surface("hole", 3) = {1};\n'
+    )
+    one_line_error(gmsh_scene(file=str(ball)), "mesh.file", "is a 3D geometry (it has volumes)")
 
 
 def test_msh_file_takes_its_own_cells(tmp_path):

@@ -159,12 +159,17 @@ def load_scene(
         parts[name] = check_table(table, FIELDS["part"], where)["where"]
     known_parts = set(BUILTIN_PARTS[mesh["kind"]]) | set(parts)
     if mesh["file"] is not None:
-        from xfem_contact.io.gmsh import physical_parts
+        from xfem_contact.io.gmsh import dimension, physical_parts
 
         try:
             known_parts |= set(physical_parts(mesh["file"]))
+            three_d = dimension(mesh["file"]) == 3
         except (OSError, ValueError) as error:
             raise SceneError("mesh.file", " ".join(str(error).split())) from None
+        if three_d:
+            raise SceneError(
+                "mesh.file", f"{mesh['file']} is a 3D geometry (it has volumes); scenes are 2D"
+            )
     stages = stages_table(data.get("stages", {}), "stages")
     loads = [
         load_spec(table, where, known_parts, stages)
