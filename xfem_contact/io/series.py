@@ -16,11 +16,10 @@ from __future__ import annotations
 
 import os
 import pathlib
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from xfem_contact.io.vtu import GridArrays, vtk_type, write_vtu
+from xfem_contact.io.vtu import GridArrays, quoteattr, vtk_type, write_vtu
 
 
 def _declarations(data: dict) -> list[tuple[str, str, int]]:

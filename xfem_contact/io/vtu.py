@@ -27,8 +27,8 @@ second): :mod:`xfem_contact.io.vtk_grids` makes pyvista objects of the same arra
 
 from __future__ import annotations
 
+import html
 from typing import NamedTuple
-from xml.sax.saxutils import quoteattr
 
 import basix
 import numpy as np
@@ -306,6 +306,12 @@ def vtk_type(name: str, values: np.ndarray) -> str:
             f"array {name!r}: dtype {np.asarray(values).dtype} has no VTK XML type "
             f"(valid: {', '.join(str(t) for t in VTK_TYPES)})"
         ) from None
+
+
+def quoteattr(text: str) -> str:
+    """``text`` as a quoted XML attribute value (``&``, ``<``, ``>`` and quotes escaped;
+    :func:`xml.sax.saxutils.quoteattr`'s job without importing its ``urllib``)."""
+    return f'"{html.escape(text, quote=True)}"'
 
 
 def write_vtu(path, arrays: GridArrays, compression: str = "none") -> None:
