@@ -21,8 +21,9 @@ units, m in the paper's cases), padded with ``z = 0``.
 Cell data: ``side`` (-1 for ``phi < 0``, +1), ``cut`` (1 on sub-triangles, 0 on
 uncut cells), ``cell`` (local index of the parent cell).
 
-This module needs VTK's own Python modules only (no pyvista import, a third of a
-second): :mod:`xfem_contact.io.vtk_grids` makes pyvista objects of the same arrays.
+:func:`write_vtu` writes uncompressed files with numpy alone and compressed ones with
+VTK's own Python modules (never pyvista); :mod:`xfem_contact.io.vtk_grids` makes
+pyvista objects of the same arrays.
 """
 
 from __future__ import annotations
