@@ -29,8 +29,7 @@ from xfem_contact.io.series import write_grid
 from xfem_contact.io.vtu import interface_arrays, lips_arrays, plain_arrays, subcell_arrays
 
 #: Compression of the ``.vtu`` files (:func:`~xfem_contact.io.vtu.write_vtu`): none, the
-#: arrays raw, written with numpy without importing VTK; files about twice the size
-#: of ``"lz4"``'s
+#: arrays raw, written with numpy without importing VTK (larger files than ``"lz4"``'s)
 VTU_COMPRESSION = "none"
 
 
