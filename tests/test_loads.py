@@ -256,3 +256,12 @@ def test_scene_stage_and_end_time_checked():
     data["solver"] = {"end_time": 0.0}
     with pytest.raises(SceneError, match=r"^solver.end_time: must be > 0.0, got 0.0$"):
         load_scene(data)
+
+
+def test_point_constraints_share_a_space_per_component():
+    """Case 2's three point constraints (u_x twice, u_y once, each on both sides' fields)
+    put their values on one space per field component, made once, not one per condition."""
+    problem = inclusion_problem(4, 2, "sticking")
+    spaces = [bc.g.function_space for bc in problem.loads.bcs]
+    assert len(spaces) == 6
+    assert len({id(V) for V in spaces}) == 4  # (field, component): (0|1, x), (0|1, y)

@@ -16,17 +16,20 @@
   it sits at that state.
 """
 
+import itertools
+
 import dolfinx.fem
 import dolfinx.fem.petsc
 import numpy as np
 import pytest
 import ufl
 from petsc4py import PETSc
+from ufl.algorithms import expand_derivatives
 
 from xfem_contact.cases.paper import inclusion_problem
 from xfem_contact.codegen import kernel_store
 from xfem_contact.fem import forms
-from xfem_contact.fem.field_blocks import uncut_field_blocks
+from xfem_contact.fem.field_blocks import _coupled, uncut_field_blocks
 from xfem_contact.fem.forms import form, form_parts
 from xfem_contact.fem.subspaces import collapse
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
@@ -334,3 +337,24 @@ def test_first_jacobian_reused_only_at_its_state(monkeypatch):
     assert len(calls) == newton.report.iterations  # no stale Jacobian reused
     assert np.allclose(problem.w.x.array, solution, rtol=0.0, atol=1e-10 * np.abs(solution).max())
     newton.destroy()
+
+
+def test_field_pairs_found_without_expanding_each_block():
+    """The pairs (trial field, test field) that a bilinear form's integrals hold, read
+    off the form once (derivatives expanded): bulk and facet jumps of each side's field
+    pair it with itself only; a cross term adds its pair; a use of the whole argument
+    (no fixed component) names no pair."""
+    problem = inclusion_problem(4, 2, "sticking")
+    W, cut = problem.space.W, problem.cut
+    u, v = ufl.TrialFunction(W), ufl.TestFunction(W)
+    (u0, u1, _), (v0, v1, _) = ufl.split(u), ufl.split(v)
+    sizes = [e.reference_value_size for e in W.ufl_element().sub_elements]
+    offsets = [0, *itertools.accumulate(sizes)]
+    a = ufl.inner(ufl.grad(u0), ufl.grad(v0)) * cut.dx(-1)
+    a += ufl.inner(ufl.grad(u1), ufl.grad(v1)) * cut.dx(1)
+    a += ufl.inner(ufl.jump(ufl.grad(u1)), ufl.jump(ufl.grad(v1))) * ufl.dS
+    assert _coupled(expand_derivatives(a), v, u, offsets) == {(0, 0), (1, 1)}
+    cross = ufl.inner(u0, v1) * cut.dx(-1)
+    assert _coupled(expand_derivatives(a + cross), v, u, offsets) == {(0, 0), (1, 1), (0, 1)}
+    whole = ufl.inner(u, v) * cut.dx(-1)
+    assert _coupled(expand_derivatives(a + whole), v, u, offsets) is None

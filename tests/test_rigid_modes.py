@@ -285,3 +285,31 @@ def test_a_line_cutting_the_body_in_two_leaves_two_bodies():
     )
     assert len(body.remedies) == 3
     assert fixed_by_the_remedies(problem)
+
+
+@pytest.mark.parametrize("cell", ["quadrilateral", "triangle"])
+def test_body_centroid_and_radius_of_gyration_are_exact(cell):
+    """The bodies' centroids and radii of gyration (the scale of their rotations): the
+    disc of radius r about (0.5, 0.5), r / sqrt(2); the unit square without it,
+    sqrt((1/6 - pi r^4 / 2) / (1 - pi r^2)); the cell maps at one rule in every uncut
+    cell (tabulated once) equal to the maps at each point."""
+    import basix
+
+    from xfem_contact.mechanics.rigid_modes import _centroid
+
+    problem = inclusion_problem(20, 2, "frictionless", cell)
+    cut, r = problem.cut, 0.2
+    owned = np.arange(cut.cell_sides.size, dtype=np.int32)
+    none = np.zeros(0, dtype=np.int32)
+    inside = _centroid(cut, {0: owned[cut.cell_sides <= 0], 1: none})
+    outside = _centroid(cut, {0: none, 1: owned[cut.cell_sides >= 0]})
+    exact = np.sqrt((1 / 6 - np.pi * r**4 / 2) / (1 - np.pi * r**2))
+    for (centre, radius), expected in ((inside, r / np.sqrt(2)), (outside, exact)):
+        np.testing.assert_allclose(centre, [0.5, 0.5], atol=1e-6)
+        assert abs(radius - expected) < 1e-5 * expected  # the P2 level set's circle
+    X, _ = basix.make_quadrature(cut.mesh.basix_cell(), 2)
+    cells = owned[:50]
+    at_points = (np.repeat(cells, X.shape[0]), np.tile(X, (cells.size, 1)))
+    np.testing.assert_allclose(
+        cut.maps.jacobian_lattice(cells, X), cut.maps.jacobian(*at_points), atol=1e-15
+    )

@@ -85,3 +85,25 @@ def test_guard_passes_symmetric_and_refuses_a_small_unsymmetric_part():
         mark_symmetric(unsymmetric)
     for A in (symmetric, unsymmetric):
         A.destroy()
+
+
+def test_each_jacobian_checked_once_and_never_copied_onto_itself(monkeypatch):
+    """A direct solve factors the Jacobian itself (no preconditioner copy): the set-up
+    Jacobian, which the only Newton step reuses, is checked for symmetry once and not
+    copied onto itself (the SNES callback's two matrices are new wrappers of one)."""
+    from xfem_contact.solvers import newton
+
+    checked, onto_itself = [], []
+    original_copy = PETSc.Mat.copy
+
+    def copy(A, result=None, *args):
+        onto_itself.append(result is not None and result.handle == A.handle)
+        return original_copy(A, result, *args)
+
+    monkeypatch.setattr(newton, "mark_symmetric", lambda A: checked.append(A) or mark_symmetric(A))
+    monkeypatch.setattr(PETSc.Mat, "copy", copy)
+    problem = inclusion_problem(8, 2, "sticking")
+    report = problem.solve()
+    assert problem.solver_options()["pc_type"] == "cholesky" and report.iterations == 1
+    assert len(checked) == 1
+    assert not any(onto_itself)

@@ -23,6 +23,8 @@ import numpy as np
 import numpy.typing as npt
 import ufl
 from ufl.algorithms import expand_derivatives
+from ufl.classes import FixedIndex, Grad, Indexed, ReferenceGrad, ReferenceValue, Restricted
+from ufl.corealg.traversal import unique_pre_traversal
 
 
 class FieldBlock(typing.NamedTuple):
@@ -83,6 +85,49 @@ def _empty(form: ufl.Form) -> bool:
     return expand_derivatives(form).empty()
 
 
+#: Operators that take an argument's value to its derivatives or a side of a facet
+_MODIFIERS = (Grad, ReferenceGrad, Restricted, ReferenceValue)
+
+
+def _fields_in(expr, argument, offsets: list[int]) -> set[int] | None:
+    """The fields of ``argument`` (on ``W``, field ``i`` its components ``offsets[i]`` to
+    ``offsets[i + 1]``) whose components appear in ``expr`` (derivatives expanded and
+    algebra lowered, as :func:`~ufl.algorithms.expand_derivatives` leaves it): the
+    first index of each ``argument[k, ...]`` (or of a derivative or restriction of it).
+    ``None`` (every field) where a use of ``argument`` names no fixed component."""
+
+    def base(node):
+        while isinstance(node, _MODIFIERS):
+            node = node.ufl_operands[0]
+        return node
+
+    found = set()
+    for node in unique_pre_traversal(expr):
+        if isinstance(node, _MODIFIERS):
+            continue
+        for k, operand in enumerate(node.ufl_operands):
+            if base(operand) != argument:
+                continue
+            first = node.ufl_operands[1][0] if isinstance(node, Indexed) and k == 0 else None
+            if not isinstance(first, FixedIndex):
+                return None
+            found.add(int(np.searchsorted(offsets, int(first), side="right")) - 1)
+    return found
+
+
+def _coupled(form: ufl.Form, test, trial, offsets: list[int]) -> set[tuple[int, int]] | None:
+    """Pairs ``(trial field, test field)`` that some integral of the bilinear ``form``
+    holds both of (a superset of its nonzero field blocks: every term of a bilinear
+    integrand holds a trial and a test component), or ``None``: maybe all of them."""
+    pairs = set()
+    for itg in form.integrals():
+        fields = [_fields_in(itg.integrand(), arg, offsets) for arg in (trial, test)]
+        if None in fields:
+            return None
+        pairs |= set(itertools.product(*fields))
+    return pairs
+
+
 def uncut_field_blocks(
     a: ufl.Form,
     field_space: Callable[[int], tuple[dolfinx.fem.FunctionSpace, npt.NDArray[np.int32]]],
@@ -132,9 +177,14 @@ def uncut_field_blocks(
     def block(i: int, j: int, u, v) -> ufl.Form:
         return ufl.replace(uncut, {trial: _embedded(u, offsets, i), test: _embedded(v, offsets, j)})
 
+    coupled = _coupled(uncut, test, trial, offsets)  # to skip blocks that are surely empty
+
+    def maybe(i: int, j: int) -> bool:
+        return coupled is None or (i, j) in coupled
+
     blocks = []
     for i in fields:
-        if _empty(block(i, i, trial, test)):
+        if not maybe(i, i) or _empty(block(i, i, trial, test)):
             continue
         V, parent = field_space(i)
         form = block(i, i, ufl.TrialFunction(V), ufl.TestFunction(V))
@@ -142,7 +192,7 @@ def uncut_field_blocks(
         blocks.append(FieldBlock(i, form, V, parent))
     rest = ufl.Form(rest)
     for i, j in itertools.permutations(fields, 2):  # trial field i, test field j
-        cross = block(i, j, trial, test)
-        if not _empty(cross):
+        cross = block(i, j, trial, test) if maybe(i, j) else None
+        if cross is not None and not _empty(cross):
             rest += cross
     return FieldBlocks(rest, blocks)

@@ -228,6 +228,13 @@ class CellMaps:
         basis = self._cmap.tabulate(0, X)[0, :, :, 0]  # (k, ndofs)
         return np.einsum("ki,cid->ckd", basis, self._geom[cells]).reshape(-1, self._gdim)
 
+    def jacobian_lattice(self, cells, X) -> npt.NDArray[np.float64]:
+        """Jacobians ``dx/dX`` at the same reference points ``X`` (k, tdim) in every cell
+        (the map tabulated once), shape ``(len(cells) * k, gdim, tdim)``, cell by cell."""
+        tab = self._cmap.tabulate(1, X)[1:, :, :, 0]  # (tdim, k, ndofs)
+        J = np.matmul(tab[None], self._geom[cells][:, None])  # (cells, tdim, k, gdim)
+        return J.transpose(0, 2, 3, 1).reshape(-1, self._gdim, tab.shape[0])
+
     def jacobian(self, cells, X) -> npt.NDArray[np.float64]:
         """Jacobians ``dx/dX`` of the cell maps, shape ``(m, gdim, tdim)``."""
         tab = self._cmap.tabulate(1, X)[1:, :, :, 0]  # (tdim, m, ndofs)

@@ -16,21 +16,10 @@ from __future__ import annotations
 
 import os
 import pathlib
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from xfem_contact.io.vtu import GridArrays, write_vtu
-
-#: VTK XML names of numpy dtypes
-VTK_TYPES = {
-    np.dtype(np.int8): "Int8",
-    np.dtype(np.uint8): "UInt8",
-    np.dtype(np.int32): "Int32",
-    np.dtype(np.int64): "Int64",
-    np.dtype(np.float32): "Float32",
-    np.dtype(np.float64): "Float64",
-}
+from xfem_contact.io.vtu import GridArrays, quoteattr, vtk_type, write_vtu
 
 
 def _declarations(data: dict) -> list[tuple[str, str, int]]:
@@ -38,10 +27,8 @@ def _declarations(data: dict) -> list[tuple[str, str, int]]:
     found = []
     for name, values in data.items():
         values = np.asarray(values)
-        if values.dtype not in VTK_TYPES:
-            raise ValueError(f"array {name!r}: dtype {values.dtype} has no VTK XML type")
         components = 1 if values.ndim == 1 else int(values.shape[1])
-        found.append((name, VTK_TYPES[values.dtype], components))
+        found.append((name, vtk_type(name, values), components))
     return found
 
 
@@ -93,7 +80,7 @@ def pvtu_text(pieces: list[str], arrays: tuple[list, list]) -> str:
 
 
 def write_grid(
-    path: str | pathlib.Path, arrays: GridArrays, comm, compression: str = "lz4"
+    path: str | pathlib.Path, arrays: GridArrays, comm, compression: str = "none"
 ) -> pathlib.Path:
     """Write this process's ``arrays`` as ``path`` (a ``.vtu``); in parallel as the piece
     ``path`` with suffix ``_r{rank}``, and rank 0 writes :func:`opened` ``(path)``, the
@@ -155,7 +142,7 @@ class StepSeries:
         compression: Of the ``.vtu`` pieces (:func:`~xfem_contact.io.vtu.write_vtu`).
     """
 
-    def __init__(self, directory: str | pathlib.Path, name: str, comm, compression: str = "lz4"):
+    def __init__(self, directory: str | pathlib.Path, name: str, comm, compression: str = "none"):
         self.directory, self.name, self.comm = pathlib.Path(directory), name, comm
         self.compression = compression
         #: ``(time, file)`` of the steps written, files relative to :attr:`path`

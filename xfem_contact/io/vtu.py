@@ -21,12 +21,14 @@ units, m in the paper's cases), padded with ``z = 0``.
 Cell data: ``side`` (-1 for ``phi < 0``, +1), ``cut`` (1 on sub-triangles, 0 on
 uncut cells), ``cell`` (local index of the parent cell).
 
-This module needs VTK's own Python modules only (no pyvista import, a third of a
-second): :mod:`xfem_contact.io.vtk_grids` makes pyvista objects of the same arrays.
+:func:`write_vtu` writes uncompressed files with numpy alone and compressed ones with
+VTK's own Python modules (never pyvista); :mod:`xfem_contact.io.vtk_grids` makes
+pyvista objects of the same arrays.
 """
 
 from __future__ import annotations
 
+import html
 from typing import NamedTuple
 
 import basix
@@ -281,9 +283,111 @@ def _node_counts(arrays: GridArrays) -> np.ndarray:
     return table[arrays.types]
 
 
-def write_vtu(path, arrays: GridArrays, compression: str = "lz4") -> None:
-    """Write ``arrays`` as a VTK XML unstructured grid (binary, compressed with
-    ``compression``: ``"lz4"``, ``"zlib"`` or ``"none"``). Not collective."""
+#: VTK XML type names of the numpy dtypes a grid's arrays may have
+VTK_TYPES = {
+    np.dtype(np.int8): "Int8",
+    np.dtype(np.uint8): "UInt8",
+    np.dtype(np.int32): "Int32",
+    np.dtype(np.int64): "Int64",
+    np.dtype(np.float32): "Float32",
+    np.dtype(np.float64): "Float64",
+}
+
+#: Compressions of :func:`write_vtu`: ``none`` is written here with numpy; ``lz4`` and
+#: ``zlib`` by VTK's XML writer (whose import takes a few tenths of a second)
+COMPRESSIONS = ("none", "lz4", "zlib")
+
+
+def vtk_type(name: str, values: np.ndarray) -> str:
+    """The VTK XML type name of the array ``values`` of data ``name``."""
+    try:
+        return VTK_TYPES[np.asarray(values).dtype]
+    except KeyError:
+        raise ValueError(
+            f"array {name!r}: dtype {np.asarray(values).dtype} has no VTK XML type "
+            f"(valid: {', '.join(str(t) for t in VTK_TYPES)})"
+        ) from None
+
+
+def quoteattr(text: str) -> str:
+    """``text`` as a quoted XML attribute value (``&``, ``<``, ``>`` and quotes escaped;
+    :func:`xml.sax.saxutils.quoteattr`'s job without importing its ``urllib``)."""
+    return f'"{html.escape(text, quote=True)}"'
+
+
+def write_vtu(path, arrays: GridArrays, compression: str = "none") -> None:
+    """Write ``arrays`` as a VTK XML unstructured grid (binary). Not collective.
+
+    Args:
+        path: The ``.vtu`` file.
+        arrays: The grid.
+        compression: ``"none"``: the arrays raw after the XML (VTK's appended raw
+            encoding, written with numpy, no VTK import); ``"lz4"`` or ``"zlib"``: blocks
+            compressed by VTK's writer (smaller files, a VTK import).
+    """
+    if compression not in COMPRESSIONS:
+        raise ValueError(
+            f"compression {compression!r} is not one of {', '.join(map(repr, COMPRESSIONS))}"
+        )
+    if compression == "none":
+        _write_raw(path, arrays)
+    else:
+        _write_compressed(path, arrays, compression)
+
+
+def _cell_arrays(arrays: GridArrays) -> tuple[np.ndarray, np.ndarray]:
+    """``(connectivity, offsets)`` (int64) of the cells of ``arrays``, VTK's XML layout:
+    the node indices of all cells, and where each cell's end; the legacy counts dropped."""
+    nodes = _node_counts(arrays)
+    offsets = np.cumsum(nodes)
+    keep = np.ones(arrays.cells.size, dtype=bool)
+    keep[offsets - nodes + np.arange(nodes.size)] = False  # the legacy counts
+    return np.ascontiguousarray(arrays.cells[keep], dtype=np.int64), offsets.astype(np.int64)
+
+
+def _write_raw(path, arrays: GridArrays) -> None:
+    """:func:`write_vtu` without compression: the XML header, then each array's byte
+    count (UInt64) and bytes (little endian) in VTK's appended raw encoding."""
+    connectivity, offsets = _cell_arrays(arrays)
+    sections = [
+        ("PointData", list(arrays.point_data.items())),
+        ("CellData", list(arrays.cell_data.items())),
+        ("Points", [("Points", arrays.points)]),
+        ("Cells", [("connectivity", connectivity), ("offsets", offsets), ("types", arrays.types)]),
+    ]
+    lines = [
+        '<?xml version="1.0"?>',
+        '<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">',
+        "  <UnstructuredGrid>",
+        f'    <Piece NumberOfPoints="{arrays.points.shape[0]}" '
+        f'NumberOfCells="{arrays.types.size}">',
+    ]
+    blocks, at = [], 0
+    for tag, data in sections:
+        lines.append(f"      <{tag}>")
+        for name, values in data:
+            values = np.ascontiguousarray(values)
+            kind = vtk_type(name, values)
+            values = values.astype(values.dtype.newbyteorder("<"), copy=False)
+            components = 1 if values.ndim == 1 else int(np.prod(values.shape[1:]))
+            lines.append(
+                f'        <DataArray type="{kind}" Name={quoteattr(name)} '
+                f'NumberOfComponents="{components}" format="appended" offset="{at}"/>'
+            )
+            blocks += [np.array([values.nbytes], dtype="<u8"), values]
+            at += 8 + values.nbytes
+        lines.append(f"      </{tag}>")
+    lines += ["    </Piece>", "  </UnstructuredGrid>", '  <AppendedData encoding="raw">', "   _"]
+    with open(path, "wb") as f:
+        f.write("\n".join(lines).encode())
+        for block in blocks:
+            f.write(memoryview(block).cast("B"))
+        f.write(b"\n  </AppendedData>\n</VTKFile>\n")
+
+
+def _write_compressed(path, arrays: GridArrays, compression: str) -> None:
+    """:func:`write_vtu` through VTK's XML writer, blocks compressed with ``compression``."""
     from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
     from vtkmodules.vtkCommonCore import VTK_UNSIGNED_CHAR, vtkPoints
     from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkUnstructuredGrid
@@ -293,15 +397,10 @@ def write_vtu(path, arrays: GridArrays, compression: str = "lz4") -> None:
     points = vtkPoints()
     points.SetData(numpy_to_vtk(np.ascontiguousarray(arrays.points, dtype=np.float64), deep=True))
     grid.SetPoints(points)
-    nodes = _node_counts(arrays)
-    offsets = np.zeros(nodes.size + 1, dtype=np.int64)
-    np.cumsum(nodes, out=offsets[1:])
-    keep = np.ones(arrays.cells.size, dtype=bool)
-    keep[offsets[:-1] + np.arange(nodes.size)] = False  # the legacy counts
+    connectivity, ends = _cell_arrays(arrays)
     cells = vtkCellArray()
-    connectivity = np.ascontiguousarray(arrays.cells[keep], dtype=np.int64)
     cells.SetData(
-        numpy_to_vtkIdTypeArray(offsets, deep=True),
+        numpy_to_vtkIdTypeArray(np.r_[np.int64(0), ends], deep=True),
         numpy_to_vtkIdTypeArray(connectivity, deep=True),
     )
     types = numpy_to_vtk(arrays.types, deep=True, array_type=VTK_UNSIGNED_CHAR)
@@ -316,11 +415,7 @@ def write_vtu(path, arrays: GridArrays, compression: str = "lz4") -> None:
     writer.SetFileName(str(path))
     writer.SetInputData(grid)
     writer.SetDataModeToBinary()
-    compressors = {
-        "lz4": writer.SetCompressorTypeToLZ4,
-        "zlib": writer.SetCompressorTypeToZLib,
-        "none": writer.SetCompressorTypeToNone,
-    }
+    compressors = {"lz4": writer.SetCompressorTypeToLZ4, "zlib": writer.SetCompressorTypeToZLib}
     compressors[compression]()
     if not writer.Write():
         raise OSError(f"could not write {path}")

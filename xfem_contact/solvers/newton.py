@@ -255,7 +255,9 @@ class ReducedNewton:
             J_r.diagonalScale(self.D, self.D)
             if self._symmetric:
                 mark_symmetric(J_r)
-        if P_r is not J_r:  # the preconditioner's copy, taken anew only when needed
+        # the preconditioner's own copy, taken anew only when needed (the callback's J_r
+        # and P_r are new Python objects even when they wrap one matrix)
+        if self.P is not self.J_r:
             grown = J_r.getInfo(_GLOBAL)["nz_allocated"] != P_r.getInfo(_GLOBAL)["nz_allocated"]
             if grown or self._refactor(snes):
                 J_r.copy(P_r, _DIFFERENT if grown else _SAME)

@@ -65,6 +65,7 @@ class Loads:
         self.stages: dict[str, tuple[float, float]] = {}
         self._terms: list = []
         self._time = 1.0
+        self._collapsed: dict[tuple, dolfinx.fem.FunctionSpace] = {}  # (component, element)
         #: Incremented by every load, support or condition added (solvers built for an
         #: older revision are rebuilt); setting values does not change it
         self.revision = 0
@@ -148,7 +149,10 @@ class Loads:
     def _dirichlet(self, sub, dofs_of: Callable) -> dolfinx.fem.Function:
         """A Dirichlet condition on sub-space ``sub`` at ``dofs_of(spaces)``; its function."""
         if sub.component():
-            V, _ = collapse(sub)
+            key = (tuple(sub.component()), sub.ufl_element())
+            if key not in self._collapsed:  # one space per component (made collectively)
+                self._collapsed[key] = collapse(sub)[0]
+            V = self._collapsed[key]
             g = dolfinx.fem.Function(V)
             self.bcs.append(dolfinx.fem.dirichletbc(g, dofs_of((sub, V)), sub))
         else:
