@@ -25,6 +25,25 @@ def unit_square(n: int, cell: str, distorted: bool = False, comm=MPI.COMM_WORLD)
     return mesh
 
 
+CELLS_3D = {
+    "tetrahedron": dolfinx.mesh.CellType.tetrahedron,
+    "hexahedron": dolfinx.mesh.CellType.hexahedron,
+}
+
+
+def unit_cube(n: int, cell: str, distorted: bool = False, comm=MPI.COMM_WORLD):
+    """[0,1]^3 mesh with n x n x n cubes (6 tetrahedra each, or hexahedra); ``distorted``
+    moves the nodes smoothly (tetrahedra of varied shapes, non-affine hexahedra)."""
+    mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, CELLS_3D[cell])
+    if distorted:
+        x = mesh.geometry.x
+        bubble = x * (1.0 - x)  # zero on the faces normal to each axis: boundary kept
+        x[:, 0] += 0.2 * bubble[:, 0] * (1.0 + x[:, 1]) * (1.0 + 2.0 * x[:, 2]) / n
+        x[:, 1] += 0.2 * bubble[:, 1] * (1.0 + 2.0 * x[:, 2]) * (1.0 + x[:, 0]) / n
+        x[:, 2] += 0.2 * bubble[:, 2] * (1.0 + 2.0 * x[:, 0]) * (1.0 + x[:, 1]) / n
+    return mesh
+
+
 def pytest_collection_modifyitems(config, items):
     """Tests marked ``parallel`` compare a run on all ranks with serial runs: on one
     rank they would compare a run with itself, so the serial suite skips them."""

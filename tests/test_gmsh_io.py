@@ -150,3 +150,68 @@ def test_distributed_area():
     # an error found on rank 0 is raised on every rank (no rank left waiting)
     with pytest.raises(FileNotFoundError):
         read_gmsh("missing.geo", comm)
+
+
+BALL = """SetFactory("OpenCASCADE");
+Sphere(1) = {0, 0, 0, 0.5};
+Physical Volume("ball", 7) = {1};
+Physical Surface("skin", 3) = {1};
+"""
+BOX = """SetFactory("OpenCASCADE");
+Box(1) = {0, 0, 0, 1, 1, 1};
+Physical Volume("box", 1) = {1};
+Physical Surface("bottom", 5) = {5};
+Physical Surface("top", 6) = {6};
+"""
+HEXES = """Point(1) = {0, 0, 0}; Point(2) = {1, 0, 0}; Point(3) = {1, 1, 0}; Point(4) = {0, 1, 0};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};
+Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};
+Transfinite Curve{1, 2, 3, 4} = 4; Transfinite Surface{1}; Recombine Surface{1};
+out[] = Extrude {0, 0, 1} {Surface{1}; Layers{3}; Recombine;};
+Physical Volume("box", 1) = {out[1]};
+Physical Surface("bottom", 5) = {1};
+Physical Surface("top", 6) = {out[0]};
+"""
+
+
+@pytest.mark.mpi
+def test_3d_meshes_with_physical_groups(tmp_path):
+    """Volumes with physical groups: a ball (curved 10-node tetrahedra follow the sphere),
+    a box of tetrahedra and one of hexahedra, cut by a plane through CutMesh: the tagged
+    faces' areas on each side are exact."""
+    from xfem_contact import CutMesh, form
+
+    files = {}
+    for name, text in (("ball", BALL), ("box", BOX), ("hexes", HEXES)):
+        files[name] = tmp_path / f"{name}.geo"
+        files[name].write_text(text)
+    assert physical_parts(files["ball"]) == {"skin": 3}
+    errors = {}
+    for degree in (1, 2):
+        gm = read_gmsh(files["ball"], MPI.COMM_WORLD, geometry_degree=degree, size=0.25)
+        assert gm.mesh.geometry.dim == 3 and gm.mesh.topology.cell_name() == "tetrahedron"
+        assert np.all(gm.cell_tags.values == 7)
+        errors[degree] = (
+            abs(integrate(gm, "dx") - np.pi / 6),
+            abs(integrate(gm, "ds", gm.parts["skin"]) - np.pi),
+        )
+    print(f"ball volume / area errors, h = 0.25: P1 {errors[1]}, P2 {errors[2]}")
+    assert errors[2][0] < errors[1][0] / 10 and errors[2][1] < errors[1][1] / 10, errors
+    with pytest.raises(ValueError, match=r"cell must be one of \('tetrahedron', 'hexahedron'\)"):
+        read_gmsh(files["box"], MPI.COMM_SELF, cell="quadrilateral")
+    with pytest.raises(ValueError, match=r"not hexahedrons only \(make the \.geo recombine"):
+        read_gmsh(files["box"], MPI.COMM_SELF, cell="hexahedron")
+    n, c = np.array([0.3, 0.4, 0.5]), 0.55  # the plane n.x = c cuts bottom and top
+    for name, cell in (("box", "tetrahedron"), ("hexes", "hexahedron")):
+        gm = read_gmsh(files[name], MPI.COMM_WORLD, cell=cell, size=0.3)
+        assert gm.mesh.topology.cell_name() == cell and gm.parts == {"bottom": 5, "top": 6}
+        cut = CutMesh(gm.mesh, lambda x: n @ x - c, degree=1)
+        for part, z in (("bottom", 0.0), ("top", 1.0)):
+            m = c - n[2] * z  # {0.3 x + 0.4 y < m} in the unit square: corner triangles
+            corners = [(0, 0, 1), (1, 0, -1), (0, 1, -1), (1, 1, 1)]
+            exact = sum(k * max(m - n[0] * i - n[1] * j, 0) ** 2 for i, j, k in corners)
+            exact /= 2 * n[0] * n[1]
+            tags = gm.facet_tags
+            area = form(1.0 * cut.ds(-1, tags, gm.parts[part]))
+            area = gm.mesh.comm.allreduce(dolfinx.fem.assemble_scalar(area))
+            assert area == pytest.approx(exact, abs=1e-13), (name, part)

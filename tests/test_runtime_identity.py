@@ -6,7 +6,7 @@ import dolfinx.fem
 import numpy as np
 import pytest
 import ufl
-from conftest import unit_square
+from conftest import CELLS_3D, unit_cube, unit_square
 from dolfinx.fem import assemble_matrix, assemble_scalar, assemble_vector
 
 import xfem_contact
@@ -16,7 +16,7 @@ DEGREE = 4
 
 def standard_rules(mesh):
     """Every owned cell gets basix's default rule of degree DEGREE."""
-    ncell = mesh.topology.index_map(2).size_local
+    ncell = mesh.topology.index_map(mesh.topology.dim).size_local
     X, W = basix.make_quadrature(mesh.basix_cell(), DEGREE)
     return xfem_contact.CellRules(
         mesh,
@@ -30,14 +30,17 @@ def standard_rules(mesh):
 def forms(mesh):
     """(name, UFL integrand) pairs: bilinear, linear, functional; one nonlinear
     residual with its Jacobian."""
-    V = dolfinx.fem.functionspace(mesh, ("Lagrange", 2, (2,)))
+    gdim = mesh.geometry.dim
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", 2, (gdim,)))
     S = dolfinx.fem.functionspace(mesh, ("Lagrange", 2))
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     p, q = ufl.TrialFunction(S), ufl.TestFunction(S)
     f = dolfinx.fem.Function(S)
     f.interpolate(lambda x: 1.0 + x[0] ** 2 + np.sin(x[1]))
     w = dolfinx.fem.Function(V)
-    w.interpolate(lambda x: np.stack([0.1 * x[0] * x[1], 0.2 * np.cos(x[0])]))
+    w.interpolate(
+        lambda x: np.stack([0.1 * x[0] * x[1], 0.2 * np.cos(x[0]), 0.3 * x[2] * x[0]][:gdim])
+    )
     eps = ufl.sym(ufl.grad(u))
     residual = ufl.inner((1 + ufl.inner(w, w)) * ufl.grad(w), ufl.grad(v)) + f * ufl.inner(w, v)
     return {
@@ -67,7 +70,19 @@ def assemble(form):
 @pytest.mark.mpi
 @pytest.mark.parametrize("distorted", [False, True], ids=["affine", "distorted"])
 def test_standard_rule_through_runtime_path(cell, distorted):
-    mesh = unit_square(4, cell, distorted)
+    check_identity(unit_square(4, cell, distorted))
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("distorted", [False, True], ids=["affine", "distorted"])
+@pytest.mark.parametrize("cell3d", list(CELLS_3D))
+def test_standard_rule_through_runtime_path_3d(cell3d, distorted):
+    """The same on tetrahedra and hexahedra (3D placeholder points)."""
+    check_identity(unit_cube(2, cell3d, distorted))
+
+
+def check_identity(mesh):
+    """Every form of :func:`forms` through the runtime path equals stock FFCx."""
     rules = standard_rules(mesh)
     dx_std = ufl.dx(domain=mesh, metadata={"quadrature_degree": DEGREE})
     for name, integrand in forms(mesh).items():

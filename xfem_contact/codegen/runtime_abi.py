@@ -52,7 +52,13 @@ LAYOUT_VERSION = 1
 #: signature (FFCx keeps options it does not know, and hashes all of them)
 LAYOUT_OPTION = "xfem_contact_layout_version"
 
-_SEEDS = {"triangle": 20261122, "quadrilateral": 20261123}
+_SEEDS = {
+    "triangle": 20261122,
+    "quadrilateral": 20261123,
+    "tetrahedron": 20261124,
+    "hexahedron": 20261125,
+}
+_DIMS = {"triangle": 2, "quadrilateral": 2, "tetrahedron": 3, "hexahedron": 3}
 
 
 @functools.cache
@@ -60,19 +66,22 @@ def placeholder_points(cell: str) -> tuple[npt.NDArray[np.float64], npt.NDArray[
     """Fixed generic points and weights that identify runtime integrals.
 
     Args:
-        cell: ``"triangle"`` or ``"quadrilateral"``.
+        cell: ``"triangle"``, ``"quadrilateral"``, ``"tetrahedron"`` or ``"hexahedron"``.
 
     Returns:
-        Points of shape ``(NUM_PLACEHOLDER_POINTS, 2)`` strictly inside the
+        Points of shape ``(NUM_PLACEHOLDER_POINTS, tdim)`` strictly inside the
         reference cell, and positive weights of shape ``(NUM_PLACEHOLDER_POINTS,)``.
     """
     if cell not in _SEEDS:
         raise NotImplementedError(f"Runtime quadrature on cell {cell!r}; valid: {sorted(_SEEDS)}")
     rng = np.random.default_rng(_SEEDS[cell])
-    pts = rng.uniform(0.05, 0.95, size=(NUM_PLACEHOLDER_POINTS, 2))
+    pts = rng.uniform(0.05, 0.95, size=(NUM_PLACEHOLDER_POINTS, _DIMS[cell]))
     if cell == "triangle":
         flip = pts.sum(axis=1) > 0.95
         pts[flip] = 0.95 - pts[flip][:, ::-1]
+    elif cell == "tetrahedron":  # gaps of sorted coordinates: sum <= 1, shrunk inside
+        s = np.sort(pts, axis=1)
+        pts = 0.05 + 0.8 * np.diff(s, axis=1, prepend=0.0)
     weights = rng.uniform(0.5, 1.5, size=NUM_PLACEHOLDER_POINTS)
     return pts, weights
 

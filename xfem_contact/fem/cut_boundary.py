@@ -8,6 +8,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from xfem_contact.fem.cut3d_boundary import boundary_parts_3d
 from xfem_contact.quadrature import boundary
 from xfem_contact.quadrature.cell_rules import IntegrationPart
 
@@ -45,12 +46,14 @@ def boundary_parts(cut, side: int, facets: np.ndarray) -> list[IntegrationPart]:
     """The integration parts of exterior ``facets`` on ``side`` of a
     :class:`~xfem_contact.fem.cutmesh.CutMesh`: the facets of the side's uncut cells
     (standard rule) and, per reference facet, the pieces on that side of the cut cells'
-    facets (runtime rules, ``ufl.FacetNormal`` replaced by the facet's normal).
-    Collective."""
+    facets (runtime rules, ``ufl.FacetNormal`` replaced by the facet's normal); in 3D
+    :func:`~xfem_contact.fem.cut3d_boundary.boundary_parts_3d`. Collective."""
     mesh, tdim = cut.mesh, cut.mesh.topology.dim
     cell_name = mesh.topology.cell_name()
     mesh.topology.create_connectivity(tdim - 1, tdim)
     mesh.topology.create_connectivity(tdim, tdim - 1)
+    if tdim == 3:
+        return boundary_parts_3d(cut, side, facets)
     pairs = dolfinx.fem.compute_integration_domains(
         dolfinx.fem.IntegralType.exterior_facet, mesh.topology, facets
     ).reshape(-1, 2)

@@ -39,7 +39,7 @@ from xfem_contact.geometry.levelset import (
 )
 from xfem_contact.quadrature import rules as quadrature
 
-__all__ = ["INTERFACE", "SIDE_MINUS", "SIDE_PLUS", "CutState", "cut_state"]
+__all__ = ["INTERFACE", "SIDE_MINUS", "SIDE_PLUS", "CutState", "cut_state", "interpolate_named"]
 
 SIDE_MINUS, SIDE_PLUS, INTERFACE = 1, 2, 3
 
@@ -57,7 +57,8 @@ class CutState:
             interface, for a Function and for cracks).
         cell_sides: Side of every owned cell: -1, +1, 0 when cut, ``(num_owned,)`` int8.
         cut_cells: Local indices of the owned cut cells, ``(ncut,)`` int32.
-        geometry: The sub-triangulation of the cut cells (rows of ``cut_cells``).
+        geometry: The sub-triangulation of the cut cells (rows of ``cut_cells``); ``None``
+            for a 3D mesh (:mod:`xfem_contact.fem.cut3d_state`: rules without sub-cells).
         rules: Per-cut-cell rules by measure id (:data:`SIDE_MINUS`,
             :data:`SIDE_PLUS`, :data:`INTERFACE`), rows of ``cut_cells``; read-only.
         cell_interface: Interface (index into ``interface_names``) of every cut cell,
@@ -75,12 +76,27 @@ class CutState:
     components: Mapping[str, Callable] | None
     cell_sides: npt.NDArray[np.int8]
     cut_cells: npt.NDArray[np.int32]
-    geometry: cut.CutGeometry
+    geometry: cut.CutGeometry | None
     rules: Mapping[int, quadrature.RuleSet]
     cell_interface: npt.NDArray[np.int64]
     crack: Crack | None
     num_cut_cells_global: int
     timings: Mapping[str, float]
+
+
+def interpolate_named(
+    mesh: dolfinx.mesh.Mesh, levelset, degree: int, names: tuple[str, ...], previous
+) -> LevelSet:
+    """The level set of the interfaces ``names`` interpolated in degree ``degree``, into
+    the Function of the ``previous`` state if any (compiled forms keep their
+    signature); a refusal names the interface when there is one. Collective."""
+    into = None if previous is None else previous.levelset.function
+    try:
+        return interpolate(mesh, levelset, degree, into=into)
+    except ValueError as error:
+        if len(names) > 1:  # the union: each interface was checked by name
+            raise
+        raise InterfaceError(names[0], str(error)) from None
 
 
 def cut_state(
@@ -106,13 +122,7 @@ def cut_state(
         levelset, tangent = union.phi, union.psi
     else:
         names, components, levelset = named_interfaces(mesh, levelset, degree, known)
-    into = None if previous is None else previous.levelset.function  # forms keep signatures
-    try:
-        phi = interpolate(mesh, levelset, degree, into=into)
-    except ValueError as error:
-        if len(names) > 1:  # the union: each interface was checked by name
-            raise
-        raise InterfaceError(names[0], str(error)) from None
+    phi = interpolate_named(mesh, levelset, degree, names, previous)
     maps = CellMaps(mesh, phi)
     owned = np.arange(mesh.topology.index_map(tdim).size_local, dtype=np.int32)
     side = cut.classify(cell_name, degree, maps.nodal_values(owned))

@@ -16,6 +16,7 @@ import ufl
 from xfem_contact._deprecation import renamed_attribute
 from xfem_contact.fem import cut_boundary
 from xfem_contact.fem.crack_cut import Crack
+from xfem_contact.fem.cut3d_state import cut_state_3d
 from xfem_contact.fem.cut_state import INTERFACE, SIDE_MINUS, SIDE_PLUS, CutState, cut_state
 from xfem_contact.fem.interface_cells import trace_nullity
 from xfem_contact.geometry import cut
@@ -29,15 +30,20 @@ _INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + in
 _BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
 _CUT_CELLS0 = 50  # measure ids of cut.dx_cut(name): _CUT_CELLS0 + index, _CUT_CELLS0 - 1 all
 _counter = itertools.count()
+CELLS = ("triangle", "quadrilateral", "tetrahedron", "hexahedron")
+"""The cell kinds of the meshes :class:`CutMesh` cuts."""
 
 
 class CutMesh:
-    """A mesh cut by the zero line of a level set.
+    """A mesh cut by the zero line (in 3D: surface) of a level set.
 
     Side -1 is ``phi < 0``, side +1 is ``phi >= 0``; the interface normal points from side
-    -1 to side +1. Cut cells are sub-triangulated into curved 6-node triangles on each side
-    and a 3-node curved segment on the interface (straight for ``degree=1``), integrated
-    with per-cell runtime rules; uncut cells use FFCx's standard rule.
+    -1 to side +1. In 2D, cut cells are sub-triangulated into curved 6-node triangles on
+    each side and a 3-node curved segment on the interface (straight for ``degree=1``).
+    In 3D (:mod:`xfem_contact.fem.cut3d_state`), P1 tetrahedra are cut exactly into
+    sub-tetrahedra and interface triangles, and Q1/Q2 hexahedra and P2 tetrahedra get
+    Saye's rules. Cut cells are integrated with per-cell runtime rules; uncut cells use
+    FFCx's standard rule.
 
     The cut is a frozen :class:`~xfem_contact.fem.cut_state.CutState` (:attr:`state`),
     built by the constructor; :meth:`update` installs the next one. The attributes
@@ -45,24 +51,29 @@ class CutMesh:
     current state.
 
     Args:
-        mesh: A triangle or quadrilateral mesh (affine, distorted or curved).
+        mesh: A triangle, quadrilateral, tetrahedron or hexahedron mesh (affine,
+            distorted or curved), of one cell kind.
         levelset: A callable ``phi(x)`` (``x`` of shape ``(3, n)``) or a scalar DOLFINx
             Function. With a callable the interface nodes lie on its exact zero set; with
-            a Function, on its interpolant's. Several interfaces: a mapping ``{name:
+            a Function, on its interpolant's (in 3D the rules always follow the
+            interpolant's zero set). Several interfaces: a mapping ``{name:
             callable}``, cut as one level set ``min_i phi_i`` (checked apart, see
             :func:`xfem_contact.geometry.levelset.union`), each with its own measure
             (:meth:`interface_measure`) and rules.
-        degree: Lagrange degree (1 or 2) the level set is interpolated in.
+        degree: Lagrange degree (1 or 2) the level set is interpolated in (P1/P2 on
+            simplices, Q1/Q2 on quadrilaterals and hexahedra).
         quadrature_degree: Polynomial degree of the rules on each curved sub-triangle and
-            on each interface segment; default 6, and 16 for a crack (its branch
-            functions vary steeply in the cells it cuts next to the tip).
+            on each interface segment (3D: on each sub-tetrahedron and interface
+            triangle; Saye's rules take ``ceil((q + 1) / 2)`` Gauss points per interval);
+            default 6, and 16 for a crack (its branch functions vary steeply in the
+            cells it cuts next to the tip).
         tangent: For a crack: its tangential level set ``psi`` (a callable or a Function,
             as ``levelset``); the crack is the zero line of ``levelset`` where
             ``psi < 0`` (see :mod:`xfem_contact.fem.crack_cut`), :attr:`crack` its data.
             Several disjoint cracks: ``levelset`` and ``tangent`` mappings ``{name: ...}``
             with the same names (``psi = None``: a closed interface), cut as one pair
             (:mod:`xfem_contact.geometry.crack_union`, ``crack.union``), each with its
-            own measure.
+            own measure. 2D only.
         tip_points: Gauss points per direction of a tip cell's Duffy rules.
 
     Example:
@@ -79,11 +90,19 @@ class CutMesh:
         tangent: LevelSetCallable | dolfinx.fem.Function | None = None,
         tip_points: int = 24,
     ):
-        cell = mesh.topology.cell_name()
-        if cell not in ("triangle", "quadrilateral"):
-            raise NotImplementedError(
-                f"CutMesh supports triangle and quadrilateral meshes, not {cell}"
+        tdim = mesh.topology.dim
+        kinds = [t.name for t in mesh.topology.entity_types[tdim]]
+        if len(kinds) > 1:
+            raise ValueError(
+                f"mesh: a mixed-topology mesh ({' + '.join(kinds)}) cannot be cut; valid: "
+                f"one cell kind of {list(CELLS)}"
             )
+        if kinds[0] not in CELLS:
+            raise ValueError(
+                f"mesh: cells of kind {kinds[0]!r} cannot be cut; valid: {list(CELLS)}"
+            )
+        if tdim == 3 and tangent is not None:
+            raise ValueError("tangent: cracks are cut on triangle and quadrilateral meshes only")
         if quadrature_degree is None:
             quadrature_degree = 6 if tangent is None else 16
         if quadrature_degree < 1:
@@ -120,6 +139,9 @@ class CutMesh:
                 "tangent: a crack's cut takes its tangential level set psi (the crack "
                 "is phi = 0 where psi < 0); an interface's none"
             )
+        if self.mesh.topology.dim == 3:
+            args3 = (self.degree, self.quadrature_degree)
+            return cut_state_3d(self.mesh, levelset, *args3, previous=previous)
         args = (self.degree, self.quadrature_degree, self.tip_points)
         return cut_state(self.mesh, levelset, tangent, *args, previous=previous)
 

@@ -26,9 +26,8 @@ def cell_interfaces(
     if components is None or len(components) == 1:
         return np.zeros(ncut, dtype=np.int32)
     rows = np.r_[rules.point_rows, np.arange(ncut)]
-    centre = np.full((ncut, rules.points.shape[1]), 1.0 / 3.0)
-    if maps.mesh.topology.cell_name() == "quadrilateral":
-        centre[:] = 0.5
+    vertices = basix.geometry(maps.mesh.basix_cell())
+    centre = np.broadcast_to(vertices.sum(axis=0) / len(vertices), (ncut, vertices.shape[1]))
     x = maps.push_forward(cut_cells[rows], np.r_[rules.points, centre])
     x3 = np.zeros((3, x.shape[0]))
     x3[: x.shape[1]] = x.T
@@ -38,7 +37,8 @@ def cell_interfaces(
     return np.argmin(totals / np.maximum(npts, 1), axis=1).astype(np.int32)
 
 
-#: Interface pieces shorter than this fraction of their cell's size are round-off
+#: Interface pieces shorter than this fraction of their cell's size (in 3D: of smaller area
+#: than this fraction of its size squared) are round-off
 SLIVER_TOLERANCE = 64 * np.finfo(np.float64).eps
 
 
@@ -48,18 +48,19 @@ def without_slivers(
     rules: quadrature.RuleSet,
     maps: CellMaps,
 ) -> quadrature.RuleSet:
-    """The interface rules without the cells whose interface length is round-off
-    (below ``SLIVER_TOLERANCE`` times the cell size): a cell touched by the interface
-    at a node can get a round-off piece or none depending on the order of the cell's
+    """The interface rules without the cells whose interface length (area) is round-off
+    (below ``SLIVER_TOLERANCE`` times the cell size ``h`` (``h^2``)): a cell touched by
+    the interface at a node can get a round-off piece or none depending on the order of the cell's
     vertices, i.e. on the number of processes, and with it multiplier dofs."""
     if rules.weights.size == 0:
         return rules
     J = maps.jacobian(cut_cells[rules.point_rows], rules.points)
-    length = np.bincount(
+    size = np.bincount(
         rules.point_rows, rules.weights * np.abs(np.linalg.det(J)), minlength=cut_cells.size
     )
-    h = mesh.h(mesh.topology.dim, cut_cells)
-    return rules.select(length > SLIVER_TOLERANCE * h)
+    tdim = mesh.topology.dim
+    h = mesh.h(tdim, cut_cells)
+    return rules.select(size > SLIVER_TOLERANCE * h ** (tdim - 1))
 
 
 #: A singular value of a cell's trace matrix below this fraction of the largest is zero

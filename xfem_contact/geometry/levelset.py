@@ -49,18 +49,49 @@ class LevelSet(typing.NamedTuple):
 ZERO_TOLERANCE = 64 * np.finfo(np.float64).eps
 
 
-def _values(levelset: LevelSetCallable, x: np.ndarray) -> np.ndarray:
+def _values(levelset: LevelSetCallable, x: np.ndarray, gdim: int = 2) -> np.ndarray:
     """``levelset(x)`` checked: one float per point of ``x`` (shape ``(3, n)``)."""
+    hint = "" if gdim < 3 else " (a 3D mesh: x[0], x[1], x[2] are x, y, z)"
     try:
         values = np.asarray(levelset(x), dtype=np.float64)
-    except (TypeError, ValueError) as error:
-        raise ValueError(f"the level set failed on points x of shape {x.shape}: {error}") from None
+    except (TypeError, ValueError, IndexError) as error:
+        raise ValueError(
+            f"the level set failed on points x of shape {x.shape}{hint}: {error}"
+        ) from None
     if values.shape != (x.shape[1],):
         raise ValueError(
             f"the level set must return one value per point, shape ({x.shape[1]},) for x "
-            f"of shape {x.shape}; it returned shape {values.shape}"
+            f"of shape {x.shape}{hint}; it returned shape {values.shape}"
         )
     return values
+
+
+def _vertex_basis(cell: str, X: np.ndarray) -> np.ndarray:
+    """The P1 (Q1) vertex functions of a tetrahedron (hexahedron) at ``X`` ``(m, 3)`` in
+    closed form, shape ``(m, nv)`` (Basix vertex order): exact 0, 1/2, 1 at the nodes of
+    degree-2 Lagrange elements."""
+    x, y, z = X.T
+    if cell == "tetrahedron":
+        return np.stack([1.0 - x - y - z, x, y, z], axis=1)
+    lx, ly, lz = ([1.0 - t, t] for t in (x, y, z))
+    return np.stack([lx[i] * ly[j] * lz[k] for k in (0, 1) for j in (0, 1) for i in (0, 1)], 1)
+
+
+def canonical_dof_points(mesh: dolfinx.mesh.Mesh, V: dolfinx.fem.FunctionSpace) -> np.ndarray:
+    """Physical points of the dofs of a degree-1 or 2 Lagrange space on a 3D mesh of
+    straight cells, per cell, shape ``(num_cells incl. ghosts, ndofs, 3)`` (m).
+
+    The same point gets the same bits in every cell that holds it, whatever the cell's
+    vertex order, i.e. on any number of processes: the vertex terms of the cell map are
+    exact (weights 0, 1/2, 1/4, 1/8 by :func:`_vertex_basis`) and summed in sorted order.
+    Summed in the cell's order (as DOLFINx's interpolation does), a level set shared by
+    cells differs by a few ulps between partitions, which flips the ties of Saye's choice
+    of axes in symmetric cells."""
+    cell = mesh.topology.cell_name()
+    N = _vertex_basis(cell, V.element.interpolation_points)  # (ndofs, nv)
+    nodes = mesh.geometry.x[mesh.geometry.dofmaps[0]]  # (ncells, nv, 3)
+    terms = N[None, :, None, :] * np.transpose(nodes, (0, 2, 1))[:, None]  # (c, dof, 3, nv)
+    return np.sort(terms, axis=3).sum(axis=3)
 
 
 def interpolate(
@@ -96,7 +127,12 @@ def interpolate(
         phi.interpolate(levelset)
         exact = None
     elif callable(levelset):
-        phi.interpolate(lambda x: _values(levelset, x))
+        if mesh.topology.dim == 3 and mesh.geometry.cmaps[0].degree == 1:
+            points = canonical_dof_points(mesh, V)  # (ncells, ndofs, 3)
+            cell_values = _values(levelset, points.reshape(-1, 3).T, 3)
+            phi.x.array[V.dofmap.list] = cell_values.reshape(points.shape[:2])
+        else:
+            phi.interpolate(lambda x: _values(levelset, x, mesh.geometry.dim))
         exact = levelset
     else:
         raise ValueError(f"A level set is a callable or a dolfinx Function, not {type(levelset)}")
