@@ -210,14 +210,21 @@ class InterfaceContext:
 class Ops(typing.NamedTuple):
     """Pointwise operations, so that one definition of a law serves UFL and numpy:
     ``minimum``, ``maximum``; ``norm(a)`` of a tangential part (a vector: UFL one, or
-    numpy ``(npoints, gdim)`` rows) and ``scale(s, a)``, ``s a`` for a scalar ``s``;
-    ``below(a, b, x, y)``: ``x`` where ``a <= b``, else ``y``."""
+    numpy ``(npoints, gdim)`` rows), ``scale(s, a)`` and ``divide(a, s)``, ``s a`` and
+    ``a / s`` for a scalar ``s``; ``below(a, b, x, y)``: ``x`` where ``a <= b``, else
+    ``y``."""
 
     minimum: typing.Callable
     maximum: typing.Callable
     norm: typing.Callable
     scale: typing.Callable
+    divide: typing.Callable
     below: typing.Callable
+
+
+def _rows(s, a):
+    """``s`` broadcast over the rows of ``a`` (numpy)."""
+    return s[..., None] if np.ndim(a) > np.ndim(s) else s
 
 
 UFL_OPS = Ops(
@@ -225,34 +232,35 @@ UFL_OPS = Ops(
     ufl.max_value,
     lambda a: ufl.sqrt(ufl.dot(a, a)),
     lambda s, a: s * a,
+    lambda a, s: a / s,
     lambda a, b, x, y: ufl.conditional(ufl.le(a, b), x, y),
 )
 NUMPY_OPS = Ops(
     np.minimum,
     np.maximum,
     lambda a: np.linalg.norm(a, axis=-1),
-    lambda s, a: (s[..., None] if np.ndim(a) > np.ndim(s) else s) * a,
-    lambda a, b, x, y: np.where(a <= b, x, y),
+    lambda s, a: _rows(s, a) * a,
+    lambda a, s: a / _rows(s, a),
+    lambda a, b, x, y: np.where(_rows(a <= b, x), x, y),
 )
 
 
 def project_on_disc(trial, bound, ops: Ops):
     """The projection of a tangential part ``trial`` on the disc ``|P| <= bound``
-    (``bound >= 0``): ``trial`` inside, ``bound trial / |trial|`` outside.
+    (``bound >= 0``): ``trial`` inside, ``bound (trial / |trial|)`` outside (``trial = 0``
+    with ``bound = 0`` is inside: no division by zero is taken).
 
-    A tangential part has one component in 2D (a scalar, :meth:`InterfaceContext.
-    tangential`): the disc is then the segment ``[-bound, bound]`` and the projection
-    the clamp ``max(-bound, min(bound, trial))``, which is the same value exactly
-    (``trial / |trial|`` is +-1) with a Jacobian free of the round-off of
-    differentiating ``trial / |trial|``. In 3D a vector, scaled by
-    ``min(1, bound / |trial|)`` (1 where ``|trial| <= bound``, so ``trial = 0`` with
-    ``bound = 0`` stays 0 without dividing by zero).
+    A tangential part is a scalar in 2D (:meth:`InterfaceContext.tangential`): the disc
+    is then the segment ``[-bound, bound]`` and the projection the clamp
+    ``max(-bound, min(bound, trial))``, the same value to the last bit (``trial /
+    |trial|`` is exactly +-1) with a Jacobian free of the round-off of differentiating
+    ``trial / |trial|``.
     """
     if len(getattr(trial, "ufl_shape", np.shape(trial)[1:])) == 0:
         return ops.maximum(-bound, ops.minimum(bound, trial))
     norm = ops.norm(trial)
-    with np.errstate(divide="ignore", invalid="ignore"):  # bound / 0: only where not taken
-        return ops.scale(ops.below(norm, bound, 1.0, bound / norm), trial)
+    with np.errstate(divide="ignore", invalid="ignore"):  # trial / 0: only where not taken
+        return ops.below(norm, bound, trial, ops.scale(bound, ops.divide(trial, norm)))
 
 #: What a closed interface transmits (:attr:`InterfaceLaw.transmits`)
 TRANSMITS = ("none", "normal", "full")
