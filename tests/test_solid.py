@@ -28,6 +28,7 @@ from xfem_contact.mechanics.laws.base import NUMPY_OPS, UFL_OPS, project_on_disc
 from xfem_contact.mechanics.materials import Material, Moduli
 from xfem_contact.mechanics.plain import PlainElasticityProblem
 from xfem_contact.mechanics.presets import ElasticityProblem
+from xfem_contact.mechanics.reactions import balance
 from xfem_contact.mechanics.rigid_modes import check_rigid_modes
 from xfem_contact.mechanics.rigid_motions import rigid_motions
 from xfem_contact.mechanics.stress import StressFields
@@ -258,6 +259,11 @@ def test_sphere_triaxial_contact_pressure(law, bound):
     assert np.asarray(state["slip"]).shape[1] == 3
     samples = problem.interface_samples(problem.w)
     assert set("xyz") <= set(samples) and np.shape(samples["lambda_t"])[1] == 3
+    # reactions in 3D: the point constraints carry nothing (the exact field meets them),
+    # the pressures balance, the interface transmits sigma n (resultant zero on a sphere)
+    summary = balance(problem, problem.w)
+    assert len(summary["applied_loads"]) == 3 and summary["balance_relative"] < 1e-10
+    assert max(np.abs(r).max() for r in summary["reactions"].values()) < 1e-10
 
 
 def test_sphere_coulomb_with_a_large_friction_sticks():
