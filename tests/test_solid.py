@@ -29,7 +29,12 @@ from xfem_contact.mechanics.materials import Material, Moduli
 from xfem_contact.mechanics.plain import PlainElasticityProblem
 from xfem_contact.mechanics.presets import ElasticityProblem
 from xfem_contact.mechanics.reactions import balance
-from xfem_contact.mechanics.rigid_modes import check_rigid_modes
+from xfem_contact.mechanics.rigid_modes import (
+    RigidModeWarning,
+    check_rigid_modes,
+    check_support,
+    free_bodies,
+)
 from xfem_contact.mechanics.rigid_motions import rigid_motions
 from xfem_contact.mechanics.stress import StressFields
 
@@ -289,3 +294,28 @@ def test_sphere_sticking_parallel_equals_serial():
         fields.append(gathered_fields(problem))
     differences = max_relative_difference(*fields)
     assert all(v <= 1e-10 for v in differences.values()), differences
+
+
+def test_sphere_frictionless_hydrostatic():
+    """Frictionless contact in 3D: under hydrostatic pressure 1 Pa the contact pressure
+    is uniform."""
+    problem = sphere_problem(4, 2, "frictionless", stress=(-1.0, -1.0, -1.0))
+    problem.solve()
+    e_n, _ = sphere_errors(problem)
+    print(f"\nsphere hydrostatic frictionless P2 n=4: pressure error {e_n:.3e}")
+    assert e_n < 1e-2
+
+
+def test_sphere_spins_under_frictionless_contact_are_a_warning():
+    """A frictionless sphere leaves three spins free (n = 8: the discrete sphere locks
+    them less than the check's tolerance): a warning naming the three rotations, not an
+    error (the 2D rule, one spin, generalised)."""
+    problem = sphere_problem(8, 1, "frictionless", stress=(-1.0, -1.0, -1.0))
+    (body,) = free_bodies(problem)
+    assert body.spin_only and [m.split(" (")[0] for m in body.modes] == ["rotation about"] * 3
+    # the remedies hold the three rotations: their velocity rows are independent
+    c = np.asarray(SPHERE_CENTRE)
+    rows = [[np.cross(w, np.asarray(q) - c)[k] for w in np.eye(3)] for q, k in body.remedies]
+    assert len(rows) == 3 and np.linalg.matrix_rank(np.array(rows), tol=1e-3) == 3
+    with pytest.warns(RigidModeWarning, match="rotation about .* rotation about .* rotation"):
+        check_support(problem)

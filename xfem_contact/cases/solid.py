@@ -99,12 +99,13 @@ def sphere_problem(
     law: str,
     cell: str = "tetrahedron",
     comm: MPI.Comm = MPI.COMM_WORLD,
+    stress: tuple[float, float, float] = TRIAXIAL,
     **options,
 ) -> ElasticityProblem:
     """A sphere (``SPHERE_RADIUS``) in the unit cube (``n`` cells per edge, even),
-    one material on both sides, pressures ``-TRIAXIAL`` on the three pairs of faces
+    one material on both sides, pressures ``-stress`` (Pa) on the three pairs of faces
     and the six rigid modes held by point constraints the exact field satisfies
-    (``u_i = 0`` where ``x_i = 1/2``): the exact stress is ``diag(TRIAXIAL)``
+    (``u_i = 0`` where ``x_i = 1/2``): the exact stress is ``diag(stress)``
     everywhere, the exact contact traction ``sigma n``. ``law``: ``bonded``,
     ``sticking`` (a contact law stays closed: every ``n.sigma.n < 0``), ...;
     ``options`` go to the problem."""
@@ -119,7 +120,8 @@ def sphere_problem(
     )
     cls = ContactProblem if law in ContactProblem.LAWS else ElasticityProblem
     problem = cls(cut, degree, SOLID, law, **options)
-    for k, s in enumerate(TRIAXIAL):
+    problem.stress = tuple(stress)
+    for k, s in enumerate(stress):
         faces = lambda x, k=k: np.isclose(x[k], 0.0) | np.isclose(x[k], 1.0)  # noqa: E731
         problem.loads.add_pressure(faces, -s)
     held = [
@@ -137,8 +139,9 @@ def sphere_problem(
 
 
 def sphere_errors(problem) -> tuple[float, float]:
-    """Relative L2 errors on the sphere of the normal and the tangential traction of the
-    multiplier (``lambda_n`` against ``n.sigma.n``, the tangential part against
+    """Relative L2 errors on the sphere of :func:`sphere_problem`'s solved ``problem`` of
+    the normal and the tangential traction of the multiplier (``lambda_n`` against
+    ``n.sigma.n``, the tangential part against
     ``(I - n n) sigma n``; the Cartesian multiplier of ``bonded`` and of the 3D contact
     laws split on the exact sphere's ``n``), summed by the interface rule at its points
     (numpy). ``frictionless`` gives ``nan`` for the tangential one. Collective."""
@@ -149,7 +152,7 @@ def sphere_errors(problem) -> tuple[float, float]:
     dA = rules.weights * np.abs(np.linalg.det(J))  # area (m^2) of each point
     arm = interface_points(cut, rules) - np.asarray(SPHERE_CENTRE)
     n = arm / np.linalg.norm(arm, axis=1)[:, None]
-    traction = n @ np.diag(TRIAXIAL)
+    traction = n @ np.diag(problem.stress)
     p_ex = np.sum(traction * n, axis=1)
     t_ex = traction - p_ex[:, None] * n
     lam = ctx.values_at(problem.w, ctx.field)  # Cartesian (bonded, contact in 3D)

@@ -21,8 +21,9 @@ class FreeBody:
         reasons: Why nothing holds them (Dirichlet data, interface laws).
         remedies: ``(point, component)`` of point constraints that remove them
             (``problem.loads.add_point_displacement(point, 0.0, component)``).
-        spin_only: The only free mode is a rotation that a frictionless interface of
-            the body leaves (a spin its geometry does not lock), not a missing support.
+        spin_only: The free modes are rotations that a frictionless interface of the
+            body leaves (a spin its geometry does not lock: a circle's, a sphere's
+            three), not a missing support.
     """
 
     body: str
@@ -88,8 +89,8 @@ def describe(problem, body: Body, S: np.ndarray, reasons: list[str]) -> FreeBody
 def describe_3d(problem, body: Body, S: np.ndarray, reasons: list[str]) -> FreeBody:
     """Names of the free motions ``S`` (6 x r) of a 3D ``body`` and point constraints
     removing them: the free translations (those of ``S`` without rotation), then each
-    free rotation by its axis through the centroid, held at the node farthest from it
-    in the component it moves most."""
+    free rotation by its axis through the centroid, held by the point constraints
+    :func:`rotation_holds` picks."""
     theta = S[3:]
     turning = np.linalg.svd(theta, full_matrices=False)[1] > 0.1
     T = S @ null_space(theta) if turning.any() else S
@@ -109,10 +110,32 @@ def describe_3d(problem, body: Body, S: np.ndarray, reasons: list[str]) -> FreeB
     for axis in U.T:
         direction = ", ".join(short_number(v, 3) for v in axis)
         modes.append(f"rotation about ({direction}) through ({centre})")
-        q = extreme_node(problem, body, None, body.centre, farthest=True)
-        arm = np.asarray(q) - body.centre
-        remedies.append((q, int(np.argmax(np.abs(np.cross(axis, arm))))))
+    remedies += rotation_holds(problem, body, U)
     return FreeBody(body.name, modes, reasons, remedies)
+
+
+def rotation_holds(problem, body: Body, U: np.ndarray) -> list[tuple[list[float], int]]:
+    """``r`` point constraints ``(node, component)`` that hold the free rotations about
+    the axes ``U`` (3 x r, orthonormal) through the centroid: the candidates are the
+    components of the node farthest from the centroid and of the node farthest from the
+    point a radius off it across that node's arm; each pick is the candidate whose row
+    (the velocity of every free rotation there) has the largest part outside the rows
+    picked before. Collective (the same picks on every process)."""
+    c = body.centre
+    first = np.asarray(extreme_node(problem, body, None, c, farthest=True))
+    arm = first - c
+    across = np.cross(arm, np.eye(3)[int(np.argmin(np.abs(arm)))])
+    off = c + body.radius * across / np.linalg.norm(across)
+    second = np.asarray(extreme_node(problem, body, None, off, farthest=False))
+    candidates = [(q, k) for q in (first, second) for k in range(3)]
+    rows = np.array([[np.cross(axis, q - c)[k] for axis in U.T] for q, k in candidates])
+    picks, basis = [], np.zeros((0, U.shape[1]))
+    for _ in range(U.shape[1]):
+        rest = rows - rows @ basis.T @ basis
+        best = int(np.argmax(np.linalg.norm(rest, axis=1)))
+        basis = np.vstack([basis, rest[best] / np.linalg.norm(rest[best])])
+        picks.append((candidates[best][0].tolist(), candidates[best][1]))
+    return picks
 
 
 

@@ -134,10 +134,8 @@ def free_bodies(problem, tol: float = 1e-3) -> list[FreeBody]:
             reasons.append("it moves together with " + ", ".join(others))
         name_motions = describe if problem.mesh.geometry.dim == 2 else describe_3d
         free = name_motions(problem, body, S, reasons)
-        free.spin_only = (
-            len(free.modes) == 1
-            and free.modes[0].startswith("rotation")
-            and any(kinds[n] == "normal" for n in names)
+        free.spin_only = all(mode.startswith("rotation") for mode in free.modes) and any(
+            kinds[n] == "normal" for n in names
         )
         found.append(free)
         # the remedies fix every free mode that moves this body: the later bodies are
