@@ -285,14 +285,29 @@ def test_sphere_coulomb_with_a_large_friction_sticks():
     assert coulomb.laws[next(iter(coulomb.laws))].status(b)["slip"] == 0
 
 
+def test_sphere_coulomb_partial_slip():
+    """Coulomb with mu = 0.1 under the triaxial load: the sphere slips but near the six
+    points where the exact tangential traction vanishes (the axes' poles)."""
+    problem = sphere_problem(4, 1, "coulomb", friction=0.1)
+    report = problem.solve()
+    law = problem.laws["interface"]
+    counts = law.status(law.state(problem.contexts["interface"], problem.w))
+    print(f"\nsphere Coulomb mu=0.1 P1 n=4: {counts}, {report.iterations} Newton iterations")
+    assert report.iterations <= 10
+    assert counts["stick"] > 0 and counts["slip"] > 10 * counts["stick"]
+
+
 @pytest.mark.mpi
-def test_sphere_sticking_parallel_equals_serial():
+@pytest.mark.parametrize("law, options", [("sticking", {}), ("coulomb", {"friction": 0.1})])
+def test_sphere_parallel_equals_serial(law, options):
     fields = []
     for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
-        problem = sphere_problem(4, 1, "sticking", comm=comm)
+        problem = sphere_problem(4, 1, law, comm=comm, **options)
         problem.solve()
         fields.append(gathered_fields(problem))
     differences = max_relative_difference(*fields)
+    if MPI.COMM_WORLD.rank == 0:
+        print(law, {k: f"{v:.1e}" for k, v in differences.items()})
     assert all(v <= 1e-10 for v in differences.values()), differences
 
 
@@ -319,3 +334,8 @@ def test_sphere_spins_under_frictionless_contact_are_a_warning():
     assert len(rows) == 3 and np.linalg.matrix_rank(np.array(rows), tol=1e-3) == 3
     with pytest.warns(RigidModeWarning, match="rotation about .* rotation about .* rotation"):
         check_support(problem)
+
+
+def test_restriction_is_refused_in_3d():
+    with pytest.raises(ValueError, match="lbb='restriction' is not available on 3D meshes"):
+        sphere_problem(4, 1, "sticking", lbb="restriction").solve()
