@@ -37,6 +37,7 @@ from xfem_contact.mechanics.rigid_modes import (
 )
 from xfem_contact.mechanics.rigid_motions import rigid_motions
 from xfem_contact.mechanics.stress import StressFields
+from xfem_contact.solvers.options import preset
 
 
 def cube(n=2, cell="tetrahedron"):
@@ -158,6 +159,8 @@ def test_rigid_mode_check_in_3d():
     bad = ElasticityProblem(sphere_cut(cube(4)), 1, SOLID, "bonded")
     with pytest.raises(ValueError, match=r"point must be 3 finite numbers \[x, y, z\]"):
         bad.loads.add_point_displacement([0.5, 0.5], 0.0, 0)
+    with pytest.raises(ValueError, match="add_rotation turns a part in the plane"):
+        bad.loads.add_rotation("boundary", angle=0.1)
 
 
 # -- Coulomb's disc -----------------------------------------------------------------------------
@@ -339,3 +342,15 @@ def test_sphere_spins_under_frictionless_contact_are_a_warning():
 def test_restriction_is_refused_in_3d():
     with pytest.raises(ValueError, match="lbb='restriction' is not available on 3D meshes"):
         sphere_problem(4, 1, "sticking", lbb="restriction").solve()
+
+
+def test_iterative_preset_in_3d_gives_the_direct_answer():
+    """The iterative preset (GMRES, band multigrid with GAMG on six rigid modes per
+    side) on the sticking sphere: the direct solver's fields."""
+    direct = sphere_problem(4, 2, "sticking")
+    direct.solve()
+    iterative = sphere_problem(4, 2, "sticking")
+    iterative.petsc_options = preset("iterative")
+    iterative.solve()
+    scale = np.abs(direct.w.x.array).max()
+    assert np.abs(iterative.w.x.array - direct.w.x.array).max() < 1e-8 * scale

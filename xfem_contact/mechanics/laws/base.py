@@ -130,6 +130,15 @@ class InterfaceContext:
         n = self.normal
         return v - ufl.dot(v, n) * n
 
+    def multiplier_parts(self, lam) -> tuple:
+        """``(lambda_n, lambda_t)`` of a multiplier with normal and tangential parts (UFL,
+        ``gdim`` components): in 2D its components in the frame ``(n, t)``; in 3D a
+        Cartesian traction, split as ``lambda.n`` and ``(I - n n) lambda`` (no tangent
+        frame is smooth on a closed surface)."""
+        if self.gdim == 2:
+            return lam[0], lam[1]
+        return ufl.dot(lam, self.normal), self.tangential(lam)
+
     def tangent_vector(self, a) -> ufl.core.expr.Expr:
         """The Cartesian vector of a tangential part ``a`` (:meth:`tangential`): ``a t``
         in 2D, ``a`` itself in 3D (UFL)."""
@@ -156,6 +165,13 @@ class InterfaceContext:
             n = self.normal_at()
             self._cache["frame"] = (n, np.c_[-n[:, 1], n[:, 0]])
         return self._cache["frame"]
+
+    def multiplier_parts_at(self, lam: npt.NDArray[np.float64]) -> tuple:
+        """:meth:`multiplier_parts` of multiplier values at the rule points, ``(npoints,
+        gdim)``: ``lambda_n`` ``(npoints,)`` and ``lambda_t`` as :meth:`tangential_at`."""
+        if self.gdim == 2:
+            return lam[:, 0], lam[:, 1]
+        return np.sum(lam * self.normal_at(), axis=1), self.tangential_at(lam)
 
     def tangential_at(self, v: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """:meth:`tangential` of vectors ``v`` given at the rule points, ``(npoints,

@@ -120,10 +120,7 @@ class ContactLaw(MultiplierLaw):
         tangential part: see the module docstring)."""
         if not self.tangential:
             return u.multiplier, None
-        if ctx.gdim == 2:
-            return u.multiplier[0], u.multiplier[1]
-        lam = u.multiplier
-        return ufl.dot(lam, ctx.normal), ctx.tangential(lam)
+        return ctx.multiplier_parts(u.multiplier)
 
     def traction_vector(self, ctx: InterfaceContext, u: Fields):
         """Cartesian multiplier vector ``lambda_n n + lambda_t`` (UFL)."""
@@ -177,11 +174,7 @@ class ContactLaw(MultiplierLaw):
         slip_increment = slip
         if self.incremental:
             slip_increment = slip - ctx.tangential_at(ctx.jump_at(ctx.w_old))
-        lam_n, lam_t = lam[:, 0], None
-        if self.tangential and ctx.gdim == 2:
-            lam_t = lam[:, 1]
-        elif self.tangential:
-            lam_n, lam_t = np.sum(lam * n, axis=1), ctx.tangential_at(lam)
+        lam_n, lam_t = ctx.multiplier_parts_at(lam) if self.tangential else (lam[:, 0], None)
         P_n, P_t = self.augmented(lam_n, lam_t, gap, slip_increment, r, NUMPY_OPS)
         lam_t = np.zeros_like(slip) if lam_t is None else lam_t
         return {

@@ -241,9 +241,14 @@ class Loads:
         history: Path = None,
     ) -> RotationLoad:
         """Rotate a boundary part rigidly by ``angle`` (rad) or ``angle_deg`` (degrees),
-        counter-clockwise about ``centre`` (m), times the factor ``path(t)``:
+        counter-clockwise about ``centre`` (m), times the factor ``path(t)`` (2D meshes):
         ``u = (Q - I)(X - c)`` on every side's field. Warns for ``angle`` outside
         [-2 pi, 2 pi] (degrees given as radians?)."""
+        if self.mesh.geometry.dim != 2:
+            raise ValueError(
+                "add_rotation turns a part in the plane (2D meshes); on a 3D mesh prescribe "
+                "the rotation's displacement with add_displacement(part, callable)"
+            )
         if (angle is None) == (angle_deg is None):
             raise ValueError("Give the rotation as angle= (rad) or angle_deg= (degrees), once")
         if angle_deg is not None:
