@@ -62,16 +62,26 @@ def plane_exact(side: int, ops=np, material: Material = SOLID):
 
 
 def plane_problem(
-    n: int, degree: int, cell: str = "tetrahedron", comm: MPI.Comm = MPI.COMM_WORLD
+    n: int,
+    degree: int,
+    cell: str = "tetrahedron",
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    quadrature_degree: int | None = None,
 ) -> ElasticityProblem:
     """The unit cube (``n`` cells per edge) cut by the plane ``a.x = d``, free (open)
     interface, each side loaded by the body force ``-div sigma_s = -S_s a`` and held on
     the whole boundary by its exact displacement (:func:`plane_exact`): the solution is
     quadratic on each side, the interface traction-free and open (its gap
-    ``PLANE_OPENING`` plus the elastic jump, > 0)."""
+    ``PLANE_OPENING`` plus the elastic jump, > 0). ``quadrature_degree``: the cut
+    rules' (:class:`~xfem_contact.fem.cutmesh.CutMesh`'s default when None)."""
     mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
     a, d = PLANE_NORMAL, PLANE_OFFSET
-    cut = CutMesh(mesh, lambda x: a[0] * x[0] + a[1] * x[1] + a[2] * x[2] - d, degree=1)
+    cut = CutMesh(
+        mesh,
+        lambda x: a[0] * x[0] + a[1] * x[1] + a[2] * x[2] - d,
+        degree=1,
+        quadrature_degree=quadrature_degree,
+    )
     problem = ElasticityProblem(cut, degree, SOLID, "free")
     problem.loads.add_displacement("boundary", {s: plane_exact(s) for s in (-1, 1)})
     for side in (-1, 1):
