@@ -4,9 +4,9 @@ import numpy as np
 
 
 def _by_position(points: np.ndarray) -> np.ndarray:
-    """Order of points ``(n, 2)``, sorted by rounded coordinates (x, then y)."""
+    """Order of points ``(n, gdim)``, sorted by rounded coordinates (x, then y, then z)."""
     rounded = np.round(np.asarray(points, dtype=np.float64), 7)
-    return np.lexsort((rounded[:, 1], rounded[:, 0]))
+    return np.lexsort([rounded[:, k] for k in reversed(range(rounded.shape[1]))])
 
 
 def gathered_fields(problem) -> dict[str, np.ndarray]:
@@ -14,17 +14,18 @@ def gathered_fields(problem) -> dict[str, np.ndarray]:
     Collective.
 
     Returns ``lambda_n``, ``lambda_t`` at the interface rule points (Pa) and
-    ``u_minus``, ``u_plus`` at the displacement dofs (m, shape ``(n, 2)``).
+    ``u_minus``, ``u_plus`` at the displacement dofs (m, shape ``(n, gdim)``).
     """
     comm = problem.mesh.comm
+    gdim = problem.mesh.geometry.dim
     samples = problem.interface_samples(problem.w)
-    order = _by_position(np.c_[samples["x"], samples["y"]])
+    order = _by_position(np.stack([samples[k] for k in "xyz"[:gdim]], axis=1))
     fields = {k: np.asarray(samples[k])[order] for k in ("lambda_n", "lambda_t")}
     for field, name in ((0, "u_minus"), (1, "u_plus")):
         V, dofs = problem.space.field_space(field)
         owned = V.dofmap.index_map.size_local
-        x = V.tabulate_dof_coordinates()[:owned, :2]
-        values = problem.w.x.array[np.asarray(dofs)].reshape(-1, 2)[:owned]
+        x = V.tabulate_dof_coordinates()[:owned, :gdim]
+        values = problem.w.x.array[np.asarray(dofs)].reshape(-1, gdim)[:owned]
         x, values = (np.concatenate(comm.allgather(a)) for a in (x, values))
         fields[name] = values[_by_position(x)]
     return fields

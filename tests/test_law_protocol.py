@@ -107,8 +107,8 @@ def test_what_each_law_transmits():
 def test_multipliers_and_tractions_by_default():
     lam = object()
     fields = Fields(None, None, lam)
-    assert Bonded().multipliers(fields) == (lam, None)
-    assert Free().multipliers(Fields(None, None)) == (None, None)
+    assert Bonded().multipliers(None, fields) == (lam, None)
+    assert Free().multipliers(None, Fields(None, None)) == (None, None)
     assert Free().traction_vector(None, Fields(None, None)) is None
     assert Bonded().traction_vector(None, fields) is lam
 

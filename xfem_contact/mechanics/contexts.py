@@ -98,12 +98,14 @@ def status_counts(
 
 
 def samples(law: InterfaceLaw, ctx: InterfaceContext, w) -> dict[str, list[float]]:
-    """The law's state for ``w`` at the rule points of all processes: ``x``, ``y`` (m)
-    and ``gap``, ``slip``, ``lambda_n``, ``lambda_t`` and, for contact laws, ``P_n``,
-    ``P_t``, each a list over the points. Collective."""
+    """The law's state for ``w`` at the rule points of all processes: ``x``, ``y`` (and
+    ``z`` in 3D) (m) and ``gap``, ``slip``, ``lambda_n``, ``lambda_t`` and, for contact
+    laws, ``P_n``, ``P_t``, each a list over the points (the tangential ones scalars
+    along ``t`` in 2D, Cartesian vectors ``[x, y, z]`` in 3D). Collective."""
     state = law.state(ctx, w)
     points = interface_points(ctx.cut, ctx.rules)
-    local = {"x": points[:, 0], "y": points[:, 1]}
+    gdim = ctx.cut.mesh.geometry.dim
+    local = {name: points[:, k] for k, name in enumerate("xyz"[:gdim])}
     keys = ("gap", "slip", "lambda_n", "lambda_t", "P_n", "P_t")
     local |= {k: state[k] for k in keys if k in state}
     comm = ctx.cut.mesh.comm

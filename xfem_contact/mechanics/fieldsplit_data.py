@@ -2,7 +2,7 @@
 
 :func:`fieldsplit_dofs` names the dofs of the displacements (``"u"``: both sides) and of
 the multipliers (``"lambda"``: every multiplier field); :func:`rigid_modes` gives the
-translations and the rotation of each side, the near null space of the displacement
+translations and the rotations of each side, the near null space of the displacement
 block for algebraic multigrid (GAMG). Used by
 :class:`~xfem_contact.mechanics.problem.Problem` for the ``"iterative"`` preset of
 :data:`~xfem_contact.solvers.options.PRESETS`.
@@ -17,6 +17,7 @@ import dolfinx.fem
 import numpy as np
 
 from xfem_contact.fem.enrichment import EnrichedSpace
+from xfem_contact.mechanics.rigid_motions import rigid_motions
 
 SIDE_FIELDS = (0, 1)
 
@@ -95,17 +96,19 @@ def vertex_interpolation(space: EnrichedSpace):
 
 
 def rigid_modes(space: EnrichedSpace) -> Iterator[dolfinx.fem.Function]:
-    """The rigid motions of each side separately (2D: two translations and the
-    rotation about the origin, per side field) on ``space.W`` (m): one Function,
-    refilled with the next mode at each step of the iteration (a Function on ``W`` is
-    large; use each mode before taking the next). Collective iteration."""
+    """The rigid motions of each side separately (:func:`~xfem_contact.mechanics.
+    rigid_motions.rigid_motions` about the origin: 3 per side field in 2D, 6 in 3D) on
+    ``space.W`` (m): one Function, refilled with the next mode at each step of the
+    iteration (a Function on ``W`` is large; use each mode before taking the next).
+    Collective iteration."""
     W = space.W
+    gdim = W.mesh.geometry.dim
     mode = dolfinx.fem.Function(W)
     for field in SIDE_FIELDS:
         V, dofs = space.field_space(field)  # dofs: the W dof of each (unrolled) V dof
-        x = V.tabulate_dof_coordinates()[:, :2]  # (nodes, 2), a node's components together
-        one, zero = np.ones(x.shape[0]), np.zeros(x.shape[0])
-        for motion in ((one, zero), (zero, one), (-x[:, 1], x[:, 0])):
+        x = V.tabulate_dof_coordinates()[:, :gdim]  # (nodes, gdim)
+        motions = rigid_motions(x)  # (nodes, gdim, m): a node's components together
+        for k in range(motions.shape[2]):
             mode.x.array[:] = 0.0
-            mode.x.array[dofs] = np.column_stack(motion).ravel()
+            mode.x.array[dofs] = motions[:, :, k].ravel()
             yield mode

@@ -65,10 +65,12 @@ def vital_vertex_prolongation(
     all_sides = np.concatenate(comm.allgather(vertex_side[ends]))
     # The greedy choice breaks ties by vertex label: label the vertices by position (the
     # global numbers depend on the partition: 2 ranks chose other vital vertices than 1)
+    gdim = mesh.geometry.dim
     nodes = dolfinx.mesh.entities_to_geometry(mesh, 0, ends.ravel().astype(np.int32))
-    all_x = np.concatenate(comm.allgather(mesh.geometry.x[nodes.ravel(), :2])).reshape(-1, 2)
+    all_x = np.concatenate(comm.allgather(mesh.geometry.x[nodes.ravel(), :gdim]))
+    all_x = all_x.reshape(-1, gdim)
     ids, first = np.unique(all_ends.ravel(), return_index=True)
-    order = np.lexsort((np.round(all_x[first, 1], 12), np.round(all_x[first, 0], 12)))
+    order = np.lexsort([np.round(all_x[first, k], 12) for k in reversed(range(gdim))])
     label = np.empty_like(order)
     label[order] = np.arange(order.size)
     by_position = label[np.searchsorted(ids, all_ends)]

@@ -19,27 +19,52 @@ import ufl
 from xfem_contact.mechanics.parameters import Parameter, bind, constant, listen
 
 PLANES = ("strain", "stress")
+#: The modes a material may take on a mesh of each geometric dimension; the first is the
+#: default (``plane=None``)
+MODES = {2: PLANES, 3: ("3d",)}
 
 
 @dataclasses.dataclass(frozen=True)
 class Material:
-    """Isotropic linear elasticity in 2D.
+    """Isotropic linear elasticity.
 
     Args:
         E: Young's modulus (Pa), > 0.
         nu: Poisson's ratio, in (-1, 0.5).
-        plane: ``"strain"`` or ``"stress"``.
+        plane: The mode: ``"strain"`` or ``"stress"`` (plane assumptions, 2D meshes) or
+            ``"3d"`` (3D meshes); None (default): the first of :data:`MODES` for the
+            mesh, plane strain in 2D, 3D in 3D (the two share Lamé's parameters).
     """
 
     E: float
     nu: float
-    plane: typing.Literal["strain", "stress"] = "strain"
+    plane: typing.Literal["strain", "stress", "3d"] | None = None
 
     def __post_init__(self):
         Moduli.E.check(self.E, "Young's modulus E")
         Moduli.nu.check(self.nu, "Poisson's ratio nu")
-        if self.plane not in PLANES:
-            raise ValueError(f"plane must be one of {PLANES}, got {self.plane!r}")
+        choices = (None, *PLANES, *MODES[3])
+        if self.plane not in choices:
+            raise ValueError(f"plane must be one of {choices}, got {self.plane!r}")
+
+    def on(self, gdim: int) -> Material:
+        """The material with its mode settled for a mesh of geometric dimension ``gdim``
+        (``plane=None`` takes the default of :data:`MODES`).
+
+        Raises:
+            ValueError: the mode does not exist in ``gdim`` (a plane assumption on a 3D
+                mesh, ``"3d"`` on a 2D one).
+        """
+        if gdim not in MODES:
+            raise ValueError(f"Material: meshes of dimension {gdim} are not supported")
+        if self.plane is None:
+            return dataclasses.replace(self, plane=MODES[gdim][0])
+        if self.plane not in MODES[gdim]:
+            raise ValueError(
+                f"Material plane={self.plane!r} does not exist on a {gdim}D mesh; choices "
+                f"there: {MODES[gdim]} (or None for {MODES[gdim][0]!r})"
+            )
+        return self
 
     @property
     def mu(self) -> float:
@@ -48,7 +73,8 @@ class Material:
 
     @property
     def lmbda(self) -> float:
-        """Lamé's first parameter of the 2D law (Pa); plane stress uses the reduced one."""
+        """Lamé's first parameter (Pa): of 3D elasticity, as in plane strain; plane stress
+        uses the reduced one."""
         lmbda = self.E * self.nu / ((1.0 + self.nu) * (1.0 - 2.0 * self.nu))
         if self.plane == "stress":
             return 2.0 * self.mu * lmbda / (lmbda + 2.0 * self.mu)
@@ -91,8 +117,12 @@ class Moduli:
     built with this object, with no new compile. Not collective.
 
     Args:
-        material: The initial values and the plane assumption (fixed).
+        material: The initial values and the mode (fixed; settled for the mesh by
+            :meth:`Material.on`).
         mesh: The mesh of the forms.
+
+    Raises:
+        ValueError: the material's mode does not exist on the mesh's dimension.
     """
 
     name = "material"
@@ -100,13 +130,14 @@ class Moduli:
     nu = Parameter("1", minimum=-1.0, strict=True, maximum=0.5)
 
     def __init__(self, material: Material, mesh: dolfinx.mesh.Mesh):
-        self._plane = material.plane
+        self._plane = material.on(mesh.geometry.dim).plane
         self.E, self.nu = material.E, material.nu
         bind(self, mesh)
 
     @property
     def plane(self) -> str:
-        """``"strain"`` or ``"stress"``: fixed, the forms are built with it."""
+        """The mode, ``"strain"``, ``"stress"`` or ``"3d"``: fixed, the forms are built
+        with it."""
         return self._plane
 
     @plane.setter
@@ -133,7 +164,7 @@ class Moduli:
 
     @property
     def ufl_lmbda(self) -> ufl.core.expr.Expr:
-        """Lame's first parameter of the 2D law (Pa), UFL (reduced in plane stress)."""
+        """Lame's first parameter (Pa), UFL (reduced in plane stress)."""
         E, nu = constant(self, "E"), constant(self, "nu")
         if self.plane == "stress":
             return E * nu / (1.0 - nu**2)

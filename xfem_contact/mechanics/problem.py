@@ -293,7 +293,8 @@ class Problem:
         """``(lambda_n, lambda_t or None)`` (UFL) of a split mixed function, for a
         contact law (the Cartesian multiplier vector for ``bonded``)."""
         name = self._name(name)
-        return self.laws[name].multipliers(self.contexts[name].fields(fields))
+        ctx = self.contexts[name]
+        return self.laws[name].multipliers(ctx, ctx.fields(fields))
 
     # -- solve -----------------------------------------------------------------------
     def prolongation(self):

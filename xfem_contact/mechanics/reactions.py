@@ -9,7 +9,7 @@ zero elsewhere). The resultant of an interface is the force its traction exerts 
 -1, ``-F_law(w; (e_c, 0))`` (the multiplier is the traction ``sigma n`` on side -1). The
 applied loads are ``L(e_c)`` (tractions, pressures, body forces). A tangential spring
 acts as a reaction too: ``-F_spring(w; e_c)``. SI units: forces per unit
-thickness (N/m), 2-vectors.
+thickness (N/m) in 2D, forces (N) in 3D; vectors of ``gdim`` components.
 
 Reactions are grouped by the load that prescribes the displacement (by its part's name,
 or its kind, e.g. ``point displacement``); a dof two loads hold (a corner held by two
@@ -88,15 +88,16 @@ def residual_vector(problem, w: dolfinx.fem.Function) -> PETSc.Vec:
 
 
 def unit_vectors(problem) -> list[np.ndarray]:
-    """``e_x``, ``e_y`` as local arrays of ``W`` (1 on the component of both sides'
-    displacement fields, 0 elsewhere; owned and ghost dofs)."""
+    """``e_x``, ``e_y`` (and ``e_z`` in 3D) as local arrays of ``W`` (1 on the component
+    of both sides' displacement fields, 0 elsewhere; owned and ghost dofs)."""
     W = problem.space.W
+    gdim = problem.mesh.geometry.dim
     size = W.dofmap.index_map.size_local + W.dofmap.index_map.num_ghosts
-    units = [np.zeros(size * W.dofmap.index_map_bs) for _ in range(2)]
+    units = [np.zeros(size * W.dofmap.index_map_bs) for _ in range(gdim)]
     for field in getattr(problem.space, "fields", (0, 1)):
         _, parent = problem.space.field_space(field)
         for c, e in enumerate(units):
-            e[parent[c::2]] = 1.0
+            e[parent[c::gdim]] = 1.0
     return units
 
 
@@ -106,7 +107,8 @@ def _owned(problem) -> int:
 
 
 def _force(problem, b: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray:
-    """``(sum_i b_i e_x(i), sum_i b_i e_y(i))`` over the owned dofs in ``mask``. Collective."""
+    """``(sum_i b_i e_x(i), sum_i b_i e_y(i)[, ...z])`` over the owned dofs in ``mask``.
+    Collective."""
     n = _owned(problem)
     keep = slice(None) if mask is None else mask[:n]
     local = np.array([np.sum((b[:n] * e[:n])[keep]) for e in unit_vectors(problem)])
@@ -117,7 +119,7 @@ def _force(problem, b: np.ndarray, mask: np.ndarray | None = None) -> np.ndarray
 def reactions(
     problem, w: dolfinx.fem.Function, b: np.ndarray | None = None
 ) -> dict[str, np.ndarray]:
-    """Force (N/m, ``(2,)``) of each support (:func:`supports`) on the body at a state.
+    """Force (``(gdim,)``, N/m; N in 3D) of each support (:func:`supports`) on the body at a state.
 
     Args:
         problem: A problem (its loads at their current time).
@@ -126,7 +128,7 @@ def reactions(
             at hand.
 
     Returns:
-        ``{name: array([R_x, R_y])}``. Collective.
+        ``{name: array([R_x, R_y(, R_z)])}``. Collective.
     """
     if b is None:
         vec = residual_vector(problem, w)
@@ -147,7 +149,7 @@ def reactions(
 
 
 def applied_loads(problem) -> tuple[np.ndarray, float]:
-    """The resultant (N/m, ``(2,)``) of the tractions, pressures and body forces at the
+    """The resultant (``(gdim,)``, N/m; N in 3D) of the tractions, pressures and body forces at the
     current time, ``L(e_c)``, and their total size ``max_c sum_i |L_i e_c(i)|`` (N/m: the
     scale of a balance of self-equilibrated loads); they do not depend on the state.
     Collective."""
@@ -158,7 +160,7 @@ def applied_loads(problem) -> tuple[np.ndarray, float]:
 
 
 def interface_resultants(problem, w: dolfinx.fem.Function) -> dict[str, np.ndarray]:
-    """Per interface, the resultant (N/m, ``(2,)``) of its traction on side -1 at the
+    """Per interface, the resultant (``(gdim,)``, N/m; N in 3D) of its traction on side -1 at the
     state ``w`` (the force side +1 exerts on side -1 across it; zero for a free
     interface). Collective."""
     out = {}
@@ -174,7 +176,7 @@ def interface_resultants(problem, w: dolfinx.fem.Function) -> dict[str, np.ndarr
                 b.zeroEntries()
             coupling.add_residual(w, b)
         if b is None:
-            out[name] = np.zeros(2)
+            out[name] = np.zeros(problem.mesh.geometry.dim)
             continue
         minus = np.zeros(unit_vectors(problem)[0].size, dtype=bool)
         minus[problem.space.field_space(0)[1]] = True
@@ -184,7 +186,7 @@ def interface_resultants(problem, w: dolfinx.fem.Function) -> dict[str, np.ndarr
 
 
 def spring_reactions(problem, w: dolfinx.fem.Function) -> np.ndarray | None:
-    """The force (N/m, ``(2,)``) of the tangential springs on the body at the
+    """The force (``(gdim,)``, N/m; N in 3D) of the tangential springs on the body at the
     state ``w``, or None without springs. Collective."""
     terms = _springs(problem, w)
     if terms is None:
@@ -207,7 +209,7 @@ def balance(problem, w: dolfinx.fem.Function) -> dict:
     if springs is not None:
         held["tangential_springs"] = springs
     loads, size = applied_loads(problem)
-    total = sum(held.values(), np.zeros(2)) + loads
+    total = sum(held.values(), np.zeros(problem.mesh.geometry.dim)) + loads
     scale = max([size, *(np.abs(r).max() for r in held.values()), 0.0])
     return {
         "reactions": {k: r.tolist() for k, r in held.items()},

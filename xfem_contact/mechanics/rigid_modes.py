@@ -9,8 +9,9 @@ without assembling anything:
 - the *bodies*: the connected parts of the sides' fields (field 1 on side +1, field 0
   on side -1, joined through the dofs their cells share and, beside a crack, through
   the ties of the two sides' dofs where the crack does not cut the body: around its
-  tips and along its extension), each with its rigid modes (translations x, y and the
-  rotation about its centroid). The two sides of a crack ending inside the body are
+  tips and along its extension), each with its rigid modes (:func:`rigid_motions` about
+  its centroid: translations x, y and the rotation in 2D; translations x, y, z and the
+  rotations about the three axes in 3D). The two sides of a crack ending inside the body are
   thus one body; a line that cuts the body in two leaves two;
 - the *Dirichlet conditions* (``problem.loads.bcs``): the values of each mode at the
   prescribed active dofs of its body;
@@ -36,7 +37,6 @@ leave a body free, which only the solve can tell.
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import warnings
 
@@ -46,6 +46,14 @@ import numpy as np
 from mpi4py import MPI
 
 from xfem_contact.fem.evaluation import interface_points
+from xfem_contact.mechanics.rigid_mode_names import (
+    FreeBody,
+    describe,
+    describe_3d,
+    null_space,
+    short_number,
+)
+from xfem_contact.mechanics.rigid_motions import Body, modes_per_body
 
 logger = logging.getLogger(__name__)
 
@@ -55,63 +63,6 @@ _KIND_TEXT = {
     "normal": "transmits no tangential traction",
     "full": "ties the two sides",
 }
-
-
-@dataclasses.dataclass
-class _Body:
-    """A connected part of the sides' fields: its owned active dofs per component."""
-
-    name: str
-    dofs: list[np.ndarray]  # per component: owned local dofs of W
-    coords: list[np.ndarray]  # their coordinates, (n, 2)
-    alone: list[np.ndarray]  # per component: whether no other side's field is active there
-    centre: np.ndarray
-    radius: float  # radius of gyration of its area (m)
-
-    def modes(self, x: np.ndarray, component: int) -> np.ndarray:
-        """Component ``component`` of the 3 scaled modes at points ``x``, shape (n, 3)."""
-        d = (x - self.centre) / self.radius
-        z = np.zeros((x.shape[0], 3))
-        z[:, component] = 1.0
-        z[:, 2] = -d[:, 1] if component == 0 else d[:, 0]
-        return z
-
-
-@dataclasses.dataclass
-class FreeBody:
-    """A body with rigid modes nothing constrains.
-
-    Attributes:
-        body: e.g. ``"side -1 (inside interface 'inclusion')"``.
-        modes: e.g. ``["translation x", "rotation about (0.5, 0.5)"]``.
-        reasons: Why nothing holds them (Dirichlet data, interface laws).
-        remedies: ``(point, component)`` of point constraints that remove them
-            (``problem.loads.add_point_displacement(point, 0.0, component)``).
-        spin_only: The only free mode is a rotation that a frictionless interface of
-            the body leaves (a spin its geometry does not lock), not a missing support.
-    """
-
-    body: str
-    modes: list[str]
-    reasons: list[str]
-    remedies: list[tuple[list[float], int]]
-    spin_only: bool = False
-
-    def message(self) -> str:
-        one = len(self.modes) == 1
-        fixes = ", ".join(
-            f"loads.add_point_displacement([{_num(p[0], 6)}, {_num(p[1], 6)}], 0.0, {c})"
-            for p, c in self.remedies
-        )
-        return (
-            f"{self.body}: {' and '.join(self.modes)} {'is' if one else 'are'} not constrained "
-            f"({'; '.join(self.reasons)}); fix {'it' if one else 'them'} with {fixes}"
-        )
-
-
-def _num(value: float, digits: int) -> str:
-    """``value`` to ``digits`` significant digits, round-off (below 1e-9) shown as 0."""
-    return f"{(0.0 if abs(value) < 1e-9 else float(value)):.{digits}g}"
 
 
 class RigidModeWarning(UserWarning):
@@ -149,12 +100,13 @@ def free_bodies(problem, tol: float = 1e-3) -> list[FreeBody]:
     """The bodies with free rigid modes (:class:`FreeBody`), collective."""
     bodies, pieces = _bodies(problem)
     nb = len(bodies)
+    m = modes_per_body(problem.mesh.geometry.dim)
     Q = _dirichlet_gram(problem, bodies)
-    held = [np.trace(Q[3 * b : 3 * b + 3, 3 * b : 3 * b + 3]) >= tol for b in range(nb)]
+    held = [np.trace(Q[m * b : m * b + m, m * b : m * b + m]) >= tol for b in range(nb)]
     kinds = {name: law.transmits for name, law in problem.laws.items()}
     bounding: list[set[str]] = [set() for _ in bodies]  # the interfaces along each body
     for name, kind in kinds.items():
-        gram, touched = _interface_gram(problem, bodies, pieces, name, kind)
+        gram, touched = _interface_gram(problem, bodies, pieces, name, kind, m)
         Q += gram
         for b in touched:
             bounding[b].add(name)
@@ -162,9 +114,9 @@ def free_bodies(problem, tol: float = 1e-3) -> list[FreeBody]:
     null = vectors[:, values < tol]  # the free combinations, orthonormal columns
     found = []
     for b, body in enumerate(bodies):
-        motion = null[3 * b : 3 * b + 3]
+        motion = null[m * b : m * b + m]
         U, s, _ = np.linalg.svd(motion, full_matrices=False)
-        S = U[:, s > 0.1]  # the body's motions in free modes, (3, r) in (ax, ay, theta)
+        S = U[:, s > 0.1]  # the body's motions in free modes, (m, r) in (a, theta)
         if S.shape[1] == 0:
             continue
         names = [name for name in kinds if name in bounding[b]]
@@ -175,82 +127,20 @@ def free_bodies(problem, tol: float = 1e-3) -> list[FreeBody]:
         others = [
             bodies[o].name
             for o in range(b + 1, nb)
-            if np.linalg.norm(null[3 * o : 3 * o + 3] @ (motion.T @ S)) > 0.1
+            if np.linalg.norm(null[m * o : m * o + m] @ (motion.T @ S)) > 0.1
         ]
         if others:
             reasons.append("it moves together with " + ", ".join(others))
-        free = _describe(problem, body, S, reasons)
-        free.spin_only = (
-            len(free.modes) == 1
-            and free.modes[0].startswith("rotation")
-            and any(kinds[n] == "normal" for n in names)
+        name_motions = describe if problem.mesh.geometry.dim == 2 else describe_3d
+        free = name_motions(problem, body, S, reasons)
+        free.spin_only = all(mode.startswith("rotation") for mode in free.modes) and any(
+            kinds[n] == "normal" for n in names
         )
         found.append(free)
         # the remedies fix every free mode that moves this body: the later bodies are
         # left with the modes that do not
-        null = null @ _null_space(motion)
+        null = null @ null_space(motion)
     return found
-
-
-def _describe(problem, body: _Body, S: np.ndarray, reasons: list[str]) -> FreeBody:
-    """Names of the free motions ``S`` of ``body`` and point constraints removing them."""
-    theta = S[2]
-    turns = np.linalg.norm(theta) > 0.1
-    # translations: the motions without rotation
-    T = S @ _null_space(theta[None, :]) if turns else S
-    modes, remedies = [], []
-    pivot = body.centre
-    if T.shape[1] == 2:
-        modes.append("translations x, y")
-        q = _node(problem, body, 0, body.centre, farthest=False)
-        remedies += [(q, 0), (q, 1)]
-        pivot = np.asarray(q)
-    elif T.shape[1] == 1:
-        d = T[:2, 0] / np.linalg.norm(T[:2, 0])
-        c = int(np.argmax(np.abs(d)))
-        modes.append(
-            ("translation x", "translation y")[c]
-            if abs(d[c]) > 0.999
-            else f"translation along ({_num(d[0], 3)}, {_num(d[1], 3)})"
-        )
-        remedies.append((_node(problem, body, c, body.centre, farthest=False), c))
-    if turns:
-        v = S @ theta / np.linalg.norm(theta)  # the free motion turning most
-        a, th = v[:2], v[2]
-        centre = body.centre
-        if T.shape[1] < 2:
-            centre = body.centre + body.radius / th * np.array([-a[1], a[0]])
-        modes.append(f"rotation about ({_num(centre[0], 3)}, {_num(centre[1], 3)})")
-        if T.shape[1] < 2:
-            pivot = centre
-        q = _node(problem, body, None, pivot, farthest=True)
-        arm = np.asarray(q) - pivot
-        remedies.append((q, int(np.argmax(np.abs([arm[1], arm[0]])))))
-    return FreeBody(body.name, modes, reasons, remedies)
-
-
-def _null_space(A: np.ndarray) -> np.ndarray:
-    _, s, Vt = np.linalg.svd(A)
-    rank = int(np.sum(s > 0.1))
-    return Vt[rank:].T
-
-
-def _node(problem, body: _Body, component, point, farthest: bool) -> list[float]:
-    """The node of ``body`` farthest from (or nearest to) ``point``, preferring nodes no
-    other side's field uses (a point constraint fixes both sides' fields). Collective."""
-    c = 0 if component is None else component
-    x = body.coords[c]
-    comm = problem.mesh.comm
-    prefer = comm.allreduce(int(body.alone[c].sum()), op=MPI.SUM) > 0
-    if prefer:
-        x = x[body.alone[c]]
-    best = None
-    if x.shape[0]:
-        dist = np.linalg.norm(x - point, axis=1)
-        i = int(np.argmax(dist) if farthest else np.argmin(dist))
-        best = (float(dist[i]) if farthest else -float(dist[i]), *x[i].tolist())
-    candidates = [b for b in comm.allgather(best) if b is not None]
-    return list(max(candidates)[1:])
 
 
 def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -326,7 +216,7 @@ def _pieces(problem) -> tuple[dict[int, np.ndarray], np.ndarray]:
     return pieces, part
 
 
-def _bodies(problem) -> tuple[list[_Body], dict[int, np.ndarray]]:
+def _bodies(problem) -> tuple[list[Body], dict[int, np.ndarray]]:
     """The bodies (the connected parts with active dofs, see :func:`_pieces`), side +1's
     first, and per field the body of each owned cell (-1: none). Collective."""
     cut, space = problem.cut, problem.space
@@ -349,19 +239,21 @@ def _bodies(problem) -> tuple[list[_Body], dict[int, np.ndarray]]:
     partner = np.full(space.active.size, -1, dtype=np.int64)
     for f in (0, 1):
         partner[W.sub(f).dofmap.list.ravel()] = W.sub(1 - f).dofmap.list.ravel()
+    gdim = problem.mesh.geometry.dim
     nodes = {}  # field -> (parent dof of each component of each node, node coordinates)
     for field in (0, 1):
         V, parent = space.field_space(field)
-        nodes[field] = ([parent[c :: V.dofmap.bs] for c in range(2)], V.tabulate_dof_coordinates())
+        parents = [parent[c :: V.dofmap.bs] for c in range(gdim)]
+        nodes[field] = (parents, V.tabulate_dof_coordinates())
     where = "interface " + repr(names[0]) if len(names) == 1 else "the interfaces"
     found = []
     for p in range(nparts):
         dofs, coords, alone = [], [], []
-        for c in (0, 1):  # components x, y
+        for c in range(gdim):  # components x, y(, z)
             parents = [nodes[f][0][c] for f in (0, 1)]
             keep = [(parent < nowned) & (part[parent] == p) for parent in parents]
             dofs.append(np.concatenate([parents[f][keep[f]] for f in (0, 1)]))
-            coords.append(np.concatenate([nodes[f][1][keep[f], :2] for f in (0, 1)]))
+            coords.append(np.concatenate([nodes[f][1][keep[f], :gdim] for f in (0, 1)]))
             alone.append(~space.active[partner[dofs[-1]]])
         if comm.allreduce(coords[0].shape[0], op=MPI.SUM) == 0:
             continue
@@ -374,14 +266,14 @@ def _bodies(problem) -> tuple[list[_Body], dict[int, np.ndarray]]:
             label = f"side -1 (inside interface {around[0]!r})"
         centre, radius = _centroid(cut, {f: owned[pieces[f] == p] for f in (0, 1)})
         first = int(np.argmax(holds[p, 2:])) if holds[p, 2:].any() else -1
-        body = _Body(label, dofs, coords, alone, centre, radius)
+        body = Body(label, dofs, coords, alone, centre, radius)
         found.append(((not holds[p, 1], first, p), body))
     found.sort(key=lambda item: item[0])  # side +1's first, then by interface
     bodies = [body for _, body in found]
     for label in {body.name for body in bodies}:
         twins = [body for body in bodies if body.name == label]
         for body in twins if len(twins) > 1 else []:
-            body.name += f", the part about ({_num(body.centre[0], 3)}, {_num(body.centre[1], 3)})"
+            body.name += f", the part about ({', '.join(short_number(v, 3) for v in body.centre)})"
     of_part = np.full(nparts + 1, -1)  # the body of each part, -1 (index -1 too): none
     of_part[[key[2] for key, _ in found]] = np.arange(len(found))
     return bodies, {f: of_part[pieces[f]] for f in (0, 1)}
@@ -401,20 +293,21 @@ def _centroid(cut, cells: dict[int, np.ndarray]) -> tuple[np.ndarray, float]:
     the side's rules. Collective."""
     maps, comm = cut.maps, cut.mesh.comm
     X, W = basix.make_quadrature(cut.mesh.basix_cell(), 2)
-    xs, ws = [np.zeros((0, 2))], [np.zeros(0)]
+    gdim = cut.mesh.geometry.dim
+    xs, ws = [np.zeros((0, gdim))], [np.zeros(0)]
     for field, where in cells.items():
         side = 2 * field - 1
         whole = where[cut.cell_sides[where] == side]
         if whole.size:  # one rule in every uncut cell: the cell maps tabulated once
             J = maps.jacobian_lattice(whole, X)
             ws.append(np.tile(W, whole.size) * _volume_ratio(J))
-            xs.append(maps.push_forward_lattice(whole, X)[:, :2])
+            xs.append(maps.push_forward_lattice(whole, X)[:, :gdim])
         rules = cut.side_rules(side)
         mine = np.isin(cut.cut_cells[rules.point_rows], where)
         rows, points = cut.cut_cells[rules.point_rows[mine]].astype(np.int32), rules.points[mine]
         if rows.size:
             ws.append(rules.weights[mine] * _volume_ratio(maps.jacobian(rows, points)))
-            xs.append(maps.push_forward(rows, points)[:, :2])
+            xs.append(maps.push_forward(rows, points)[:, :gdim])
     x, weights = np.concatenate(xs), np.concatenate(ws)
     area = comm.allreduce(float(weights.sum()), op=MPI.SUM)
     centre = comm.allreduce(weights @ x, op=MPI.SUM) / area
@@ -422,27 +315,29 @@ def _centroid(cut, cells: dict[int, np.ndarray]) -> tuple[np.ndarray, float]:
     return centre, float(np.sqrt(inertia / area))
 
 
-def _dirichlet_gram(problem, bodies: list[_Body]) -> np.ndarray:
+def _dirichlet_gram(problem, bodies: list[Body]) -> np.ndarray:
     """Block-diagonal Gram of each body's modes at its prescribed dofs (global)."""
     W = problem.space.W
     imap = W.dofmap.index_map
     prescribed = np.zeros((imap.size_local + imap.num_ghosts) * W.dofmap.index_map_bs, bool)
     for bc in problem.loads.bcs:
         prescribed[bc.dof_indices()[0]] = True
-    G = np.zeros((3 * len(bodies), 3 * len(bodies)))
+    m = modes_per_body(problem.mesh.geometry.dim)
+    G = np.zeros((m * len(bodies), m * len(bodies)))
     for b, body in enumerate(bodies):
-        for c in (0, 1):
+        for c in range(problem.mesh.geometry.dim):
             z = body.modes(body.coords[c][prescribed[body.dofs[c]]], c)
-            G[3 * b : 3 * b + 3, 3 * b : 3 * b + 3] += z.T @ z
+            G[m * b : m * b + m, m * b : m * b + m] += z.T @ z
     return problem.mesh.comm.allreduce(G, op=MPI.SUM)
 
 
 def _interface_gram(
-    problem, bodies: list[_Body], pieces: dict[int, np.ndarray], name: str, kind: str
+    problem, bodies: list[Body], pieces: dict[int, np.ndarray], name: str, kind: str, m: int
 ) -> tuple[np.ndarray, set[int]]:
-    """Gram (global, per unit length) of the jump of the bodies' modes across interface
-    ``name`` (at each rule point, from the body of field 0 of its cell to that of field
-    1): the whole jump, its normal part or nothing (``kind``); and the bodies along it."""
+    """Gram (global, per unit length or area) of the jump of the bodies' ``m`` modes
+    across interface ``name`` (at each rule point, from the body of field 0 of its cell
+    to that of field 1): the whole jump, its normal part or nothing (``kind``); and the
+    bodies along it."""
     cut, comm = problem.cut, problem.mesh.comm
     rules = cut.interface_rules_of(name)
     cells = cut.cut_cells[rules.point_rows]
@@ -451,17 +346,18 @@ def _interface_gram(
     touched.discard(-1)
     nb = len(bodies)
     if kind == "none":
-        return np.zeros((3 * nb, 3 * nb)), touched
-    x = interface_points(cut, rules)[:, :2]
-    n = cut.normal_at(rules)[:, :2]
+        return np.zeros((m * nb, m * nb)), touched
+    gdim = cut.mesh.geometry.dim
+    x = interface_points(cut, rules)[:, :gdim]
+    n = cut.normal_at(rules)[:, :gdim]
     J = cut.maps.jacobian(cells, rules.points)
     w = rules.weights * np.abs(np.linalg.det(J))
-    jump = np.zeros((x.shape[0], 2, 3 * nb))  # per point, component, coefficient
+    jump = np.zeros((x.shape[0], gdim, m * nb))  # per point, component, coefficient
     for bs, sign in ((minus, -1.0), (plus, 1.0)):
         for b in np.unique(bs[bs >= 0]):
             at = bs == b
-            for c in (0, 1):
-                jump[at, c, 3 * b : 3 * b + 3] += sign * bodies[b].modes(x[at], c)
+            for c in range(gdim):
+                jump[at, c, m * b : m * b + m] += sign * bodies[b].modes(x[at], c)
     jump[(minus == plus) | (minus < 0) | (plus < 0)] = 0.0  # one body, or a side without
     if kind == "normal":
         jump = np.einsum("pc,pcm->pm", n, jump)[:, None, :]

@@ -2,11 +2,11 @@
 
 The stress of a side is evaluated from its material's own UFL law (``material.stress(u)``,
 or ``material.piola(u)`` in large kinematics), so moduli held as Constants or DG0
-Functions are read at evaluation time and new values compile nothing. In 2D the
-out-of-plane stress enters the 3 x 3 tensor: ``sigma_zz = nu (sigma_xx + sigma_yy)`` in
-plane strain (``lambda tr(E) / J`` with the Green-Lagrange ``E`` in large kinematics),
-0 in plane stress. ``nu`` is read from the law itself (its response to a uniaxial strain),
-not from a number.
+Functions are read at evaluation time and new values compile nothing. In 3D the stress
+is the law's own 3 x 3 tensor. In 2D the out-of-plane stress enters the 3 x 3 tensor:
+``sigma_zz = nu (sigma_xx + sigma_yy)`` in plane strain (``lambda tr(E) / J`` with the
+Green-Lagrange ``E`` in large kinematics), 0 in plane stress. ``nu`` is read from the law
+itself (its response to a uniaxial strain), not from a number.
 
 :class:`StressFields` interpolates both into discontinuous Lagrange spaces of degree
 ``k - 1`` (``k`` the displacement degree; DG0 for P1): for affine simplices the
@@ -41,15 +41,22 @@ def _lame(material, mesh) -> tuple:
 
 
 def cauchy_stress(material, u, kinematics: str = "small") -> ufl.core.expr.Expr:
-    """The 3 x 3 Cauchy stress (Pa, UFL) of a 2D displacement ``u`` (m).
+    """The 3 x 3 Cauchy stress (Pa, UFL) of a displacement ``u`` (m), 2D or 3D.
 
     Args:
         material: Anything with ``stress(u)`` (and ``piola(u)`` for large kinematics)
             returning UFL (Pa): a material, its moduli on a mesh, a material field.
-        u: Displacement (UFL vector, 2 components).
+        u: Displacement (UFL vector, 2 or 3 components).
         kinematics: ``"small"`` (Hooke's law) or ``"large"`` (``P F^T / det F`` of
             the first Piola-Kirchhoff stress ``P``).
     """
+    if kinematics not in ("small", "large"):
+        raise ValueError(f"kinematics must be 'small' or 'large', got {kinematics!r}")
+    if len(u) == 3:
+        if kinematics == "small":
+            return material.stress(u)
+        F = ufl.Identity(3) + ufl.grad(u)
+        return material.piola(u) * F.T / ufl.det(F)
     mesh = ufl.domain.extract_unique_domain(u)
     lmbda, two_mu_lmbda = _lame(material, mesh)
     if kinematics == "large":
@@ -60,8 +67,6 @@ def cauchy_stress(material, u, kinematics: str = "small") -> ufl.core.expr.Expr:
     elif kinematics == "small":
         s = material.stress(u)
         zz = lmbda / (lmbda + two_mu_lmbda) * (s[0, 0] + s[1, 1])  # nu (s_xx + s_yy)
-    else:
-        raise ValueError(f"kinematics must be 'small' or 'large', got {kinematics!r}")
     if _plane(material) == "stress":
         zz = 0.0 * s[0, 0]
     return ufl.as_matrix([[s[0, 0], s[0, 1], 0.0], [s[1, 0], s[1, 1], 0.0], [0.0, 0.0, zz]])

@@ -16,9 +16,12 @@ interface. A law
   :meth:`~InterfaceLaw.point_status`, :meth:`~InterfaceLaw.options`. Callers never
   test a law's type or name.
 
-Conventions: the normal ``n`` points from side -1 to side +1, ``t`` is ``n``
-turned by +90 degrees, the jump is ``[u] = u_+ - u_-`` and the multiplier is the
-traction ``sigma n`` on side -1 (Pa, compression negative). SI units.
+Conventions: the normal ``n`` points from side -1 to side +1, the jump is
+``[u] = u_+ - u_-`` and the multiplier is the traction ``sigma n`` on side -1 (Pa,
+compression negative). The tangential part of a vector ``v``
+(:meth:`InterfaceContext.tangential`) is, in 2D, the scalar ``v.t`` along ``t``, ``n``
+turned by +90 degrees, and in 3D the vector ``(I - n n) v``: the laws are written once
+on these parts, for any ``gdim``. SI units.
 """
 
 from __future__ import annotations
@@ -102,27 +105,81 @@ class InterfaceContext:
         return self._cache[key]
 
     @property
+    def gdim(self) -> int:
+        """The mesh's geometric dimension (2 or 3)."""
+        return self.cut.mesh.geometry.dim
+
+    @property
     def normal(self) -> ufl.core.expr.Expr:
         """Unit normal ``grad phi_h / |grad phi_h|`` (UFL)."""
         return self.cut.normal
 
     def frame(self) -> tuple:
-        """Unit normal ``n`` and tangent ``t`` (UFL)."""
+        """Unit normal ``n`` and tangent ``t`` (``n`` turned by +90 degrees), UFL; 2D only
+        (a law uses :meth:`tangential`)."""
+        if self.gdim != 2:
+            raise ValueError(f"frame: the tangent t is a 2D notion (gdim={self.gdim})")
         n = self.normal
-        return n, ufl.as_vector([-n[1], n[0]])
+        return n, self.once("tangent", lambda: ufl.as_vector([-n[1], n[0]]))
+
+    def tangential(self, v) -> ufl.core.expr.Expr:
+        """The tangential part of the vector ``v`` (UFL): ``v.t`` in 2D (a scalar, see
+        :meth:`frame`), ``(I - n n) v`` in 3D (a vector)."""
+        if self.gdim == 2:
+            return ufl.dot(v, self.frame()[1])
+        n = self.normal
+        return v - ufl.dot(v, n) * n
+
+    def multiplier_parts(self, lam) -> tuple:
+        """``(lambda_n, lambda_t)`` of a multiplier with normal and tangential parts (UFL,
+        ``gdim`` components): in 2D its components in the frame ``(n, t)``; in 3D a
+        Cartesian traction, split as ``lambda.n`` and ``(I - n n) lambda`` (no tangent
+        frame is smooth on a closed surface)."""
+        if self.gdim == 2:
+            return lam[0], lam[1]
+        return ufl.dot(lam, self.normal), self.tangential(lam)
+
+    def tangent_vector(self, a) -> ufl.core.expr.Expr:
+        """The Cartesian vector of a tangential part ``a`` (:meth:`tangential`): ``a t``
+        in 2D, ``a`` itself in 3D (UFL)."""
+        return a * self.frame()[1] if self.gdim == 2 else a
 
     def fields(self, parts) -> Fields:
         """The law's :class:`Fields` of a split mixed function or argument."""
         return Fields(parts[0], parts[1], None if self.field is None else parts[self.field])
 
     # -- the same quantities at the rule points (numpy, local) -----------------------
+    def normal_at(self) -> npt.NDArray[np.float64]:
+        """``n`` at the rule points, ``(npoints, gdim)``: the UFL normal evaluated there
+        (not the interface's own normal)."""
+        if "normal" not in self._cache:
+            self._cache["normal"] = self.cut.normal_at(self.rules)
+        return self._cache["normal"]
+
     def frame_at(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-        """``n`` and ``t`` at the rule points, each ``(npoints, gdim)``: the UFL normal
-        evaluated there (not the curve's own normal)."""
+        """``n`` and ``t`` at the rule points, each ``(npoints, 2)`` (2D only, as
+        :meth:`frame`)."""
+        if self.gdim != 2:
+            raise ValueError(f"frame_at: the tangent t is a 2D notion (gdim={self.gdim})")
         if "frame" not in self._cache:
-            n = self.cut.normal_at(self.rules)
+            n = self.normal_at()
             self._cache["frame"] = (n, np.c_[-n[:, 1], n[:, 0]])
         return self._cache["frame"]
+
+    def multiplier_parts_at(self, lam: npt.NDArray[np.float64]) -> tuple:
+        """:meth:`multiplier_parts` of multiplier values at the rule points, ``(npoints,
+        gdim)``: ``lambda_n`` ``(npoints,)`` and ``lambda_t`` as :meth:`tangential_at`."""
+        if self.gdim == 2:
+            return lam[:, 0], lam[:, 1]
+        return np.sum(lam * self.normal_at(), axis=1), self.tangential_at(lam)
+
+    def tangential_at(self, v: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """:meth:`tangential` of vectors ``v`` given at the rule points, ``(npoints,
+        gdim)``: ``(npoints,)`` in 2D, ``(npoints, 3)`` in 3D."""
+        if self.gdim == 2:
+            return np.sum(v * self.frame_at()[1], axis=1)
+        n = self.normal_at()
+        return v - np.sum(v * n, axis=1)[:, None] * n
 
     def values_at(self, w: dolfinx.fem.Function, field: int) -> npt.NDArray[np.float64]:
         """Values of field ``field`` of ``w`` (a Function on the problem's mixed space)
@@ -167,14 +224,59 @@ class InterfaceContext:
 
 
 class Ops(typing.NamedTuple):
-    """Pointwise min/max, so that one definition of a law serves UFL and numpy."""
+    """Pointwise operations, so that one definition of a law serves UFL and numpy:
+    ``minimum``, ``maximum``; ``norm(a)`` of a tangential part (a vector: UFL one, or
+    numpy ``(npoints, gdim)`` rows), ``scale(s, a)`` and ``divide(a, s)``, ``s a`` and
+    ``a / s`` for a scalar ``s``; ``below(a, b, x, y)``: ``x`` where ``a <= b``, else
+    ``y``."""
 
     minimum: typing.Callable
     maximum: typing.Callable
+    norm: typing.Callable
+    scale: typing.Callable
+    divide: typing.Callable
+    below: typing.Callable
 
 
-UFL_OPS = Ops(ufl.min_value, ufl.max_value)
-NUMPY_OPS = Ops(np.minimum, np.maximum)
+def _rows(s, a):
+    """``s`` broadcast over the rows of ``a`` (numpy)."""
+    return s[..., None] if np.ndim(a) > np.ndim(s) else s
+
+
+UFL_OPS = Ops(
+    ufl.min_value,
+    ufl.max_value,
+    lambda a: ufl.sqrt(ufl.dot(a, a)),
+    lambda s, a: s * a,
+    lambda a, s: a / s,
+    lambda a, b, x, y: ufl.conditional(ufl.le(a, b), x, y),
+)
+NUMPY_OPS = Ops(
+    np.minimum,
+    np.maximum,
+    lambda a: np.linalg.norm(a, axis=-1),
+    lambda s, a: _rows(s, a) * a,
+    lambda a, s: a / _rows(s, a),
+    lambda a, b, x, y: np.where(_rows(a <= b, x), x, y),
+)
+
+
+def project_on_disc(trial, bound, ops: Ops):
+    """The projection of a tangential part ``trial`` on the disc ``|P| <= bound``
+    (``bound >= 0``): ``trial`` inside, ``bound (trial / |trial|)`` outside (``trial = 0``
+    with ``bound = 0`` is inside: no division by zero is taken).
+
+    A tangential part is a scalar in 2D (:meth:`InterfaceContext.tangential`): the disc
+    is then the segment ``[-bound, bound]`` and the projection the clamp
+    ``max(-bound, min(bound, trial))``, the same value to the last bit (``trial /
+    |trial|`` is exactly +-1) with a Jacobian free of the round-off of differentiating
+    ``trial / |trial|``.
+    """
+    if len(getattr(trial, "ufl_shape", np.shape(trial)[1:])) == 0:
+        return ops.maximum(-bound, ops.minimum(bound, trial))
+    norm = ops.norm(trial)
+    with np.errstate(divide="ignore", invalid="ignore"):  # trial / 0: only where not taken
+        return ops.below(norm, bound, trial, ops.scale(bound, ops.divide(trial, norm)))
 
 #: What a closed interface transmits (:attr:`InterfaceLaw.transmits`)
 TRANSMITS = ("none", "normal", "full")
@@ -214,8 +316,9 @@ class InterfaceLaw(abc.ABC):
         """Number of components of the law's multiplier field (0: none)."""
         return 0
 
-    def multipliers(self, u: Fields) -> tuple:
-        """``(lambda_n, lambda_t or None)`` of the law's fields (UFL); by default the
+    def multipliers(self, ctx: InterfaceContext, u: Fields) -> tuple:
+        """``(lambda_n, lambda_t or None)`` of the law's fields (UFL; ``lambda_t`` a
+        tangential part, :meth:`InterfaceContext.tangential`); by default the
         multiplier as it is (a Cartesian vector, or None without one)."""
         return u.multiplier, None
 
@@ -255,7 +358,8 @@ class InterfaceLaw(abc.ABC):
         return None
 
     def state(self, ctx: InterfaceContext, w: dolfinx.fem.Function) -> dict[str, np.ndarray]:
-        """The law's state at this process's rule points, each ``(npoints,)``."""
+        """The law's state at this process's rule points, each ``(npoints,)`` (the
+        tangential parts ``(npoints, 3)`` in 3D)."""
         return {}
 
     def status(self, state: dict[str, np.ndarray]) -> dict[str, int]:

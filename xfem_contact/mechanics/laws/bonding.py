@@ -45,12 +45,13 @@ class Bonded(MultiplierLaw):
         return F if lbb is None else F - lbb
 
     def state(self, ctx: InterfaceContext, w: dolfinx.fem.Function) -> dict[str, np.ndarray]:
-        """``gap``, ``slip`` (m), ``lambda_n``, ``lambda_t`` (Pa) at the rule points."""
-        n, t = ctx.frame_at()
+        """``gap``, ``slip`` (m), ``lambda_n``, ``lambda_t`` (Pa) at the rule points
+        (``slip`` and ``lambda_t`` tangential parts: ``(npoints, 3)`` in 3D)."""
+        n = ctx.normal_at()
         jump, lam = ctx.jump_at(w), ctx.values_at(w, ctx.field)
         return {
             "gap": np.sum(jump * n, axis=1),
-            "slip": np.sum(jump * t, axis=1),
+            "slip": ctx.tangential_at(jump),
             "lambda_n": np.sum(lam * n, axis=1),
-            "lambda_t": np.sum(lam * t, axis=1),
+            "lambda_t": ctx.tangential_at(lam),
         }

@@ -2,21 +2,28 @@
 
 Unknowns: the displacement of each side (``u_-``, ``u_+``, m) and the interface
 multipliers (Pa): the normal pressure ``lambda_n`` and, with friction, the
-tangential traction ``lambda_t``; ``lambda = lambda_n n + lambda_t t`` is the
-traction ``sigma n`` on side -1, compression negative. With the jump
-``[u] = u_+ - u_-``, gap ``g_n = [u].n`` and slip ``g_t = [u].t`` (sticking: the
-tangential jump from the reference state) or slip increment ``g_t = [u - u_old].t``
-(Coulomb, path dependent: ``u_old`` the last accepted load step), the
-Alart-Curnier augmented multipliers are (:meth:`ContactLaw.augmented`)
+tangential traction ``lambda_t``; ``lambda = lambda_n n + lambda_t`` is the traction
+``sigma n`` on side -1, compression negative. Tangential quantities are tangential parts
+(:meth:`~xfem_contact.mechanics.laws.base.InterfaceContext.tangential`): scalars along
+``t`` in 2D, where the multiplier field holds ``(lambda_n, lambda_t)``; vectors
+``(I - n n) v`` in 3D, where it holds the Cartesian traction ``lambda`` and
+``lambda_n = lambda.n``, ``lambda_t = (I - n n) lambda`` (no tangent frame is smooth on a
+closed surface; docs' mechanics page). With the jump ``[u] = u_+ - u_-``, gap
+``g_n = [u].n`` and slip ``g_t`` the tangential part of ``[u]`` (sticking: the
+tangential jump from the reference state) or of ``[u - u_old]`` (Coulomb, path
+dependent: ``u_old`` the last accepted load step), the Alart-Curnier augmented
+multipliers are (:meth:`ContactLaw.augmented`)
 
     P_n = min(0, lambda_n + r g_n)
     P_t = lambda_t + r g_t                                 (sticking)
-    P_t = clamp(lambda_t + r g_t, mu P_n, -mu P_n)          (Coulomb)
+    P_t = proj_{|P| <= -mu P_n}(lambda_t + r g_t)         (Coulomb)
 
-and the law's residual terms (Ben Dhia's mixed form; generalized Newton through
-``ufl.derivative``):
+the Coulomb one the projection on the disc of radius ``mu |P_n|``
+(:func:`~xfem_contact.mechanics.laws.base.project_on_disc`; in 2D the clamp on
+``[mu P_n, -mu P_n]``), and the law's residual terms (Ben Dhia's mixed form;
+generalized Newton through ``ufl.derivative``):
 
-    int (P_n [v].n + P_t [v].t) - int (1/r) ((lambda_n - P_n) mu_n + (lambda_t - P_t) mu_t)
+    int (P_n [v].n + P_t.[v]_t) - int (1/r) ((lambda_n - P_n) mu_n + (lambda_t - P_t).mu_t)
 
 minus the LBB terms. ``r = augmentation * E / h`` (Pa/m, ``E`` the harmonic mean of
 the two sides' moduli, ``h`` the cell diameter). The same :meth:`ContactLaw.augmented`
@@ -39,6 +46,7 @@ from xfem_contact.mechanics.laws.base import (
     Fields,
     InterfaceContext,
     Ops,
+    project_on_disc,
 )
 from xfem_contact.mechanics.laws.multiplier import MultiplierLaw
 from xfem_contact.mechanics.parameters import Parameter, constant
@@ -96,43 +104,45 @@ class ContactLaw(MultiplierLaw):
 
     def augmented(self, lam_n, lam_t, gap, slip, r, ops: Ops) -> tuple:
         """Augmented multipliers ``(P_n, P_t)`` (Pa; ``P_t`` None without a tangential
-        multiplier) from the multipliers, gap and slip (increment) and ``r``."""
+        multiplier) from the multipliers, gap and slip (increment; tangential parts) and
+        ``r``."""
         P_n = ops.minimum(0.0, lam_n + r * gap)
         if lam_t is None:
             return P_n, None
-        trial = lam_t + r * slip
+        trial = lam_t + ops.scale(r, slip)
         bound = self.friction_bound(P_n, ops)
         if bound is None:
             return P_n, trial
-        return P_n, ops.maximum(-bound, ops.minimum(bound, trial))
+        return P_n, project_on_disc(trial, bound, ops)
 
-    def multipliers(self, u: Fields) -> tuple:
-        """``(lambda_n, lambda_t or None)`` of the law's fields."""
+    def multipliers(self, ctx: InterfaceContext, u: Fields) -> tuple:
+        """``(lambda_n, lambda_t or None)`` of the law's fields (``lambda_t`` a
+        tangential part: see the module docstring)."""
         if not self.tangential:
             return u.multiplier, None
-        return u.multiplier[0], u.multiplier[1]
+        return ctx.multiplier_parts(u.multiplier)
 
     def traction_vector(self, ctx: InterfaceContext, u: Fields):
-        """Cartesian multiplier vector ``lambda_n n + lambda_t t`` (UFL)."""
-        n, t = ctx.frame()
-        lam_n, lam_t = self.multipliers(u)
-        return lam_n * n if lam_t is None else lam_n * n + lam_t * t
+        """Cartesian multiplier vector ``lambda_n n + lambda_t`` (UFL)."""
+        n = ctx.normal
+        lam_n, lam_t = self.multipliers(ctx, u)
+        return lam_n * n if lam_t is None else lam_n * n + ctx.tangent_vector(lam_t)
 
     # -- the residual ----------------------------------------------------------------
     def residual(self, ctx: InterfaceContext, u: Fields, v: Fields) -> ufl.Form:
-        n, t = ctx.frame()
+        n = ctx.normal
         r = self.augmentation_coefficient(ctx.materials, ctx.cell_size)
-        lam_n, lam_t = self.multipliers(u)
-        mu_n, mu_t = self.multipliers(v)
+        lam_n, lam_t = self.multipliers(ctx, u)
+        mu_n, mu_t = self.multipliers(ctx, v)
         slip_jump = u.jump
         if self.incremental:
             slip_jump = slip_jump - ctx.fields(ctx.split(ctx.w_old)).jump
         P_n, P_t = self.augmented(
-            lam_n, lam_t, ufl.dot(u.jump, n), ufl.dot(slip_jump, t), r, UFL_OPS
+            lam_n, lam_t, ufl.dot(u.jump, n), ctx.tangential(slip_jump), r, UFL_OPS
         )
         interface = P_n * ufl.dot(v.jump, n) - (lam_n - P_n) * mu_n / r
         if P_t is not None:
-            interface += P_t * ufl.dot(v.jump, t) - (lam_t - P_t) * mu_t / r
+            interface += ufl.dot(P_t, ctx.tangential(v.jump)) - ufl.dot(lam_t - P_t, mu_t) / r
         F = interface * ctx.measure
         lbb = self.lbb_terms(ctx, self.traction_vector(ctx, u), self.traction_vector(ctx, v), u, v)
         if lbb is not None:
@@ -142,31 +152,31 @@ class ContactLaw(MultiplierLaw):
             # stabilisation is measured from the last accepted step too, so that the
             # steps telescope (sticking in n steps = in one). Jacobian unchanged.
             old = ctx.fields(ctx.split(ctx.w_old))
-            _, old_t = self.multipliers(old)
-            old_residual = old_t - ufl.dot(self.interface_traction(ctx, old), t)
-            F += self.stabilization_scale(ctx) * old_residual * mu_t * ctx.measure
+            _, old_t = self.multipliers(ctx, old)
+            old_residual = old_t - ctx.tangential(self.interface_traction(ctx, old))
+            F += ufl.dot(self.stabilization_scale(ctx) * old_residual, mu_t) * ctx.measure
         return F
 
     # -- the state at the rule points ------------------------------------------------
     def state(self, ctx: InterfaceContext, w: dolfinx.fem.Function) -> dict[str, np.ndarray]:
         """Point values at this process's rule points of the interface, each
-        ``(npoints,)``: ``gap``, ``slip`` and ``slip_increment`` (the slip the
-        tangential law sees: of the load step for Coulomb, else the slip) (m), the
-        multipliers ``lambda_n``, ``lambda_t``, the augmented (applied) tractions
-        ``P_n``, ``P_t`` (Pa; tangential ones zero when frictionless), the trial
-        tangential traction ``trial_t`` (Pa) and ``r`` (Pa/m)."""
-        n, t = ctx.frame_at()
+        ``(npoints,)`` (tangential parts ``(npoints, 3)`` in 3D): ``gap``, ``slip`` and
+        ``slip_increment`` (the slip the tangential law sees: of the load step for
+        Coulomb, else the slip) (m), the multipliers ``lambda_n``, ``lambda_t``, the
+        augmented (applied) tractions ``P_n``, ``P_t`` (Pa; tangential ones zero when
+        frictionless), the trial tangential traction ``trial_t`` (Pa) and ``r``
+        (Pa/m)."""
+        n = ctx.normal_at()
         jump, lam = ctx.jump_at(w), ctx.values_at(w, ctx.field)
         r = self.augmentation_coefficient(ctx.materials, ctx.cell_size_at())
         gap = np.sum(jump * n, axis=1)
-        slip = np.sum(jump * t, axis=1)
+        slip = ctx.tangential_at(jump)
         slip_increment = slip
         if self.incremental:
-            slip_increment = slip - np.sum(ctx.jump_at(ctx.w_old) * t, axis=1)
-        lam_n = lam[:, 0]
-        lam_t = lam[:, 1] if self.tangential else None
+            slip_increment = slip - ctx.tangential_at(ctx.jump_at(ctx.w_old))
+        lam_n, lam_t = ctx.multiplier_parts_at(lam) if self.tangential else (lam[:, 0], None)
         P_n, P_t = self.augmented(lam_n, lam_t, gap, slip_increment, r, NUMPY_OPS)
-        lam_t = np.zeros_like(lam_n) if lam_t is None else lam_t
+        lam_t = np.zeros_like(slip) if lam_t is None else lam_t
         return {
             "gap": gap,
             "slip": slip,
@@ -174,9 +184,9 @@ class ContactLaw(MultiplierLaw):
             "lambda_n": lam_n,
             "lambda_t": lam_t,
             "P_n": P_n,
-            "P_t": np.zeros_like(P_n) if P_t is None else P_t,
+            "P_t": np.zeros_like(slip) if P_t is None else P_t,
             "r": r,
-            "trial_t": lam_t + r * slip_increment,
+            "trial_t": lam_t + NUMPY_OPS.scale(r, slip_increment),
         }
 
     def point_status(self, state: dict[str, np.ndarray], npoints: int) -> np.ndarray:
@@ -188,7 +198,9 @@ class ContactLaw(MultiplierLaw):
             stick = np.zeros_like(contact)
         else:
             bound = self.friction_bound(state["P_n"], NUMPY_OPS)
-            stick = contact if bound is None else contact & (np.abs(state["trial_t"]) <= bound)
+            trial = state["trial_t"]
+            size = np.abs(trial) if trial.ndim == 1 else np.linalg.norm(trial, axis=1)
+            stick = contact if bound is None else contact & (size <= bound)
         return np.where(contact, np.where(stick, STICK, SLIP), OPEN).astype(np.int8)
 
     def status(self, state: dict[str, np.ndarray]) -> dict[str, int]:
@@ -216,8 +228,8 @@ class Sticking(ContactLaw):
 
 
 class CoulombFriction:
-    """Coulomb's bound ``|P_t| <= mu |P_n|`` on the slip of the step, written once for
-    the small- and large-sliding laws (the first base of :class:`Coulomb` and
+    """Coulomb's bound ``|P_t| <= mu |P_n|`` (a disc; a segment in 2D) on the slip of the
+    step, written once for the small- and large-sliding laws (the first base of :class:`Coulomb` and
     :class:`~xfem_contact.mechanics.laws.sliding.SlidingCoulomb`).
 
     Args:

@@ -134,7 +134,7 @@ class SlidingContact(ContactLaw):
             gamma = constant(self, "multiplier_stabilization")
             scale = gamma * ctx.cell_size / (2.0 * ctx.materials[self.slave].ufl_mu)
             T_n, T_t = self.slave_traction(ctx, u)
-            lam_n, lam_t = self.multipliers(u)
+            lam_n, lam_t = self.multipliers(ctx, u)
             misfit = (lam_n - T_n) ** 2
             if lam_t is not None:
                 misfit = misfit + (lam_t - T_t) ** 2

@@ -205,16 +205,20 @@ class Loads:
         self, point, value: float, component: int, *, path: Path = None, history: Path = None
     ) -> DirichletLoad:
         """Prescribe one displacement component (m) at a mesh node (e.g. to remove
-        rigid modes), on every side's field."""
+        rigid modes), on every side's field. ``point``: ``[x, y]`` (or ``[x, y, 0]``) on
+        a 2D mesh, ``[x, y, z]`` on a 3D one."""
+        gdim = self.mesh.geometry.dim
+        shapes = ((2,), (3,)) if gdim == 2 else ((3,),)
         try:
             point = np.asarray(point, dtype=float)
         except (TypeError, ValueError):
             point = np.zeros(0)
-        if point.shape not in ((2,), (3,)) or not np.isfinite(point).all():
-            raise ValueError(f"point must be 2 finite numbers [x, y] (m), got {point!r}")
+        if point.shape not in shapes or not np.isfinite(point).all():
+            names = "[x, y]" if gdim == 2 else "[x, y, z]"
+            raise ValueError(f"point must be {gdim} finite numbers {names} (m), got {point!r}")
 
         def at_point(x):
-            return np.isclose(x[0], point[0]) & np.isclose(x[1], point[1])
+            return np.all([np.isclose(x[k], point[k]) for k in range(gdim)], axis=0)
 
         path = self._load_path(path, history)
         functions, found = [], 0
@@ -241,9 +245,14 @@ class Loads:
         history: Path = None,
     ) -> RotationLoad:
         """Rotate a boundary part rigidly by ``angle`` (rad) or ``angle_deg`` (degrees),
-        counter-clockwise about ``centre`` (m), times the factor ``path(t)``:
+        counter-clockwise about ``centre`` (m), times the factor ``path(t)`` (2D meshes):
         ``u = (Q - I)(X - c)`` on every side's field. Warns for ``angle`` outside
         [-2 pi, 2 pi] (degrees given as radians?)."""
+        if self.mesh.geometry.dim != 2:
+            raise ValueError(
+                "add_rotation turns a part in the plane (2D meshes); on a 3D mesh prescribe "
+                "the rotation's displacement with add_displacement(part, callable)"
+            )
         if (angle is None) == (angle_deg is None):
             raise ValueError("Give the rotation as angle= (rad) or angle_deg= (degrees), once")
         if angle_deg is not None:

@@ -1,0 +1,184 @@
+"""3D validation cases with exact solutions: a unit cube cut by an inclined plane with an
+open interface (the analogue of paper case 1) and a sphere in a unit cube under triaxial
+compression (the analogue of case 2). Shared by the tests and the benchmarks (SI
+units, tension positive)."""
+
+from __future__ import annotations
+
+import dolfinx.mesh
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from xfem_contact.cases.paper import integrate
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.evaluation import interface_points, rule_cells
+from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.presets import ContactProblem, ElasticityProblem
+
+#: The inclined plane ``a.x = d`` (``a`` a unit vector): off every mesh vertex of the
+#: unit cubes ``n = 1 .. 8``
+PLANE_NORMAL = np.array([0.3, 0.5, 0.8]) / np.linalg.norm([0.3, 0.5, 0.8])
+PLANE_OFFSET = float(PLANE_NORMAL @ np.full(3, 0.5)) + 0.013
+#: The uniform stress factors ``S_s`` of ``sigma_s = (a.x - d) S_s`` on each side (Pa/m)
+PLANE_STRESS = {
+    -1: np.array([[2.0, 0.5, -0.3], [0.5, -1.0, 0.2], [-0.3, 0.2, 1.5]]),
+    1: np.array([[-1.0, 0.3, 0.4], [0.3, 2.0, -0.6], [0.4, -0.6, 0.5]]),
+}
+#: The opening of side +1 along ``a`` (m), much larger than the elastic jump
+PLANE_OPENING = 1e-2
+#: The material of the 3D cases
+SOLID = Material(100.0, 0.3)
+
+#: Sphere case: centre (m), radius (m), principal stresses (Pa) along x, y, z
+SPHERE_CENTRE, SPHERE_RADIUS = (0.5, 0.5, 0.5), 0.2
+TRIAXIAL = (-1.0, -2.0, -3.0)
+
+
+def _strain_factor(side: int, material: Material) -> np.ndarray:
+    """``M_s``: the strain ``(a.x - d) M_s`` of the stress ``(a.x - d) S_s`` (1/m)."""
+    S, mu, lmbda = PLANE_STRESS[side], material.mu, material.lmbda
+    return (S - lmbda / (2 * mu + 3 * lmbda) * np.trace(S) * np.eye(3)) / (2 * mu)
+
+
+def plane_exact(side: int, ops=np, material: Material = SOLID):
+    """The exact displacement (m) of ``side`` of the plane case,
+    ``u = (a.x - d) M x - (x.M x) a / 2`` (its strain is ``(a.x - d) M``, its stress
+    ``(a.x - d) S_s``), side +1 moved by ``PLANE_OPENING a``: a callable of points ``x``
+    (numpy ``(3, n)`` giving ``(3, n)``, or with ``ops=ufl`` the spatial coordinate
+    giving a UFL vector)."""
+    M, a, d = _strain_factor(side, material), PLANE_NORMAL, PLANE_OFFSET
+    shift = PLANE_OPENING * a if side == 1 else np.zeros(3)
+
+    def u(x):
+        x = [x[k] for k in range(3)]
+        phi = sum(a[k] * x[k] for k in range(3)) - d
+        Mx = [sum(M[i, k] * x[k] for k in range(3)) for i in range(3)]
+        xMx = sum(x[i] * Mx[i] for i in range(3))
+        values = [phi * Mx[i] - 0.5 * xMx * a[i] + shift[i] for i in range(3)]
+        return ops.as_vector(values) if ops is not np else np.array(values)
+
+    return u
+
+
+def plane_problem(
+    n: int,
+    degree: int,
+    cell: str = "tetrahedron",
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    quadrature_degree: int | None = None,
+) -> ElasticityProblem:
+    """The unit cube (``n`` cells per edge) cut by the plane ``a.x = d``, free (open)
+    interface, each side loaded by the body force ``-div sigma_s = -S_s a`` and held on
+    the whole boundary by its exact displacement (:func:`plane_exact`): the solution is
+    quadratic on each side, the interface traction-free and open (its gap
+    ``PLANE_OPENING`` plus the elastic jump, > 0). ``quadrature_degree``: the cut
+    rules' (:class:`~xfem_contact.fem.cutmesh.CutMesh`'s default when None)."""
+    mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
+    a, d = PLANE_NORMAL, PLANE_OFFSET
+    cut = CutMesh(
+        mesh,
+        lambda x: a[0] * x[0] + a[1] * x[1] + a[2] * x[2] - d,
+        degree=1,
+        quadrature_degree=quadrature_degree,
+    )
+    problem = ElasticityProblem(cut, degree, SOLID, "free")
+    problem.loads.add_displacement("boundary", {s: plane_exact(s) for s in (-1, 1)})
+    for side in (-1, 1):
+        problem.loads.add_body_force(tuple(-PLANE_STRESS[side] @ a), side=side)
+    return problem
+
+
+def plane_errors(problem: ElasticityProblem) -> dict[int, float]:
+    """Relative L2 error of each side's displacement on its own part of the cube, against
+    :func:`plane_exact` (UFL, exact). Collective."""
+    errors = {}
+    fields = problem.space.split(problem.w)
+    x = ufl.SpatialCoordinate(problem.mesh)
+    for side, u_h in ((-1, fields[0]), (1, fields[1])):
+        exact = plane_exact(side, ufl)(x)
+        dx, e = problem.cut.dx(side), u_h - exact
+        ratio = integrate(ufl.dot(e, e) * dx) / integrate(ufl.dot(exact, exact) * dx)
+        errors[side] = float(np.sqrt(ratio))
+    return errors
+
+
+def sphere_problem(
+    n: int,
+    degree: int,
+    law: str,
+    cell: str = "tetrahedron",
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    stress: tuple[float, float, float] = TRIAXIAL,
+    **options,
+) -> ElasticityProblem:
+    """A sphere (``SPHERE_RADIUS``) in the unit cube (``n`` cells per edge, even),
+    one material on both sides, pressures ``-stress`` (Pa) on the three pairs of faces
+    and the six rigid modes held by point constraints the exact field satisfies
+    (``u_i = 0`` where ``x_i = 1/2``): the exact stress is ``diag(stress)``
+    everywhere, the exact contact traction ``sigma n``. ``law``: ``bonded``,
+    ``sticking`` (a contact law stays closed: every ``n.sigma.n < 0``), ...;
+    ``options`` go to the problem."""
+    if n % 2:
+        raise ValueError(f"n must be even (the point constraints are mesh nodes), got {n}")
+    mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
+    c, R = np.asarray(SPHERE_CENTRE), SPHERE_RADIUS
+    cut = CutMesh(
+        mesh,
+        lambda x: np.sqrt((x[0] - c[0]) ** 2 + (x[1] - c[1]) ** 2 + (x[2] - c[2]) ** 2) - R,
+        degree=2,
+    )
+    cls = ContactProblem if law in ContactProblem.LAWS else ElasticityProblem
+    problem = cls(cut, degree, SOLID, law, **options)
+    problem.stress = tuple(stress)
+    for k, s in enumerate(stress):
+        faces = lambda x, k=k: np.isclose(x[k], 0.0) | np.isclose(x[k], 1.0)  # noqa: E731
+        problem.loads.add_pressure(faces, -s)
+    held = [
+        ((0.5, 0.0, 0.5), 0),
+        ((0.5, 1.0, 0.5), 0),
+        ((0.5, 0.5, 0.0), 0),
+        ((0.5, 0.5, 1.0), 0),
+        ((0.0, 0.5, 0.5), 1),
+        ((0.5, 0.5, 0.0), 1),
+        ((0.0, 0.5, 0.5), 2),
+    ]
+    for point, component in held:
+        problem.loads.add_point_displacement(list(point), 0.0, component)
+    return problem
+
+
+def sphere_errors(problem) -> tuple[float, float]:
+    """Relative L2 errors on the sphere of :func:`sphere_problem`'s solved ``problem`` of
+    the normal and the tangential traction of the multiplier (``lambda_n`` against
+    ``n.sigma.n``, the tangential part against
+    ``(I - n n) sigma n``; the Cartesian multiplier of ``bonded`` and of the 3D contact
+    laws split on the exact sphere's ``n``), summed by the interface rule at its points
+    (numpy). ``frictionless`` gives ``nan`` for the tangential one. Collective."""
+    (name,) = problem.laws
+    ctx = problem.contexts[name]
+    cut, rules = problem.cut, ctx.rules
+    J = cut.maps.jacobian(rule_cells(cut, rules), rules.points)
+    dA = rules.weights * np.abs(np.linalg.det(J))  # area (m^2) of each point
+    arm = interface_points(cut, rules) - np.asarray(SPHERE_CENTRE)
+    n = arm / np.linalg.norm(arm, axis=1)[:, None]
+    traction = n @ np.diag(problem.stress)
+    p_ex = np.sum(traction * n, axis=1)
+    t_ex = traction - p_ex[:, None] * n
+    lam = ctx.values_at(problem.w, ctx.field)  # Cartesian (bonded, contact in 3D)
+    if lam.shape[1] == 3:
+        lam_n = np.sum(lam * n, axis=1)
+        lam_t = lam - lam_n[:, None] * n
+    else:  # frictionless: lambda_n alone
+        lam_n, lam_t = lam[:, 0], None
+    comm = cut.mesh.comm
+
+    def total(values) -> float:
+        return comm.allreduce(float(np.sum(values * dA)), op=MPI.SUM)
+
+    e_n = np.sqrt(total((lam_n - p_ex) ** 2) / total(p_ex**2))
+    e_t = np.nan
+    if lam_t is not None:
+        misfit = total(np.sum((lam_t - t_ex) ** 2, axis=1))
+        e_t = np.sqrt(misfit / total(np.sum(t_ex**2, axis=1)))
+    return float(e_n), float(e_t)
