@@ -9,7 +9,7 @@ time. Meshes: n radial x 4n around (n = 10, 20, 40, 80), and the paper's n x n
 reading (20, 40, 80). Angles 0 (1 step), pi/4 (2 steps), pi/2 (4 steps), 0.3 rad and
 1 rad (4 steps each; not multiples of the cell angle: pi/4 and pi/2 map the mesh
 onto itself). The non-aligned angles are run with segment-to-segment integration
-(the default: slave pieces split where their feet cross master-piece ends) and
+(the default: slave pieces broken where their feet cross master-piece ends) and
 without (the interface rule's Gauss points, which then integrate across master
 kinks): the ``segments`` column. Time per Newton iteration: the solves' wall time
 (and CPU time of the process, less sensitive to other loads on the machine) over

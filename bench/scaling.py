@@ -5,7 +5,7 @@ P2 at N = 20 ... 320 cells per side, each run as a process of its own, next to
 ``bench/plain_elasticity.py`` (no cut; the same mesh, loads, MUMPS controls and
 factorisation: Cholesky where the demo's Jacobian is symmetric, else LU) in the same
 session: dofs, whole-process wall time, peak resident memory, and the demo's
-own split into phases (its ``summary.json``). The ratio cut / plain is printed per N;
+own breakdown into phases (its ``summary.json``). The ratio cut / plain is printed per N;
 the JIT (cold FFCx cache) is measured apart, once per degree at the smallest N, in an
 empty cache directory. ``--ranks 2`` adds the largest P2 case on 2 MPI ranks (speed-up
 per phase, plain DOLFINx's next to it). Wall times vary from run to run on a shared

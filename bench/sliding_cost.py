@@ -6,9 +6,9 @@ integration) and, in the same run on the same mesh, the small-sliding solve of c
 (:func:`~xfem_contact.cases.paper.annulus_problem`, a second solve from zero, as
 ``bench/rotating_inclusion.py`` measures it). CPU time (``time.process_time``: less
 sensitive to the other loads of a shared machine than wall time) per Newton
-iteration, the first load step left out (it sets up and compiles), split into the
+iteration, the first load step left out (it sets up and compiles), divided into the
 hybrid elements' residual and Jacobian (:class:`~xfem_contact.mechanics.sliding.
-coupling.SlidingCoupling`: split, pairing, element, blocks) and the rest (bulk
+coupling.SlidingCoupling`: breakpoints, pairing, element, blocks) and the rest (bulk
 assembly, factorisation, solve). Also the CPU time of the whole large-sliding run
 (set-up, 4 steps, pressure errors), and with ``--profile`` its top cProfile entries.
 

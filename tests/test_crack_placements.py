@@ -115,7 +115,7 @@ def test_measures_with_nodes_on_the_line_parallel(cell, degree, tip):
 @pytest.mark.parametrize("degree", [1, 2])
 def test_circle_through_boundary_nodes(cell, degree):
     """An interface leaving the boundary at nodes (a circle about a corner through
-    (0, -1) and (-1, 0)): each face split exactly, each facet once."""
+    (0, -1) and (-1, 0)): each face cut exactly, each facet once."""
     mesh = _mesh(cell)
     cut = CutMesh(mesh, lambda x: (x[0] + 1) ** 2 + (x[1] + 1) ** 2 - 1.0, degree=degree)
     one = dolfinx.fem.Constant(mesh, 1.0)

@@ -488,7 +488,7 @@ def test_circle_through_one_vertex():
 
 def grid_cells(cell: str, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Affine cells of an n x n grid of [0, 1]^2 as origin ``(m, 2)`` and
-    Jacobian ``(m, 2, 2)`` (triangles: each square split in two)."""
+    Jacobian ``(m, 2, 2)`` (triangles: each square cut in two)."""
     h = 1.0 / n
     corners = np.array([[i * h, j * h] for i in range(n) for j in range(n)])
     if cell == "quadrilateral":
@@ -755,7 +755,7 @@ def test_cap_converges_fifth_order(cell: str):
 @pytest.mark.parametrize("offset", [0.0, 0.07])
 @pytest.mark.parametrize("cell", CELLS)
 def test_closed_piece_inside_cell(cell: str, offset: float):
-    """A small circle inside one cell, crossing no edge: cut (not uncut), split
+    """A small circle inside one cell, crossing no edge: cut (not uncut), subdivided
     through its inside; area and circumference within 5e-4 of the circle's (the
     pieces are refined to stray less than 2e-4 of their chord, depth permitting)."""
     centre = (np.array([0.3, 0.3]) if cell == "triangle" else np.array([0.5, 0.5])) + offset
@@ -810,7 +810,7 @@ def test_saddle_hyperbola(degree: int, c: float):
 
 @pytest.mark.parametrize("degree", DEGREES)
 def test_crossing_lines(degree: int):
-    """Zero lines that cross: at a split point (the centre) the sub-cells see the
+    """Zero lines that cross: at a subdivision point (the centre) the sub-cells see the
     interface along two of their edges and are exact; elsewhere the crossing
     stays inside a sub-cell at every level and the cell is reported."""
     X = nodes("quadrilateral", degree)

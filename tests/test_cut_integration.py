@@ -122,7 +122,7 @@ def test_runtime_rules_match_moment_fitting(cell, degree):
 @pytest.mark.mpi
 @pytest.mark.parametrize("degree", [1, 2])
 def test_boundary_pieces_exact(cell, degree):
-    """cut.ds(side, facets): split lengths of cut boundary facets, with the facet normal."""
+    """cut.ds(side, facets): the parts of cut boundary facets, exact lengths and facet normal."""
     mesh = unit_square(5, cell, distorted=False)
     cut = xfem_contact.CutMesh(mesh, lambda x: 0.3 * x[0] + x[1] - 0.61, degree=degree)
     fdim = mesh.topology.dim - 1

@@ -1,7 +1,7 @@
 """The iterative linear solver of the Newton steps gives the direct solver's answer.
 
 GMRES with the band multigrid (``LINEAR_PRESETS["iterative"]``): the band and the
-displacement split cover what they should, the interpolation from the vertices is
+displacement fieldsplit cover what they should, the interpolation from the vertices is
 exact on bilinear fields, the Krylov iterations are reported and do not grow with N,
 and a scene selects the preset with ``[solver] preset``.
 """

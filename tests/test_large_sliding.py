@@ -26,7 +26,7 @@ from xfem_contact.mechanics.problem import Problem
 from xfem_contact.mechanics.sliding import element
 from xfem_contact.mechanics.sliding.lips import CurvePoint
 from xfem_contact.mechanics.sliding.projection import closest_points
-from xfem_contact.mechanics.sliding.segments import split
+from xfem_contact.mechanics.sliding.segments import break_pieces
 from xfem_contact.solvers.newton import NewtonFailure, ReducedNewton
 from xfem_contact.solvers.options import preset
 
@@ -409,14 +409,14 @@ def test_segments_keep_every_gauss_rule_on_one_master_piece():
         first[segment[::-1]] = feet.piece[::-1]
         return np.any(feet.piece != first[segment]), weights.sum()
 
-    segments = split(pieces, values, lip, coupling.radius)
+    segments = break_pieces(pieces, values, lip, coupling.radius)
     assert segments.piece.size > whole.piece.size
     assert np.all(segments.master >= 0)
     across, length = spread(segments)
     assert not across
     # the same total length, up to the rules' error on the arc length (not polynomial)
     assert abs(length - spread(whole)[1]) < 1e-9 * length
-    assert spread(whole)[0]  # the unsplit rule crosses master kinks
+    assert spread(whole)[0]  # the unbroken rule crosses master kinks
 
 
 @pytest.mark.parametrize("segments", [True, False])
@@ -494,8 +494,8 @@ def test_a_reused_factorisation_that_fails_is_refactored_not_fatal():
 def test_aligned_pieces_keep_the_pattern_and_the_factorisation(monkeypatch, touch):
     """Turned by whole cells at every step (n = 20: 4.5 degree cells, steps of 22.5
     degrees) slave nodes sit over master nodes: crossings within round-off of a
-    slave-piece end are not split points, so the Jacobian's pattern grows only where
-    a step brings new pairs and the factorisation is reused within the steps. Split at
+    slave-piece end are not breakpoints, so the Jacobian's pattern grows only where
+    a step brings new pairs and the factorisation is reused within the steps. Broken at
     such crossings (``TOUCH = 0``, the negative), slivers paired with either
     neighbour in turn grow the pattern at every iterate and each refactors."""
     if touch is not None:

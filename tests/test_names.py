@@ -9,8 +9,11 @@ from test_scenes import base
 
 import xfem_contact.mechanics.loads as loads_package
 from xfem_contact.cases.paper import inclusion_problem
+from xfem_contact.cases.rotation import rotating_annulus_problem
+from xfem_contact.mechanics.fieldsplit_data import fieldsplit_dofs
+from xfem_contact.mechanics.sliding import segments
 from xfem_contact.scenes.scene import SceneError, load_scene
-from xfem_contact.solvers import linear, newton
+from xfem_contact.solvers import linear, newton, options
 
 
 def test_problem_prolongation_and_its_old_name():
@@ -114,3 +117,61 @@ def test_a_report_gives_the_displacement_of_a_side():
         assert (u.x.array == report.field(field).x.array).all()
     with pytest.raises(ValueError, match=r"side must be one of \[-1, 1\], got 0"):
         report.displacement(0)
+
+
+def _newton(problem, **fieldsplit):
+    """A ReducedNewton of ``problem`` with PETSc's fieldsplit preconditioner."""
+    options = {"ksp_type": "gmres", "pc_type": "fieldsplit"}
+    R = problem.prolongation()
+    solver = newton.ReducedNewton(
+        problem.residual(problem.w), problem.w, problem.loads.bcs, R, options, **fieldsplit
+    )
+    R.destroy()
+    return solver
+
+
+def test_fieldsplit_dofs_keyword_and_its_old_name():
+    problem = inclusion_problem(4, 1, "sticking", "triangle")
+    dofs = fieldsplit_dofs(problem.space)
+    new = _newton(problem, fieldsplit_dofs=dofs)
+    with pytest.warns(DeprecationWarning, match="use fieldsplit_dofs="):
+        old = _newton(problem, splits=dofs)
+    indices = [[s.getIndices().tolist() for s in n._fieldsplit_objects] for n in (new, old)]
+    assert len(indices[0]) == 3 and indices[0] == indices[1]  # u, lambda, band
+    new.destroy(), old.destroy()
+    with pytest.raises(ValueError, match="give fieldsplit_dofs= only"):
+        with pytest.warns(DeprecationWarning):
+            _newton(problem, splits=dofs, fieldsplit_dofs=dofs)
+
+
+def test_old_fieldsplit_preconditioners_name_warns():
+    with pytest.warns(DeprecationWarning, match="FIELDSPLIT_PRECONDITIONERS"):
+        assert options.SPLIT_PRECONDITIONERS is options.FIELDSPLIT_PRECONDITIONERS
+
+
+@pytest.mark.parametrize(
+    "old, new", [("split", "break_pieces"), ("split_gradient", "breakpoint_gradient")]
+)
+def test_old_breakpoint_function_names_warn(old, new):
+    with pytest.warns(DeprecationWarning, match=new):
+        assert getattr(segments, old) is getattr(segments, new)
+
+
+def test_breakpoint_linearisation_and_its_old_name():
+    coupling = rotating_annulus_problem(4, 1, 0.3).couplings["interface"]
+    assert coupling.breakpoint_linearisation is True
+    with pytest.warns(DeprecationWarning, match="SlidingCoupling.breakpoint_linearisation"):
+        coupling.split_linearisation = False
+    assert coupling.breakpoint_linearisation is False
+    with pytest.warns(DeprecationWarning, match="SlidingCoupling.breakpoint_linearisation"):
+        assert coupling.split_linearisation is False
+
+
+def test_side_measure_ids_and_its_old_name():
+    cut = inclusion_problem(4, 1, "sticking", "triangle").cut
+    for side in (-1, 1):
+        measure = cut.dx(side).subdomain_id()
+        with pytest.warns(DeprecationWarning, match="CutMesh.side_measure_ids"):
+            assert cut.split_side_measure(measure) == cut.side_measure_ids(measure)
+        assert len(set(cut.side_measure_ids(measure)) | {measure}) == 3
+    assert cut.side_measure_ids(cut.dGamma.subdomain_id()) is None

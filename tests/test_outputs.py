@@ -125,7 +125,7 @@ def test_forces_at_a_state_are_those_of_the_problem_solved_to_it(law, options):
     assert again["balance_relative"] < BALANCE, again
 
 
-def test_spring_supports_are_reactions():
+def test_tangential_springs_are_reactions():
     data = plate("sticking")
     data["loads"].append({"part": "left", "type": "tangential_spring", "value": 1e9})
     problem = solved(data)
@@ -266,7 +266,7 @@ def test_plain_scene_series_holds_the_mesh_nodes(tmp_path, cell, per_square):
 
 def _lips_by_position(grid) -> np.ndarray:
     """Rows ``(side, x, y, ux, uy)`` of a lips grid, one per distinct (side, point),
-    sorted: comparable between runs that number and split the points differently."""
+    sorted: comparable between runs that number and divide the points differently."""
     side = np.zeros(grid.n_points)
     side[grid.cell_connectivity] = np.repeat(
         np.asarray(grid.cell_data["side"]), np.diff(grid.cell_offsets)

@@ -101,7 +101,7 @@ def polyline_length(poly) -> float:
 def test_region_outline_is_the_interface_and_the_boundary(cell):
     """Each side's outline of the sub-cell grid: the interface (side -1) and the
     interface plus the square's boundary (side +1), against the cut's own interface
-    length. The triangles' fans split edges that their neighbours keep whole (hanging
+    length. The triangles' fans divide edges that their neighbours keep whole (hanging
     nodes): without dropping the overlapping edges side +1 measures 1.25 m more."""
     mesh = unit_square(8, cell, comm=MPI.COMM_SELF)
     cut = CutMesh(mesh, disc, degree=2)

@@ -166,7 +166,7 @@ def test_a_facet_term_coupling_two_fields_is_kept():
     ],
 )
 def test_uncut_cells_on_the_fields_own_spaces(law, cell, blocked, coupled):
-    """The Jacobian split into the uncut cells' field blocks (inserted 2 x 2 where the
+    """The Jacobian divided into the uncut cells' field blocks (inserted 2 x 2 where the
     unknowns pair up; the single-component pins of case 2 among the Dirichlet dofs)
     and the rest: PtAP's matrix. A term coupling two fields on uncut cells stays."""
     options = {"friction": 0.3} if law == "coulomb" else {}
@@ -176,11 +176,11 @@ def test_uncut_cells_on_the_fields_own_spaces(law, cell, blocked, coupled):
     if coupled:  # u_- tested with v_+ on the uncut cells of side -1 (inactive dofs aside)
         u_minus, v_plus = ufl.split(ufl.TrialFunction(W))[0], ufl.split(ufl.TestFunction(W))[1]
         J = J + 1e6 * ufl.inner(u_minus, v_plus) * problem.cut.dx(-1)
-    split = uncut_field_blocks(J, problem.space.field_space)
-    assert [b.field for b in split.blocks] == [0, 1]  # the multipliers have no bulk
+    parts = uncut_field_blocks(J, problem.space.field_space)
+    assert [b.field for b in parts.blocks] == [0, 1]  # the multipliers have no bulk
     R = problem.prolongation()
-    blocks = [(form(b.form), b.parent, True) for b in split.blocks]
-    reduced = ReducedMatrix(form(split.rest), problem.loads.bcs, R, field_blocks=blocks)
+    blocks = [(form(b.form), b.parent, True) for b in parts.blocks]
+    reduced = ReducedMatrix(form(parts.rest), problem.loads.bcs, R, field_blocks=blocks)
     assert [b[2] for b in reduced._blocks] == [blocked, blocked]
     A = reduced.assemble()
     assert A.getInfo()["mallocs"] == 0
@@ -201,9 +201,9 @@ def test_constant_blocks_are_added_from_their_copy(problem):
     state the matrix equals one assembled afresh there."""
     W = problem.space.W
     J = ufl.derivative(problem.residual(problem.w), problem.w, ufl.TrialFunction(W))
-    split = uncut_field_blocks(J, problem.space.field_space)
-    blocks = [(form(b.form), b.parent, True) for b in split.blocks]
-    R, rest = problem.prolongation(), form(split.rest)
+    parts = uncut_field_blocks(J, problem.space.field_space)
+    blocks = [(form(b.form), b.parent, True) for b in parts.blocks]
+    R, rest = problem.prolongation(), form(parts.rest)
     kept = ReducedMatrix(rest, problem.loads.bcs, R, field_blocks=blocks)
     kept.keep_constant_blocks()
     kept.assemble()  # keeps the copy
@@ -220,10 +220,10 @@ def test_constant_blocks_are_added_from_their_copy(problem):
         obj.destroy()
 
 
-def test_split_newton_lifts_unmet_dirichlet_data():
+def test_field_block_newton_lifts_unmet_dirichlet_data():
     """Where w misses its Dirichlet data the residual is lifted with the whole
     Jacobian (compiled then): DOLFINx's lifted residual; and the solution is the
-    one without the split."""
+    one without the field blocks."""
     problem = inclusion_problem(8, 2, "sticking")
     problem.loads.add_displacement(lambda x: np.isclose(x[1], 0.0), 1e-4)  # not met by w = 0
     R, bcs = problem.prolongation(), problem.loads.bcs

@@ -138,7 +138,7 @@ def rotating_annulus_problem(
         quadrature_degree: Of the cut's rules (the cut's default 6), i.e. of each
             slave (sub-)segment's Gauss rule.
         segments: Segment-to-segment integration of the hybrid elements (the slave
-            pieces split where their feet cross master-piece ends, where the master
+            pieces broken where their feet cross master-piece ends, where the master
             field's derivative jumps); False: the cut's interface rule, whose Gauss
             points then integrate across those kinks (see the docs' large-sliding
             page).

@@ -13,6 +13,7 @@ import numpy as np
 import numpy.typing as npt
 import ufl
 
+from xfem_contact._deprecation import renamed_attribute
 from xfem_contact.fem import cut_boundary
 from xfem_contact.fem.crack_cut import Crack
 from xfem_contact.fem.cut_state import INTERFACE, SIDE_MINUS, SIDE_PLUS, CutState, cut_state
@@ -23,7 +24,7 @@ from xfem_contact.geometry.levelset import CellMaps, LevelSet, LevelSetCallable
 from xfem_contact.quadrature import rules as quadrature
 from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart, marker_space
 
-_SPLIT = {SIDE_MINUS: (4, 6), SIDE_PLUS: (5, 7)}  # side measure: uncut, cut cells parts
+_SIDE_PARTS = {SIDE_MINUS: (4, 6), SIDE_PLUS: (5, 7)}  # side measure: uncut, cut cells parts
 _INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + index
 _BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
 _CUT_CELLS0 = 50  # measure ids of cut.dx_cut(name): _CUT_CELLS0 + index, _CUT_CELLS0 - 1 all
@@ -321,11 +322,13 @@ class CutMesh:
             "dx", domain=self.mesh, subdomain_data=self, subdomain_id=sid, metadata=metadata or {}
         )
 
-    def split_side_measure(self, subdomain_id: int) -> tuple[int, int] | None:
+    def side_measure_ids(self, subdomain_id: int) -> tuple[int, int] | None:
         """For the id of a side measure (:meth:`dx`): the ids of its two parts, the
         uncut cells (standard rule) and the cut cells (runtime rules), whose sum it is;
         ``None`` for other ids. For :func:`xfem_contact.fem.field_blocks.uncut_field_blocks`."""
-        return _SPLIT.get(subdomain_id)
+        return _SIDE_PARTS.get(subdomain_id)
+
+    split_side_measure = renamed_attribute("CutMesh", "split_side_measure", "side_measure_ids")
 
     @property
     def dGamma(self) -> ufl.Measure:
@@ -396,7 +399,7 @@ class CutMesh:
                 r = self.interface_rules_of(self.interface_names[k])
                 self._cell_rules[k + _INTERFACE0] = self._rules(self.cut_cells, r)
             return [IntegrationPart("cell", rules=self._cell_rules[subdomain_id])]
-        for side, (uncut, cut_part) in _SPLIT.items():  # a part of a side measure
+        for side, (uncut, cut_part) in _SIDE_PARTS.items():  # a part of a side measure
             if subdomain_id == uncut:
                 return [IntegrationPart("cell", entities=self._standard[side])]
             if subdomain_id == cut_part:

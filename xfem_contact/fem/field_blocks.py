@@ -116,8 +116,8 @@ def uncut_field_blocks(
             continue
         data = itg.subdomain_data()
         ids = None
-        if itg.integral_type() == "cell" and hasattr(data, "split_side_measure"):
-            ids = data.split_side_measure(itg.subdomain_id())
+        if itg.integral_type() == "cell" and hasattr(data, "side_measure_ids"):
+            ids = data.side_measure_ids(itg.subdomain_id())
         if ids is None:
             rest.append(itg)
             continue

@@ -79,7 +79,7 @@ class _Rewrite(typing.NamedTuple):
 
 
 def _rewrite(ufl_form: ufl.Form) -> _Rewrite:
-    """Split every cut integral into its standard and runtime parts."""
+    """Every cut integral rewritten as its standard and runtime parts."""
     ours = [i for i in ufl_form.integrals() if _is_cut_source(i.subdomain_data())]
     if ours:
         for itg in ufl_form.integrals():

@@ -6,7 +6,7 @@ each tip (and its ramp) or the tip cells' patch. Their integrands are far from
 polynomials and need a high degree (the cut's ``quadrature_degree``); everywhere else
 the integrand of a polynomial space is a polynomial of low degree. :class:`TipZone` is a
 source of cut measures (``integration_parts``, as :class:`~xfem_contact.fem.cutmesh.CutMesh`)
-that splits the uncut cells of each side measure into the zone, with the zone's
+that divides the uncut cells of each side measure into the zone, with the zone's
 metadata, and the rest, with the measure's own: the same integrals, at a fraction of
 the points. Cut cells keep their runtime rules.
 """
@@ -62,13 +62,13 @@ class TipZone:
         applies to the uncut cells outside the zone."""
         return self.cut.dx(side, metadata).reconstruct(subdomain_data=self)
 
-    def split_side_measure(self, subdomain_id: int) -> tuple[int, int] | None:
-        """See :meth:`CutMesh.split_side_measure
-        <xfem_contact.fem.cutmesh.CutMesh.split_side_measure>`."""
-        return self.cut.split_side_measure(subdomain_id)
+    def side_measure_ids(self, subdomain_id: int) -> tuple[int, int] | None:
+        """See :meth:`CutMesh.side_measure_ids
+        <xfem_contact.fem.cutmesh.CutMesh.side_measure_ids>`."""
+        return self.cut.side_measure_ids(subdomain_id)
 
     def integration_parts(self, subdomain_id: int) -> list[IntegrationPart]:
-        """The cut's parts, each standard cell part split into the zone's cells (with
+        """The cut's parts, each standard cell part divided into the zone's cells (with
         :attr:`metadata`) and the others. Every process returns the same parts."""
         parts = []
         for part in self.cut.integration_parts(subdomain_id):

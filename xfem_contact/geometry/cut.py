@@ -25,7 +25,7 @@ degeneracy policy); after ``max_depth`` levels (default :data:`MAX_DEPTH`)
 
 This module is the driver. Data flows one way through its helpers:
 :mod:`~xfem_contact.geometry.cut_topology` (reference cells, sign topology) ->
-:mod:`~xfem_contact.geometry.cut_split` (splitting cells) and
+:mod:`~xfem_contact.geometry.cut_children` (subdividing cells) and
 :mod:`~xfem_contact.geometry.cut_subcells` (side sub-triangles) ->
 :mod:`~xfem_contact.geometry.cut_simple` (simply cut cells) ->
 :mod:`~xfem_contact.geometry.cut_subdivision` (everything else) -> here.
@@ -46,7 +46,7 @@ from xfem_contact.geometry.cut_subdivision import (
     Pieces,
     compose,
     corner_pieces,
-    needs_split,
+    needs_subdivision,
     subdivide,
 )
 from xfem_contact.geometry.cut_topology import (
@@ -129,7 +129,7 @@ def subtriangulate(
     xtol: float = 1e-14,
     max_depth: int = MAX_DEPTH,
 ) -> CutGeometry:
-    """Split cut cells into curved P2 sub-triangles on each side and SEG3 interface pieces.
+    """Subtriangulate cut cells: curved P2 sub-triangles on each side and SEG3 interface pieces.
 
     Edge crossings are closed-form roots of the edge polynomials. The SEG3
     mid-node is the zero of the interpolant on the perpendicular bisector of
@@ -183,12 +183,12 @@ def subtriangulate(
         data, phi[simple], neg[simple], compose(exact, simple), xtol
     )
     corner = np.flatnonzero(kind == CORNER)
-    split = np.flatnonzero(needs_split(kind))
+    recursive = np.flatnonzero(needs_subdivision(kind))
     reference = np.broadcast_to(data.vertices, (corner.size, data.nv, 2))
     pieces = [
         (tri_m, simple[cell_m], tri_p, simple[cell_p], seg, simple),
         corner_pieces(data, phi[corner], reference, corner),
-        *subdivide(data, phi, split, neg[split], kind[split], exact, xtol, max_depth),
+        *subdivide(data, phi, recursive, neg[recursive], kind[recursive], exact, xtol, max_depth),
     ]
     return _collect(pieces, n, subdivided)
 

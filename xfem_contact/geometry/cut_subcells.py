@@ -171,7 +171,7 @@ def _best_fan(
     scores = np.stack([o[2] for o in options], axis=1)
     # Near ties (the two diagonals of a symmetric side) go to the first fan: a bare
     # argmax followed 1-ulp noise in the nodal level set, which depends on the cell
-    # numbering, so 1 and 2 processes split some annulus cells differently.
+    # numbering, so 1 and 2 processes subdivide some annulus cells differently.
     top = scores.max(axis=1, keepdims=True)
     margin = np.where(np.isfinite(top), _TIE * np.abs(top), 0.0)  # inf: every child dropped
     best = np.argmax(scores >= top - margin, axis=1)

@@ -14,28 +14,28 @@ interpolant
 * changes sign inside but not on the boundary (a closed piece; degree 2 only,
   seen on a 9 x 9 sample lattice, so smaller pieces between its points are missed)
 
-is *subdivided*: split in reference coordinates into 4 sub-cells (quadrilateral:
+is *subdivided*: in reference coordinates into 4 sub-cells (quadrilateral:
 4 rectangles; triangle: 3 corner triangles and a middle one), at the edge
-mid-points except that an edge crossed twice is split between its crossings
+mid-points except that an edge crossed twice is divided between its crossings
 (at the extremum of its polynomial) and a closed piece through its inside
-(:func:`xfem_contact.geometry.cut_split.split_parameters`). On an affine sub-cell
+(:func:`xfem_contact.geometry.cut_children.subdivision_parameters`). On an affine sub-cell
 the interpolant is again a Lagrange interpolant of the same degree, with the
 parent's values at the sub-cell's nodes; ``exact`` is composed with the
 sub-cell map. Sub-cells are cut as reference cells (the same rules, ``xtol``
 in sub-cell units), uncut ones become straight sub-triangles of their side,
 and everything is mapped back affinely (P2 nodes map exactly). Sub-cells that
-still need it are split again, up to ``max_depth`` levels (default
+still need it are subdivided again, up to ``max_depth`` levels (default
 :data:`xfem_contact.geometry.cut.MAX_DEPTH` = 5). Inside subdivided cells only, a simply
 cut sub-cell whose SEG3 strays from the zero set by more than ``2e-4`` times its chord at
-its quarter points (as a circular arc of about 29 degrees would) is split
+its quarter points (as a circular arc of about 29 degrees would) is subdivided
 once more through the farthest point while depth allows, unless one of its
-children would then need splitting (accuracy refinement never fails). A
+children would then need subdivision (accuracy refinement never fails). A
 subdivided cell has one SEG3 per cut sub-cell (those shorter than ``64 eps``
 dropped), possibly none.
 
 A (sub-)cell whose interpolant vanishes identically on two or more of its
 edges and is negative at its other vertices (a corner of a mesh-aligned
-interface, or crossing branches meeting at a split point) lies wholly on side
+interface, or crossing branches meeting at a subdivision point) lies wholly on side
 -1 and carries those edges as straight interface pieces (:func:`corner_pieces`):
 the convention of an interface along one edge, where the cell on side -1
 carries it. If such a degree-2 interpolant turns positive inside, the cell is
@@ -43,7 +43,7 @@ subdivided instead.
 
 After ``max_depth`` levels :func:`subdivide` raises ``ValueError`` naming
 the cells and the reason. This happens for interface branches that cross
-(an exact saddle with zero value) away from split points, and for details
+(an exact saddle with zero value) away from subdivision points, and for details
 finer than the last level. Cells that are not subdivided are never refined for
 accuracy, however strongly their SEG3 bends.
 """
@@ -52,8 +52,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from xfem_contact.geometry.cut_children import (
+    child_cells,
+    straight_triangles,
+    subdivision_parameters,
+)
 from xfem_contact.geometry.cut_simple import ExactLevelSet, call_exact, cut_simple, interpolant
-from xfem_contact.geometry.cut_split import split_cells, split_parameters, straight_triangles
 from xfem_contact.geometry.cut_topology import (
     CORNER,
     CellData,
@@ -73,7 +77,7 @@ Pieces = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.nd
 """``(tri_minus, cell, tri_plus, cell, seg, seg_cell)`` with rows of the parent ``phi``."""
 
 
-def needs_split(kind: np.ndarray) -> np.ndarray:
+def needs_subdivision(kind: np.ndarray) -> np.ndarray:
     """Cells that must be subdivided, boolean ``(n,)``, from the ``kind`` flags
     ``(n,)`` of :func:`~xfem_contact.geometry.cut_topology.topology`: flagged, and not
     just :data:`CORNER`."""
@@ -139,7 +143,7 @@ def _map(points: np.ndarray, origin: np.ndarray, matrix: np.ndarray) -> np.ndarr
 def _restricted_values(data: CellData, phi: np.ndarray, vertices: np.ndarray) -> np.ndarray:
     """Nodal values ``(m, ndofs)`` on sub-cells with vertices ``(m, nv, 2)`` (root
     reference coordinates) of the root interpolants ``phi`` ``(m, ndofs)``: exact
-    for the affine (quadrilaterals: axis-parallel) sub-cells of :func:`split_cells`."""
+    for the affine (quadrilaterals: axis-parallel) sub-cells of :func:`child_cells`."""
     nodes = data.node_weights @ vertices
     basis = lagrange_basis(data.cell_type, data.degree, nodes.reshape(-1, 2))
     return (basis.reshape(len(phi), data.ndofs, -1) @ phi[:, :, None])[:, :, 0]
@@ -196,11 +200,11 @@ def subdivide(
 
     All sub-cells of one level are processed together; each carries its root
     row and its vertices in the root's reference coordinates. Besides the
-    sub-cells that need splitting, simply cut sub-cells whose SEG3 strays from
+    sub-cells that need subdivision, simply cut sub-cells whose SEG3 strays from
     the zero set by more than ``_GAP`` times its chord (see :func:`_gap`) are
-    split once more, through the SEG3 point farthest from the zero set and
+    subdivided once more, through the SEG3 point farthest from the zero set and
     across its tangent, while depth allows; if one of their children then needs
-    splitting, the coarse piece is kept instead (refining for accuracy never
+    subdivision, the coarse piece is kept instead (refining for accuracy never
     fails).
 
     Args:
@@ -215,7 +219,7 @@ def subdivide(
         max_depth: Maximum number of subdivision levels.
 
     Raises:
-        ValueError: Sub-cells still need splitting after ``max_depth`` levels.
+        ValueError: Sub-cells still need subdivision after ``max_depth`` levels.
     """
     pieces: list[Pieces] = []
     if rows.size == 0:
@@ -227,13 +231,13 @@ def subdivide(
     bent = np.zeros(rows.size, dtype=bool)
     fallback: Pieces | None = None  # pieces of the bent sub-cells, by index in ``root``
     for depth in range(1, max_depth + 1):
-        t = split_parameters(data, sub_phi, neg, kind, through, across)
-        vertices = split_cells(data, vertices, t).reshape(-1, data.nv, 2)
+        t = subdivision_parameters(data, sub_phi, neg, kind, through, across)
+        vertices = child_cells(data, vertices, t).reshape(-1, data.nv, 2)
         parent = np.repeat(np.arange(root.size), 4)
         sub_phi = _restricted_values(data, phi[root[parent]], vertices)
         neg, kind = topology(data, sub_phi)
         if fallback is not None:
-            failed = bent & needs_split(kind).reshape(-1, 4).any(axis=1)
+            failed = bent & needs_subdivision(kind).reshape(-1, 4).any(axis=1)
             pieces.append(_take(fallback, failed, root))
             keep = ~failed[parent]
             vertices, parent, sub_phi = vertices[keep], parent[keep], sub_phi[keep]
@@ -276,7 +280,7 @@ def subdivide(
         corner = np.flatnonzero(kind == CORNER)
         if corner.size:
             pieces.append(corner_pieces(data, sub_phi[corner], vertices[corner], root[corner]))
-        again = np.flatnonzero(needs_split(kind) | bent)
+        again = np.flatnonzero(needs_subdivision(kind) | bent)
         if again.size == 0:
             return pieces
         local = np.full(root.size, -1)

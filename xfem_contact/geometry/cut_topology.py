@@ -25,8 +25,8 @@ values. Two exceptions keep exact zeros from creating spurious topology:
 :func:`topology` also flags the cells whose zero line one SEG3 cannot represent
 (:data:`TWICE`, :data:`MANY`, :data:`INTERIOR`, :data:`CORNER`). Cells with
 only :data:`CORNER` lie wholly on side -1 with the interface along their zero
-edges (:func:`zero_edges`); the others are cut after splitting them into
-sub-cells (:mod:`xfem_contact.geometry.cut_split`), on which the level set is again a
+edges (:func:`zero_edges`); the others are cut after subdividing them into
+sub-cells (:mod:`xfem_contact.geometry.cut_children`), on which the level set is again a
 degree-1 or 2 Lagrange interpolant (:func:`lagrange_basis` evaluates it at
 their nodes). :func:`side_polygon` lists the two sides of a simply cut cell.
 """

@@ -2,8 +2,8 @@
 
 A region's outline is the set of cell edges that only one cell of it owns, once
 coincident nodes of neighbouring cells are merged (a sub-triangulated cut cell has
-nodes of its own). Where a cut cell's sub-triangles split an edge that its neighbour
-keeps whole or splits elsewhere (hanging nodes), the pieces of both sides look like
+nodes of its own). Where a cut cell's sub-triangles divide an edge that its neighbour
+keeps whole or divides elsewhere (hanging nodes), the pieces of both sides look like
 outline edges too; they are dropped: edges that overlap along one curve. Edges are
 curved (quadratic cells: ends and mid node) and sampled as polylines. Cost: a sort of
 the edges, linear in the cells, where merging the points of a subdivided surface
@@ -96,7 +96,7 @@ def _curve(edges: np.ndarray, points: np.ndarray, t: np.ndarray):
 
 def _overlapping(outline: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Which outline edges overlap another one along the same curve (True to drop):
-    a cut cell's sub-triangles split an edge that its neighbour keeps whole or splits
+    a cut cell's sub-triangles divide an edge that its neighbour keeps whole or divides
     elsewhere, so both look like outline edges although the region lies on both sides.
     Two edges overlap when both ends of one lie on the other's curve (extended beyond
     its ends) and their parameter ranges share a piece of positive length."""

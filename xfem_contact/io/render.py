@@ -19,7 +19,7 @@ from xfem_contact.io.outlines import cell_outlines, region_outline
 
 
 def _surface(grid: pyvista.DataSet, subdivision: int = 3) -> pyvista.PolyData:
-    """Linear triangles of (possibly quadratic) 2D cells, curved edges subdivided."""
+    """Straight (degree-1) triangles of (possibly quadratic) 2D cells, curved edges subdivided."""
     return grid.extract_surface(nonlinear_subdivision=subdivision, algorithm="dataset_surface")
 
 

@@ -241,7 +241,7 @@ def interface_arrays(cut: CutMesh) -> GridArrays:
 
 
 def plain_arrays(u, fields: dict | None = None) -> GridArrays:
-    """The mesh at the nodes of ``u``'s Lagrange space (linear cells for degree 1,
+    """The mesh at the nodes of ``u``'s Lagrange space (degree-1 cells for degree 1,
     quadratic ones for 2, VTK Lagrange cells above) with point data ``u`` (m, padded to
     3 components) and ``fields`` (name to Function, e.g. a discontinuous stress,
     interpolated into ``u``'s degree). This process's cells."""

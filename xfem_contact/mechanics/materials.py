@@ -75,7 +75,7 @@ def hooke(mu, lmbda, u) -> ufl.core.expr.Expr:
 def saint_venant_kirchhoff(mu, lmbda, u) -> ufl.core.expr.Expr:
     """``P = F S``, ``S = 2 mu E + lmbda tr(E) I``, ``E = (F^T F - I) / 2``,
     ``F = I + grad u`` (Pa; ``mu``, ``lmbda`` numbers or DG0 Functions, Pa): objective,
-    so a rigid rotation gives ``P = 0``; equal to the linear law to first order in
+    so a rigid rotation gives ``P = 0``; equal to Hooke's law to first order in
     ``grad u``."""
     d = len(u)
     identity = ufl.Identity(d)

@@ -26,12 +26,16 @@ from xfem_contact.mechanics.bulk import BULK_MODELS, KINEMATICS, cell_size, chec
 from xfem_contact.mechanics.composition import Materials, interface_laws, side_and_law_materials
 from xfem_contact.mechanics.contexts import interface_context, samples, status_counts
 from xfem_contact.mechanics.defaults import DEFAULT
+from xfem_contact.mechanics.fieldsplit_data import (
+    fieldsplit_dofs,
+    rigid_modes,
+    vertex_interpolation,
+)
 from xfem_contact.mechanics.laws import InterfaceLaw, large_sliding
 from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loads import Loads, SideFields
 from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
-from xfem_contact.mechanics.splits import field_splits, rigid_modes, vertex_interpolation
 from xfem_contact.solvers.linear import solve_reduced, tip_transform
 from xfem_contact.solvers.log_lines import lines_to
 from xfem_contact.solvers.newton import NewtonFailure, ReducedNewton, weak_method
@@ -404,7 +408,7 @@ class Problem:
             self._newton.destroy()  # loads or solver options changed since it was built
             self._newton = None
         if self._newton is None:
-            split = uses_fieldsplit(petsc_options)
+            fieldsplit = uses_fieldsplit(petsc_options)
             self._newton = ReducedNewton(
                 self.residual(self.w),
                 self.w,
@@ -413,12 +417,12 @@ class Problem:
                 petsc_options,
                 self.petsc_options_prefix,
                 status=weak_method(self.interface_status),
-                splits=field_splits(self.space) if split else None,
-                near_nullspace=rigid_modes(self.space) if split else None,
-                interpolation=vertex_interpolation(self.space) if split else None,
+                fieldsplit_dofs=fieldsplit_dofs(self.space) if fieldsplit else None,
+                near_nullspace=rigid_modes(self.space) if fieldsplit else None,
+                interpolation=vertex_interpolation(self.space) if fieldsplit else None,
                 couplings=list(self.couplings.values()),
                 field_space=self.space.field_space,
-                transform=tip_transform(self.space, off=split or bool(self.couplings)),
+                transform=tip_transform(self.space, off=fieldsplit or bool(self.couplings)),
             )
             self._newton_loads, self._options_changed = self.loads.revision, False
         accepted = self.w.x.array.copy()

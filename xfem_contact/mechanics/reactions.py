@@ -8,7 +8,7 @@ force a support exerts on the body is ``R_c = sum_i b_i e_c(i)`` over its Dirich
 zero elsewhere). The resultant of an interface is the force its traction exerts on side
 -1, ``-F_law(w; (e_c, 0))`` (the multiplier is the traction ``sigma n`` on side -1). The
 applied loads are ``L(e_c)`` (tractions, pressures, body forces). A tangential spring
-support acts as a reaction too: ``-F_spring(w; e_c)``. SI units: forces per unit
+acts as a reaction too: ``-F_spring(w; e_c)``. SI units: forces per unit
 thickness (N/m), 2-vectors.
 
 Reactions are grouped by the load that prescribes the displacement (by its part's name,
@@ -184,7 +184,7 @@ def interface_resultants(problem, w: dolfinx.fem.Function) -> dict[str, np.ndarr
 
 
 def spring_reactions(problem, w: dolfinx.fem.Function) -> np.ndarray | None:
-    """The force (N/m, ``(2,)``) of the tangential spring supports on the body at the
+    """The force (N/m, ``(2,)``) of the tangential springs on the body at the
     state ``w``, or None without springs. Collective."""
     terms = _springs(problem, w)
     if terms is None:

@@ -47,7 +47,7 @@ def cauchy_stress(material, u, kinematics: str = "small") -> ufl.core.expr.Expr:
         material: Anything with ``stress(u)`` (and ``piola(u)`` for large kinematics)
             returning UFL (Pa): a material, its moduli on a mesh, a material field.
         u: Displacement (UFL vector, 2 components).
-        kinematics: ``"small"`` (the linear law) or ``"large"`` (``P F^T / det F`` of
+        kinematics: ``"small"`` (Hooke's law) or ``"large"`` (``P F^T / det F`` of
             the first Piola-Kirchhoff stress ``P``).
     """
     mesh = ufl.domain.extract_unique_domain(u)

@@ -1,7 +1,7 @@
 """Rules of tetrahedra cut by P2 level sets (curved interfaces): Saye's rules on the four
 hexahedra of each tetrahedron, pure numpy and Basix.
 
-The reference tetrahedron splits into four hexahedra, one per vertex ``i``, with corners
+The reference tetrahedron is subdivided into four hexahedra, one per vertex ``i``, with corners
 ``i``, the midpoints of its three edges, the centroids of its three faces and the
 centroid of the tetrahedron. Each is the image of the unit cube by a trilinear map ``M``
 with a positive Jacobian determinant (a polynomial bounded away from zero). A P2
@@ -41,7 +41,7 @@ from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
 __all__ = ["HEXAHEDRA", "classify_p2_tets", "hexahedron_map", "p2_tet_cut_rules"]
 
 
-def _split() -> np.ndarray:
+def _subdivision() -> np.ndarray:
     """Corners ``(4, 8, 3)`` of the four hexahedra of the reference tetrahedron, in Basix
     hexahedron vertex order."""
     V = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
@@ -58,7 +58,7 @@ def _split() -> np.ndarray:
     return np.array(hexes)
 
 
-HEXAHEDRA = _split()
+HEXAHEDRA = _subdivision()
 """Corners of the four hexahedra of the reference tetrahedron, shape ``(4, 8, 3)``."""
 
 

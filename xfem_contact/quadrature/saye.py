@@ -23,7 +23,7 @@ On a box ``U = [lo, hi]`` of the reference cube, with ``psi`` the cell's level s
    ``grad psi / |d psi / d x_k3|`` (reference coordinates) and the weight of its line.
    Every integrand is smooth between the breakpoints, so the rules converge at the rate
    of Gauss-Legendre rules; all weights are positive.
-4. When no pair is valid the box is split in eight, down to ``max_depth`` levels; a box
+4. When no pair is valid the box is subdivided into eight, down to ``max_depth`` levels; a box
    at that depth that still has none uses the best monotone height axis alone (a
    lower-order rule on a box of size ``2^-max_depth``; the cell is reported in
    :attr:`CutRules.reduced`), and one with no monotone axis at all (a singular
@@ -235,8 +235,8 @@ def saye_points(
             group = pair == index
             if group.any():
                 _box_rules(C, cell[group], lo[group], hi[group], k3, k2, gauss, parts)
-        split = pair < 0
-        cell, lo, hi = _subdivide(cell[split], lo[split], hi[split])
+        subdivided = pair < 0
+        cell, lo, hi = _subdivide(cell[subdivided], lo[subdivided], hi[subdivided])
     return SayePoints(
         tuple(_gather(parts["minus"], (1, 3, 1))),
         tuple(_gather(parts["plus"], (1, 3, 1))),
@@ -341,14 +341,14 @@ def _box_rules(C, cell, lo, hi, k3, k2, gauss, parts):
     """Nested Gauss rules of boxes sharing the axes ``k3`` (height) and ``k2``."""
     k1 = 3 - k3 - k2
     m = cell.size
-    # level 1: along k1, split at the roots of psi on the four edges parallel to k1
+    # level 1: along k1, breakpoints at the roots of psi on the four edges parallel to k1
     roots = []
     for v, w in itertools.product((lo[:, k2], hi[:, k2]), (lo[:, k3], hi[:, k3])):
         X = np.zeros((m, 3))
         X[:, k2], X[:, k3] = v, w
         roots.append(line_roots(line_coefficients(C[cell], k1, X), lo[:, k1], hi[:, k1]))
     box1, u, w1, _, _ = _pieces(np.concatenate(roots, axis=1), lo[:, k1], hi[:, k1], gauss)
-    # level 2: along k2 at each u, split at the roots of the two face functions
+    # level 2: along k2 at each u, breakpoints at the roots of the two face functions
     roots = []
     for end in (lo, hi):
         X = np.zeros((u.size, 3))
@@ -363,7 +363,7 @@ def _box_rules(C, cell, lo, hi, k3, k2, gauss, parts):
     X[:, k1], X[:, k2] = u[p1], v
     C2 = C[cell[box2]]
     lo3, hi3 = lo[box2, k3], hi[box2, k3]
-    # level 3: along k3 at each (u, v), split at the roots of psi
+    # level 3: along k3 at each (u, v), breakpoints at the roots of psi
     r = line_roots(line_coefficients(C2, k3, X), lo3, hi3)
     p2, w, w3, piece, (pline, mid) = _pieces(r, lo3, hi3, gauss)
     Xmid = X[pline].copy()

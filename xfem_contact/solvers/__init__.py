@@ -1,6 +1,6 @@
 """Solves on the reduced space: linear (PETSc KSP) and generalized Newton (PETSc SNES).
 
-Owns the assembly and solution of systems restricted to the active dofs of an
+Owns the assembly and solution of systems reduced to the active dofs of an
 enriched space, ``x = R y`` with ``R`` from
 :func:`xfem_contact.fem.prolongation.prolongation_matrix`: one KSP solve of
 ``R^T A R y = R^T b`` (:mod:`~xfem_contact.solvers.linear`), generalized Newton on

@@ -228,7 +228,7 @@ def _block_lgmap(
 def _zeros_outside_the_pattern(A: PETSc.Mat, skip: bool) -> None:
     """Facet kernels on ``W`` fill every field's block with explicit zeros: with
     ``skip`` these are skipped (and the pattern itself is stored whole,
-    :func:`_fill_pattern`); without facet integrals on ``W`` (the ghost penalty split
+    :func:`_fill_pattern`); without facet integrals on ``W`` (the ghost penalty assembled
     by field) every insertion lies in the pattern and zeros are stored. A nonzero
     outside the pattern (a facet term coupling two fields) is inserted, slowly, never
     dropped: the per-field pattern is an optimisation, not an assumption. Set before

@@ -7,7 +7,7 @@ One application to a residual ``r`` (a petsc4py Python PC, ``pc_type = python``)
    augmentation, ``bonded``, does not put into ``A_uu``, leaving the inclusion floating
    there): the displacement block by one V-cycle of a two-level multigrid, degree 2
    on degree 1 (the interpolation ``P`` from each field's vertex values,
-   :func:`xfem_contact.mechanics.splits.vertex_interpolation`). The fine level is
+   :func:`xfem_contact.mechanics.fieldsplit_data.vertex_interpolation`). The fine level is
    ``A_uu`` read in place from ``J`` (a virtual sub-matrix: no copy), smoothed by
    Chebyshev-Jacobi; the coarse level ``P^T A_uu P + (B P)^T (B P)`` (augmented: it
    holds the floating bodies) by algebraic multigrid (GAMG with the rigid modes), so
@@ -17,8 +17,8 @@ One application to a residual ``r`` (a petsc4py Python PC, ``pc_type = python``)
    displacements of the cut cells and their facet neighbours (where the ghost penalty
    acts) and every multiplier.
 
-Algebraic multigrid alone (GAMG on ``A_uu``, with the multipliers by a Schur field
-split) does not suffice: the ghost-penalty rows make the degree-2 operator hard to
+Algebraic multigrid alone (GAMG on ``A_uu``, with the multipliers by a Schur
+fieldsplit) does not suffice: the ghost-penalty rows make the degree-2 operator hard to
 aggregate, and the multipliers couple only through the band. With the band solved
 exactly and the bulk by the p-multigrid, the Krylov iteration count does not grow with
 the mesh size nor with tiny cuts (measured by ``bench/iterative.py``). The band has
@@ -58,7 +58,7 @@ class BandMultigrid:
         self._built = False
 
     def configure(self, u: PETSc.IS, band: PETSc.IS, modes: list[PETSc.Vec], interpolation):
-        """Give the splits. Collective.
+        """Give the fieldsplits. Collective.
 
         Args:
             u: The displacement unknowns (owned, global indices of the operator).
@@ -214,7 +214,7 @@ def _prolongation(
     coarse_cols = np.rint(gather(number, cols)).astype(PETSc.IntType)
     number.destroy()
     if np.any(coarse_cols < 0) or not np.all(np.isin(rows, owned_u)):
-        raise RuntimeError("BandMultigrid: the interpolation does not fit the splits")
+        raise RuntimeError("BandMultigrid: the interpolation does not fit the fieldsplits")
     order = np.lexsort((coarse_cols, rows))
     rows, coarse_cols, weights = rows[order], coarse_cols[order], weights[order]
     indptr = np.searchsorted(rows, np.arange(first, last + 1)).astype(PETSc.IntType)

@@ -63,7 +63,7 @@ def tip_scaling(space: EnrichedSpace, R: PETSc.Mat, J: PETSc.Mat) -> PETSc.Mat:
 
     Args:
         space: The enriched space, with a crack (``space.branch_field`` set).
-        R: Its restriction operator (full x reduced).
+        R: Its prolongation (full x reduced).
         J: The unscaled reduced Jacobian ``R^T J R`` (not modified).
 
     Returns:

@@ -1,7 +1,7 @@
 """The Jacobian of a residual on a mixed space, as the forms the Newton solver uses.
 
 :class:`JacobianForms` compiles ``dF/dw``: with the fields' own spaces (and a
-restriction that selects dofs) the field blocks of the uncut cells and interior
+prolongation that selects dofs) the field blocks of the uncut cells and interior
 facets apart from the rest
 (:func:`xfem_contact.fem.field_blocks.uncut_field_blocks`), for
 :class:`~xfem_contact.solvers.assembly.ReducedMatrix`; and lifts a residual with the

@@ -106,7 +106,7 @@ def solve_reduced(
     """
     if (petsc_options or {}).get("pc_type") == "python":
         raise ValueError(
-            "solver.linear = 'iterative' (the band multigrid) preconditions the Newton "
+            "solver preset 'iterative' (the band multigrid) preconditions the Newton "
             "steps of contact problems; a linear problem (interfaces 'bonded' or 'free' "
             "only) takes 'direct'"
         )

@@ -22,11 +22,12 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from xfem_contact._deprecation import renamed
+from xfem_contact._deprecation import renamed, renamed_keyword
 from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.forms import form_parts
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
 from xfem_contact.solvers.block_scaling import TipFactor
+from xfem_contact.solvers.fieldsplit_sets import fieldsplit_sets
 from xfem_contact.solvers.jacobian import JacobianForms
 from xfem_contact.solvers.options import (
     REFACTOR_AFTER,
@@ -36,7 +37,6 @@ from xfem_contact.solvers.options import (
 )
 from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
-from xfem_contact.solvers.split_sets import split_sets
 from xfem_contact.solvers.symmetry import mark_symmetric
 
 logger = logging.getLogger(__name__)
@@ -77,15 +77,15 @@ class ReducedNewton:
             a unique one.
         status: Called with ``w`` at every iterate, on every process; returns a
             dict shown in the log.
-        splits: For a ``fieldsplit`` preconditioner, or the band multigrid of the
-            ``"iterative"`` preset of :data:`~xfem_contact.solvers.options.PRESETS`
-            (which reads ``"u"`` and ``"band"``): split name to the
+        fieldsplit_dofs: For a ``fieldsplit`` preconditioner, or the band multigrid of
+            the ``"iterative"`` preset of :data:`~xfem_contact.solvers.options.PRESETS`
+            (which reads ``"u"`` and ``"band"``): fieldsplit name to the
             local dofs of ``W`` it holds: shape ``(n,)``, the reduced unknowns touching
             them; or ``(n, bs)``, blocks of dofs that are reduced unknowns themselves
             (a node's components), kept together as blocks of size ``bs`` (what
             algebraic multigrid needs for elasticity). Ignored by other preconditioners.
         near_nullspace: Functions on ``W`` (e.g. rigid modes) given, reduced and
-            orthonormalised, as the near null space of the split named ``"u"``.
+            orthonormalised, as the near null space of the fieldsplit named ``"u"``.
         couplings: Terms assembled outside UFL (e.g. the large-sliding hybrid
             elements of :class:`~xfem_contact.mechanics.sliding.coupling.SlidingCoupling`):
             objects with ``bind(columns, bcs)``, ``begin_step(w)``,
@@ -94,7 +94,7 @@ class ReducedNewton:
             selecting ``R`` (no multiplier prolongation).
         interpolation: For the band multigrid (the ``"iterative"`` preset): ``(rows,
             cols, weights)`` on local dofs of ``W``
-            (:func:`xfem_contact.mechanics.splits.vertex_interpolation`), or ``None``.
+            (:func:`xfem_contact.mechanics.fieldsplit_data.vertex_interpolation`), or ``None``.
         field_space: ``field_space(i)``: field ``i``'s own space and the parent dofs
             (:meth:`EnrichedSpace.field_space
             <xfem_contact.fem.enrichment.EnrichedSpace.field_space>`). With a selecting
@@ -105,7 +105,8 @@ class ReducedNewton:
             :func:`~xfem_contact.solvers.block_scaling.tip_scaling`): each Newton step
             then factors ``Z^T J_r Z`` (:class:`~xfem_contact.solvers.block_scaling.TipFactor`);
             SNES's unknowns and residual norms stay ``D``-scaled. Not with couplings or a
-            split preconditioner.
+            fieldsplit preconditioner.
+        splits: Deprecated name of ``fieldsplit_dofs``.
     """
 
     def __init__(
@@ -117,13 +118,18 @@ class ReducedNewton:
         petsc_options: dict | None = None,
         petsc_options_prefix: str | None = None,
         status: Callable[[dolfinx.fem.Function], dict] | None = None,
-        splits: dict[str, np.ndarray] | None = None,
+        fieldsplit_dofs: dict[str, np.ndarray] | None = None,
         near_nullspace: list[dolfinx.fem.Function] | None = None,
         couplings: list | None = None,
         interpolation=None,
         field_space: Callable | None = None,
         transform: Callable[[PETSc.Mat, PETSc.Mat], PETSc.Mat] | None = None,
+        *,
+        splits: dict[str, np.ndarray] | None = None,
     ):
+        fieldsplit_dofs = renamed_keyword(
+            "ReducedNewton", "splits", "fieldsplit_dofs", splits, fieldsplit_dofs
+        )
         self.w, self.bcs, self.R = w, bcs, R
         self.couplings = list(couplings or [])
         timer = phase("Newton set-up: selection")
@@ -191,13 +197,13 @@ class ReducedNewton:
                 self.snes.setMaxLinearSolveFailures(self.snes.getTolerances()[3])
             #: The factorisation through the tip enrichment's change of unknowns, or None
             self.tip = None if Z is None else TipFactor(self.snes, Z, self.D, self._symmetric)
-        self._split_objects = split_sets(
+        self._fieldsplit_objects = fieldsplit_sets(
             self.snes.getKSP().getPC(),
             self.R,
             self.D,
             self.w,
             self.jacobian.selection,
-            splits or {},
+            fieldsplit_dofs or {},
             near_nullspace or [],
             interpolation,
         )
@@ -369,7 +375,7 @@ class ReducedNewton:
             self.P.destroy()
         for coupling in self.couplings:
             coupling.destroy()
-        for obj in (self.snes, self.b, self.y, self.F_r, self.R, self.D, *self._split_objects):
+        for obj in (self.snes, self.b, self.y, self.F_r, self.R, self.D, *self._fieldsplit_objects):
             obj.destroy()
         if self.tip is not None:
             self.tip.destroy()

@@ -28,6 +28,8 @@ import typing
 
 from petsc4py import PETSc
 
+from xfem_contact._deprecation import renamed
+
 #: The solvers that have defaults in :data:`SOLVER_OPTIONS`
 SOLVERS = ("linear", "newton")
 
@@ -104,15 +106,16 @@ SOLVER_OPTIONS: dict[str, Option] = {
 #: many iterations
 REFACTOR_AFTER = 20
 
-#: The preconditioners that take the fields apart (a field split, the band multigrid):
-#: they read the diagonal scaling, so a crack's solve does without the change of unknowns
-SPLIT_PRECONDITIONERS = ("fieldsplit", "python")
+#: The preconditioners that take the fields apart (PETSc's fieldsplit, the band
+#: multigrid): they read the diagonal scaling, so a crack's solve does without the change
+#: of unknowns
+FIELDSPLIT_PRECONDITIONERS = ("fieldsplit", "python")
 
 
 def uses_fieldsplit(options: dict) -> bool:
-    """Whether ``options`` choose a preconditioner of :data:`SPLIT_PRECONDITIONERS`.
+    """Whether ``options`` choose a preconditioner of :data:`FIELDSPLIT_PRECONDITIONERS`.
     Not collective."""
-    return options.get("pc_type") in SPLIT_PRECONDITIONERS
+    return options.get("pc_type") in FIELDSPLIT_PRECONDITIONERS
 
 
 class Facts(typing.NamedTuple):
@@ -191,7 +194,7 @@ PRESETS: dict[str, Preset] = {
     "crack": Preset(
         {"mat_mumps_icntl_14": 100},
         "a crack's tip enrichment without the change of unknowns "
-        "(xfem_contact.solvers.block_scaling): a split preconditioner, or large sliding",
+        "(xfem_contact.solvers.block_scaling): a fieldsplit preconditioner, or large sliding",
         "100 % more MUMPS workspace: the branch functions are then nearly dependent on the "
         "polynomials far from the tip and the delayed pivots outgrow the default workspace "
         "(INFO(1) = -9)",
@@ -392,3 +395,6 @@ def applied_options(prefix: str, options: dict[str, OptionValue]):
         database = PETSc.Options()
         for key in options:
             database.delValue(f"{prefix}{key}")
+
+
+__getattr__ = renamed(__name__, {"SPLIT_PRECONDITIONERS": "FIELDSPLIT_PRECONDITIONERS"}, globals())

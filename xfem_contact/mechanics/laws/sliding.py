@@ -47,7 +47,7 @@ class SlidingContact(ContactLaw):
         pairing: ``"iterate"`` (pair at every Newton iterate) or ``"step"`` (pair at
             the start of each load step).
         radius: Search radius of the pairing (m); default the largest cut-cell size.
-        segments: Segment-to-segment integration: each slave piece split where the
+        segments: Segment-to-segment integration: each slave piece broken where the
             feet of its points cross master-piece ends, a Gauss rule per sub-segment
             (:mod:`~xfem_contact.mechanics.sliding.segments`); False: the interface
             rule's points. An attribute, settable between solves.

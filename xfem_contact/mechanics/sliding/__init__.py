@@ -5,7 +5,7 @@ motion its two lips (side -1 and side +1 of the Heaviside-enriched field) no lon
 face each other at the same reference point. Every slave quadrature point is paired,
 in the deformed configuration, with its closest point on the deformed master lip
 (:mod:`~xfem_contact.mechanics.sliding.lips`, :mod:`~xfem_contact.mechanics.sliding.projection`),
-the slave pieces first split where their feet cross master-piece ends, one Gauss rule
+the slave pieces first broken where their feet cross master-piece ends, one Gauss rule
 per sub-segment (:mod:`~xfem_contact.mechanics.sliding.segments`);
 the hybrid element of each pair couples the slave cell's displacement and multiplier
 dofs with the master cell's displacement dofs

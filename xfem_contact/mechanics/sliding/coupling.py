@@ -2,7 +2,7 @@
 
 :class:`SlidingCoupling` is what a large-sliding law hands the Newton solver
 (:meth:`~xfem_contact.mechanics.laws.base.InterfaceLaw.coupling`): at every residual
-evaluation it splits the slave pieces at the master-piece ends their feet cross
+evaluation it breaks the slave pieces at the master-piece ends their feet cross
 (:mod:`~xfem_contact.mechanics.sliding.segments`), pairs the sub-segments' Gauss
 points with the deformed master lip
 (:mod:`~xfem_contact.mechanics.sliding.projection`) and adds the hybrid element terms
@@ -11,7 +11,7 @@ by global dof (a master dof may live on another process: PETSc sends it there); 
 every Jacobian it adds their matrix, in the reduced numbering, through a COO matrix
 whose pattern (slave cell x master cell pairs) is merged into the Jacobian's when a
 pair appears that the Jacobian has not held yet
-(:mod:`~xfem_contact.mechanics.sliding.blocks`), with the motion of the split points.
+(:mod:`~xfem_contact.mechanics.sliding.blocks`), with the motion of the breakpoints.
 SI units (m, Pa).
 """
 
@@ -21,6 +21,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from xfem_contact._deprecation import renamed_attribute
 from xfem_contact.fem.evaluation import rule_cells
 from xfem_contact.mechanics.sliding.blocks import BlockMatrix, cell_pairs, role
 from xfem_contact.mechanics.sliding.element import PairTerms, frictionless_terms
@@ -33,8 +34,8 @@ from xfem_contact.mechanics.sliding.projection import Pairing, closest_points
 from xfem_contact.mechanics.sliding.segments import (
     Segments,
     SlavePieces,
-    split,
-    split_gradient,
+    break_pieces,
+    breakpoint_gradient,
 )
 
 #: When the master lip is paired: at every Newton iterate, or once per load step
@@ -47,10 +48,10 @@ class SlidingCoupling:
     The state (:meth:`evaluate`: gaps, multipliers, pairing counts) is at the points
     of the interface's rule. The terms added to the Newton system are integrated, when
     the law's ``segments`` is true, by segment-to-segment rules
-    (:mod:`~xfem_contact.mechanics.sliding.segments`): the slave pieces split where
-    their feet cross master-piece ends, the split points taken at the iterate and
+    (:mod:`~xfem_contact.mechanics.sliding.segments`): the slave pieces broken where
+    their feet cross master-piece ends, the breakpoints taken at the iterate and
     held fixed in its Jacobian (their motion enters only through the discontinuity of
-    the integrand at a split, which vanishes with the master's kink); else by the
+    the integrand at a breakpoint, which vanishes with the master's kink); else by the
     rule's own points.
 
     Args:
@@ -62,7 +63,7 @@ class SlidingCoupling:
         radius: Search radius (m); default the largest cut-cell size of the
             interface.
         update: ``"iterate"`` (pair at every Newton iterate) or ``"step"`` (pair at
-            the start of each solve and keep the master pieces, and the split points;
+            the start of each solve and keep the master pieces, and the breakpoints;
             the feet still move along them).
 
     Construction is collective; the solver then calls :meth:`bind`.
@@ -96,7 +97,7 @@ class SlidingCoupling:
         self.points = self._points(cells, rules.points, rules.weights * np.abs(np.linalg.det(J)))
         self.pieces = SlavePieces(cut, V_s, self.rows, cut.quadrature_degree)
         _, X, _ = self.pieces.rule(self.pieces.whole())
-        # the rule's points are the pieces' Gauss points in order: their feet help split
+        # the rule's points are the pieces' Gauss points in order: their feet help break
         self._ordered = X.shape == rules.points.shape and np.allclose(X, rules.points, atol=1e-12)
         self._paired: tuple | None = None
         self._materials = ctx.materials
@@ -110,9 +111,9 @@ class SlidingCoupling:
         self._accepted_cells: np.ndarray | None = None
         self._blocks = BlockMatrix()
         self._cells = cut.mesh.topology.index_map(cut.mesh.topology.dim).size_global
-        #: Linearise the motion of the split points (iterate pairing): the jump of
-        #: the integrand at each split point times the point's derivative
-        self.split_linearisation = True
+        #: Linearise the motion of the breakpoints (iterate pairing): the jump of
+        #: the integrand at each breakpoint times the point's derivative
+        self.breakpoint_linearisation = True
         #: Frictionless through the complex-step element too (a cross-check)
         self.complex_step = False
         #: ``(slip increment (m), lambda_t, P_t (Pa))`` at the points (Coulomb)
@@ -162,6 +163,10 @@ class SlidingCoupling:
         self._columns = columns
         self._blocks.reset()
         self._integrated = self._paired = None
+
+    split_linearisation = renamed_attribute(
+        "SlidingCoupling", "split_linearisation", "breakpoint_linearisation"
+    )
 
     # -- evaluation ------------------------------------------------------------------
     def evaluate(self, w, jacobian: bool = True) -> tuple[Pairing, PairTerms]:
@@ -214,7 +219,7 @@ class SlidingCoupling:
                 piece, count = self._pair(w)[1].piece, self.pieces.size  # none on a process
                 feet = piece.reshape(count, piece.size // max(count, 1))
             self.lip.refresh(w)
-            segments = split(self.pieces, w.x.array, self.lip, self.radius, feet)
+            segments = break_pieces(self.pieces, w.x.array, self.lip, self.radius, feet)
         self.lip.refresh(w)
         segment, X, weights = self.pieces.rule(segments)
         points = self._points(self.pieces.cells[segments.piece[segment]], X, weights)
@@ -222,20 +227,20 @@ class SlidingCoupling:
         pairing = closest_points(self.lip, x_s, self.radius, only=segments.master[segment])
         terms, _ = self._terms(w, points, x_s, pairing)
         motion = None
-        if self._frozen_segments is None and self.split_linearisation:
-            motion = self._split_terms(w, segments)
+        if self._frozen_segments is None and self.breakpoint_linearisation:
+            motion = self._breakpoint_terms(w, segments)
         self._integrated = (w.x.array.copy(), points, pairing, terms, motion)
         return points, pairing, terms
 
-    def _split_terms(self, w, segments: Segments):
-        """The Jacobian block of the split points' motion: at each split point, the
+    def _breakpoint_terms(self, w, segments: Segments):
+        """The Jacobian block of the breakpoints' motion: at each breakpoint, the
         integrand's jump (left sub-segment's minus right's, per unit ``t``) times the
         point's derivative. ``(rows (b, 2 nz), cols (b, nc), values (b, 2 nz, nc),
         the (row, column) pairs of cells it couples
         (:func:`~xfem_contact.mechanics.sliding.blocks.cell_pairs`)``, None without
-        splits."""
+        breakpoints."""
         lip = self.lip
-        k, grad = split_gradient(self.pieces, w.x.array, lip, segments)
+        k, grad = breakpoint_gradient(self.pieces, w.x.array, lip, segments)
         if k.size == 0:
             return None
         piece = segments.piece[k]
@@ -307,8 +312,9 @@ class SlidingCoupling:
         return terms, (s_t, lam_t, P_t)
 
     def begin_step(self, w) -> None:
-        """At the start of a solve: with ``update="step"``, pair (and split) now and
-        keep the master pieces (and split points) over the solve. Collective."""
+        """At the start of a solve: with ``update="step"``, pair (and break the slave
+        pieces) now and keep the master pieces (and breakpoints) over the solve.
+        Collective."""
         if self.update_mode == "step":
             self._frozen = self._frozen_segments = None
             self._paired = None
@@ -317,7 +323,7 @@ class SlidingCoupling:
             self._evaluated = self._integrated = self._paired = None
             if self.segments:
                 self.lip.refresh(w)
-                self._frozen_segments = split(self.pieces, w.x.array, self.lip, self.radius)
+                self._frozen_segments = break_pieces(self.pieces, w.x.array, self.lip, self.radius)
 
     def accept(self, w) -> None:
         """The end of an accepted load step: pairs whose master cell changes are

@@ -1,11 +1,12 @@
-"""Segment-to-segment integration: slave pieces split where their feet cross master-piece ends.
+"""Segment-to-segment integration: slave pieces broken where their feet cross master-piece ends.
 
 A slave piece is a SEG3 of a cut cell on the slave side, ``X(t)``, ``t in [0, 1]``, in
 the cell's reference coordinates; deformed, ``x_s(t) = F_c(X(t)) + u_s(X(t))``. The
 foot of ``x_s(t)`` on the master lip passes from one master piece to the next where it
 reaches a piece end ``x_e`` (tangent ``t_e``): ``h(t) = (x_s(t) - x_e) . t_e = 0``.
 There the master field's derivative jumps (C0 between cells), so a Gauss rule across
-such a point integrates a kink. :func:`split` finds these points (Newton on ``t``) for
+such a point integrates a kink. :func:`break_pieces` finds these *breakpoints* (Newton on
+``t``) for
 both ends of every master piece that the feet of the slave piece's ends and of its
 rule points (or of :data:`SAMPLES`) reach (the ends of an unreached piece lying
 between two reached ones are theirs too; two unreached pieces in a row would be
@@ -13,7 +14,7 @@ missed) and cuts each slave piece there into sub-segments. Each sub-segment gets
 own Gauss rule (:meth:`SlavePieces.rule`, weights scaled by its length) and one master
 piece, that of its midpoint's foot (past a crossing into a piece, that piece; between
 the two crossings of one corner of the lip, the previous sub-segment's), on which all
-its points are projected. Geometry only, no physics; local (each process splits its
+its points are projected. Geometry only, no physics; local (each process breaks its
 own slave pieces against the whole lip). SI units (m).
 """
 
@@ -25,6 +26,7 @@ import basix
 import numpy as np
 import numpy.typing as npt
 
+from xfem_contact._deprecation import renamed
 from xfem_contact.fem.evaluation import cell_dofs, lagrange_element
 from xfem_contact.geometry.cut_topology import seg3_basis
 from xfem_contact.mechanics.sliding.element import node_slots
@@ -35,7 +37,7 @@ from xfem_contact.mechanics.sliding.projection import closest_points
 SAMPLES = np.linspace(0.0, 1.0, 5)
 #: Sub-segments shorter than this (in ``t``) are dropped (two roots at one point)
 MIN_LENGTH = 1e-12
-#: Crossings this close (in ``t``) to an end of the slave piece are not split points:
+#: Crossings this close (in ``t``) to an end of the slave piece are not breakpoints:
 #: aligned pieces (a slave node over a master node) would otherwise get slivers of
 #: round-off length paired with either neighbour in turn, a new Jacobian pattern at
 #: every iterate; the kink left inside the piece's rule costs ``TOUCH^2`` of its
@@ -55,7 +57,7 @@ class Segments(typing.NamedTuple):
         t0, t1: Its parameter interval on the piece, ``(k,)``.
         master: Master piece (index into the lip) of its points, ``(k,)``; -1: none
             within the search radius (unpaired).
-        start_master, start_end: Where ``t0`` is a split point (the previous
+        start_master, start_end: Where ``t0`` is a breakpoint (the previous
             sub-segment on the same piece ends there): the master piece and its end
             (0.0 or 1.0) whose crossing it is, ``(k,)``; -1 where ``t0`` is fixed.
     """
@@ -76,7 +78,7 @@ class SlavePieces:
         V: The slave displacement space (``W.sub(field)``).
         rows: Cut-cell rows whose pieces carry the interface's rule.
         degree: Degree of the Gauss-Legendre rule of each (sub-)segment (the cut's
-            quadrature degree: unsplit, the rule is the cut's interface rule).
+            quadrature degree: unbroken, the rule is the cut's interface rule).
 
     Attributes:
         seg: Piece nodes (a, b, mid) in reference coordinates, ``(P, 3, 2)``.
@@ -157,7 +159,7 @@ class SlavePieces:
         return segment, X, w * speed
 
     def whole(self) -> Segments:
-        """Every piece unsplit, without master pieces (the cut's own rule)."""
+        """Every piece unbroken, without master pieces (the cut's own rule)."""
         P = self.size
         none = np.full(P, -1)
         return Segments(np.arange(P), np.zeros(P), np.ones(P), none, none, np.zeros(P))
@@ -194,8 +196,11 @@ def _roots(pieces: SlavePieces, values, lip, slave, master, x0, x1, iterations=3
     return slave, t, master, ends, entering
 
 
-def split(pieces: SlavePieces, values: np.ndarray, lip, radius: float, feet=None) -> Segments:
-    """Split the slave pieces at the crossings of master-piece ends (see the module).
+def break_pieces(
+    pieces: SlavePieces, values: np.ndarray, lip, radius: float, feet=None
+) -> Segments:
+    """Break the slave pieces at their breakpoints, the crossings of master-piece ends
+    (see the module).
 
     Args:
         pieces: The slave pieces.
@@ -235,7 +240,7 @@ def split(pieces: SlavePieces, values: np.ndarray, lip, radius: float, feet=None
     keep = (piece[1:] == piece[:-1]) & (t[1:] - t[:-1] > MIN_LENGTH)
     piece, t0, t1 = piece[:-1][keep], t[:-1][keep], t[1:][keep]
     source, end, entering = source[:-1][keep], end[:-1][keep], entering[order][:-1][keep]
-    # a split point ends the previous sub-segment of its piece (else it is not one)
+    # a breakpoint ends the previous sub-segment of its piece (else it is not one)
     after = np.r_[False, piece[1:] == piece[:-1]] & np.r_[False, t0[1:] == t1[:-1]]
     source = np.where(after, source, -1)
     mid, _ = pieces.curve(values, piece, 0.5 * (t0 + t1))
@@ -261,9 +266,9 @@ def split(pieces: SlavePieces, values: np.ndarray, lip, radius: float, feet=None
     return Segments(piece, t0, t1, master, source, end)
 
 
-def split_gradient(pieces: SlavePieces, values: np.ndarray, lip, segments: Segments):
-    """How the split points move with the dofs: ``(k, grad)``, ``k`` the sub-segments
-    that start at a split point ``(b,)`` and ``grad`` ``(b, 2 nn_s + 2 nn_m)`` the
+def breakpoint_gradient(pieces: SlavePieces, values: np.ndarray, lip, segments: Segments):
+    """How the breakpoints move with the dofs: ``(k, grad)``, ``k`` the sub-segments
+    that start at a breakpoint ``(b,)`` and ``grad`` ``(b, 2 nn_s + 2 nn_m)`` the
     derivative of that point's ``t`` in the slave piece's displacement dofs and in
     those of the master piece whose end it crosses (node by node), from ``h(t) = 0``:
     ``dt = -(dh/dz) / (dh/dt)``. Local."""
@@ -278,3 +283,8 @@ def split_gradient(pieces: SlavePieces, values: np.ndarray, lip, segments: Segme
     )
     dh_dt = np.sum(dx * end.t, axis=1)
     return k, -dh / np.where(dh_dt != 0.0, dh_dt, np.inf)[:, None]
+
+
+__getattr__ = renamed(
+    __name__, {"split": "break_pieces", "split_gradient": "breakpoint_gradient"}, globals()
+)

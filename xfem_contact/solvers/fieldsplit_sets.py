@@ -1,4 +1,4 @@
-"""The index sets, near null space and interpolation a split preconditioner of the
+"""The index sets, near null space and interpolation a fieldsplit preconditioner of the
 Newton steps reads (:class:`~xfem_contact.solvers.newton.ReducedNewton`): PETSc's
 ``fieldsplit`` or the band multigrid of
 :class:`~xfem_contact.solvers.band_multigrid.BandMultigrid`, in the reduced, scaled
@@ -14,13 +14,13 @@ from petsc4py import PETSc
 from xfem_contact.solvers.scaling import gather
 
 
-def split_sets(
+def fieldsplit_sets(
     pc: PETSc.PC,
     R: PETSc.Mat,
     D: PETSc.Vec,
     w,
     chosen,
-    splits: dict,
+    fieldsplit_dofs: dict,
     near_nullspace: Iterable,
     interpolation=None,
 ) -> list:
@@ -32,21 +32,22 @@ def split_sets(
 
     Args:
         pc: The Newton steps' preconditioner (its type already set from the options).
-        R: The scaled restriction ``R D``, global shape ``(dim W, n_reduced)``.
+        R: The scaled prolongation ``R D``, global shape ``(dim W, n_reduced)``.
         D: The scaling of the reduced unknowns.
         w: The unknown on ``W`` (for its local sizes).
         chosen: The dof selection of a selecting ``R``
             (:func:`~xfem_contact.solvers.assembly.selection`), or ``None``.
-        splits: Split name to the local dofs of ``W`` it holds, as for
+        fieldsplit_dofs: Fieldsplit name to the local dofs of ``W`` it holds, as for
             :class:`~xfem_contact.solvers.newton.ReducedNewton`.
-        near_nullspace: Functions on ``W`` (any iterable) for the near null space of split ``"u"``.
+        near_nullspace: Functions on ``W`` (any iterable) for the near null space of
+            fieldsplit ``"u"``.
         interpolation: ``(rows, cols, weights)`` on local dofs of ``W``, or ``None``.
 
     Returns:
         The PETSc objects made here, for the caller to destroy.
     """
     kind = pc.getType()
-    if kind not in (PETSc.PC.Type.FIELDSPLIT, PETSc.PC.Type.PYTHON) or not splits:
+    if kind not in (PETSc.PC.Type.FIELDSPLIT, PETSc.PC.Type.PYTHON) or not fieldsplit_dofs:
         return []
     comm = R.getComm()
     first = R.getOwnershipRangeColumn()[0]
@@ -57,7 +58,7 @@ def split_sets(
     column = np.full(n_owned, -1, dtype=np.int64)
     column[single] = columns[indptr[:-1][single]]
     objects, sets = [], []
-    for name, dofs in splits.items():
+    for name, dofs in fieldsplit_dofs.items():
         dofs = np.asarray(dofs)
         if dofs.ndim == 2:  # blocks (a node's components), kept in order and together
             blocks = dofs[np.all(dofs < n_owned, axis=1)]
@@ -114,7 +115,7 @@ def _reduced(interpolation, chosen, D):
 
 def _orthonormalise(vectors: list[PETSc.Vec]) -> list[PETSc.Vec]:
     """Modified Gram-Schmidt (a near null space must be orthonormal): the orthonormal
-    vectors kept, the ones that vanish on the split (e.g. the rigid modes of a body
+    vectors kept, the ones that vanish on the fieldsplit (e.g. the rigid modes of a body
     that lies in the interface layer) destroyed. Collective."""
     kept = []
     for v in vectors:

@@ -1,10 +1,11 @@
-"""Splitting (sub-)cells into four, and straight sub-triangles of uncut ones.
+"""One level of subdivision: (sub-)cells into four children, and straight sub-triangles
+of uncut ones.
 
 Helper of :mod:`xfem_contact.geometry.cut_subdivision` (pure numpy). Cells flagged by
-:func:`xfem_contact.geometry.cut_topology.topology` as needing subdivision are split at
-one parameter per loop edge (:func:`split_parameters`: the mid-points, or
+:func:`xfem_contact.geometry.cut_topology.topology` as needing subdivision are subdivided
+at one parameter per loop edge (:func:`subdivision_parameters`: the mid-points, or
 adaptive points that separate a cap on an edge or a closed interface piece)
-into four children (:func:`split_cells`), all in the reference coordinates of
+into four children (:func:`child_cells`), all in the reference coordinates of
 the root cell. Children are affine images of the reference cell
 (quadrilaterals: axis-parallel rectangles), so the level set on them is again a
 Lagrange interpolant of the root's degree. :func:`straight_triangles` tiles
@@ -26,10 +27,10 @@ from xfem_contact.geometry.cut_topology import (
     loop_edges,
 )
 
-_SPLIT_MARGIN = 1.0 / 16.0  # adaptive split parameters stay in [margin, 1 - margin]
+_MARGIN = 1.0 / 16.0  # adaptive subdivision parameters stay in [margin, 1 - margin]
 
 
-def split_parameters(
+def subdivision_parameters(
     data: CellData,
     phi: np.ndarray,
     neg: np.ndarray,
@@ -37,17 +38,17 @@ def split_parameters(
     through: np.ndarray | None = None,
     across: np.ndarray | None = None,
 ) -> npt.NDArray[np.float64]:
-    """Where to split each loop edge of cells that need subdividing, ``(ncells, nv)``.
+    """Where to subdivide each loop edge of cells that need it, ``(ncells, nv)``.
 
     By default the mid-point (1/2). An edge crossed twice (:data:`TWICE`) is
-    split at the extremum of its polynomial, between the two crossings, so that
+    divided at the extremum of its polynomial, between the two crossings, so that
     a cap of any width is separated in one step. Otherwise a cell with a point
-    ``through`` is split by a line through it: an uncut cell with an interior
+    ``through`` is subdivided by a line through it: an uncut cell with an interior
     sign change (:data:`INTERIOR`) through the lattice point of largest
     opposite value, inside the closed piece (both lines for quadrilaterals,
     the one parallel to edge (1, 2) for triangles); with a direction ``across``
     given, by the one available line most transversal to it. Adaptive parameters are clamped
-    to ``[1/16, 15/16]``. Quadrilaterals split along one ``X`` and one ``Y``
+    to ``[1/16, 15/16]``. Quadrilaterals are subdivided along one ``X`` and one ``Y``
     line, so opposite loop edges get matching parameters (``t_2 = 1 - t_0``,
     ``t_3 = 1 - t_1``).
 
@@ -57,7 +58,7 @@ def split_parameters(
         neg: Topological vertex sides from :func:`~xfem_contact.geometry.cut_topology.topology`,
             ``(ncells, nv)``.
         kind: Flags from :func:`~xfem_contact.geometry.cut_topology.topology`, ``(ncells,)``.
-        through: Optional points to split through, ``(ncells, 2)``, NaN rows: none.
+        through: Optional points to subdivide through, ``(ncells, 2)``, NaN rows: none.
         across: Optional directions to cross there, ``(ncells, 2)``, NaN rows: any.
     """
     n, nv = neg.shape
@@ -68,7 +69,7 @@ def split_parameters(
         values = interior_values(data, phi, interior)
         sign = np.where(neg[interior].any(axis=1), 1.0, -1.0)  # towards the other side
         P[interior] = data.lattice[np.argmax(sign[:, None] * values, axis=1)]
-    P = np.clip(P, _SPLIT_MARGIN, 1.0 - _SPLIT_MARGIN)
+    P = np.clip(P, _MARGIN, 1.0 - _MARGIN)
     t = np.full((n, nv), 0.5)
     has, free = ~np.isnan(P[:, 0]), np.isnan(d[:, 0])
     if data.cell_type == "triangle":
@@ -79,7 +80,7 @@ def split_parameters(
         cross = np.abs(dd[:, [0]] * directions[:, 1] - dd[:, [1]] * directions[:, 0])
         line = np.where(free, 0, np.argmax(cross, axis=1))
         x, y = P[:, 0], P[:, 1]
-        s = np.clip(x + y, _SPLIT_MARGIN, 1.0 - _SPLIT_MARGIN)
+        s = np.clip(x + y, _MARGIN, 1.0 - _MARGIN)
         options = [{0: s, 2: 1.0 - s}, {0: x, 1: 1.0 - x}, {2: 1.0 - y, 1: y}]
         for k, option in enumerate(options):
             rows = has & (line == k)
@@ -92,7 +93,7 @@ def split_parameters(
     start, _, A, B = loop_edges(data, phi)
     tol = TANGENCY * np.abs(phi).max(axis=1)
     double, tstar = double_crossings(start, A, B, neg, tol)
-    tstar = np.clip(np.where(double, tstar, 0.5), _SPLIT_MARGIN, 1.0 - _SPLIT_MARGIN)
+    tstar = np.clip(np.where(double, tstar, 0.5), _MARGIN, 1.0 - _MARGIN)
     if data.cell_type == "triangle":
         t = np.where(double, tstar, t)
     else:  # per axis: the first of the two parallel edges that is crossed twice
@@ -104,11 +105,11 @@ def split_parameters(
     return t
 
 
-def split_cells(data: CellData, vertices: np.ndarray, t: np.ndarray) -> npt.NDArray[np.float64]:
-    """Split cells into four at the loop-edge parameters ``t`` (``(m, nv)``, from
-    :func:`split_parameters`).
+def child_cells(data: CellData, vertices: np.ndarray, t: np.ndarray) -> npt.NDArray[np.float64]:
+    """The four children of cells subdivided at the loop-edge parameters ``t``
+    (``(m, nv)``, from :func:`subdivision_parameters`).
 
-    Triangles split into three corner triangles and a middle one; quadrilaterals
+    Triangles have three corner triangles and a middle one as children; quadrilaterals
     (axis-parallel rectangles in the coordinates of ``vertices``) into four
     rectangles. Children keep the orientation of the parent, and vertices shared
     by siblings are the same floating-point numbers.
@@ -116,7 +117,7 @@ def split_cells(data: CellData, vertices: np.ndarray, t: np.ndarray) -> npt.NDAr
     Args:
         data: Reference-cell data.
         vertices: Vertices of the cells in Basix order, shape ``(m, nv, 2)``.
-        t: Split parameters, shape ``(m, nv)``.
+        t: Subdivision parameters, shape ``(m, nv)``.
 
     Returns:
         Vertices of the children, shape ``(m, 4, nv, 2)``.

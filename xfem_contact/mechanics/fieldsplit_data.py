@@ -1,6 +1,6 @@
-"""What a field-split preconditioner needs to know of a problem's mixed space.
+"""What a fieldsplit preconditioner needs to know of a problem's mixed space.
 
-:func:`field_splits` names the dofs of the displacements (``"u"``: both sides) and of
+:func:`fieldsplit_dofs` names the dofs of the displacements (``"u"``: both sides) and of
 the multipliers (``"lambda"``: every multiplier field); :func:`rigid_modes` gives the
 translations and the rotation of each side, the near null space of the displacement
 block for algebraic multigrid (GAMG). Used by
@@ -21,7 +21,7 @@ from xfem_contact.fem.enrichment import EnrichedSpace
 SIDE_FIELDS = (0, 1)
 
 
-def field_splits(space: EnrichedSpace) -> dict[str, np.ndarray]:
+def fieldsplit_dofs(space: EnrichedSpace) -> dict[str, np.ndarray]:
     """``{"u": nodes, "lambda": dofs}``: local dofs of ``space.W`` (owned and ghost) of
     the displacement fields, one row ``(x, y)`` per node and side, and of the multiplier
     fields (no ``"lambda"`` without a multiplier). Not collective."""
@@ -34,12 +34,12 @@ def field_splits(space: EnrichedSpace) -> dict[str, np.ndarray]:
     for field in SIDE_FIELDS:
         parts = [W.sub(field).sub(c).dofmap.list.ravel() for c in range(W.mesh.geometry.dim)]
         nodes.append(np.unique(np.stack(parts, axis=1), axis=0))
-    splits = {"u": np.concatenate(nodes)}
+    dofs_of = {"u": np.concatenate(nodes)}
     multipliers = [field for field, _, _ in space.multiplier_fields]
     if multipliers:
-        splits["lambda"] = dofs(multipliers)
-    splits["band"] = np.union1d(_band_displacements(space), splits.get("lambda", []))
-    return splits
+        dofs_of["lambda"] = dofs(multipliers)
+    dofs_of["band"] = np.union1d(_band_displacements(space), dofs_of.get("lambda", []))
+    return dofs_of
 
 
 def _band_displacements(space: EnrichedSpace) -> np.ndarray:
