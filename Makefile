@@ -58,6 +58,7 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/moving_interface.py --no-progress
 	$(PY) bench/parameter_sweep.py --no-progress
 	$(PY) bench/crack_convergence.py --no-progress
+	$(PY) bench/inf_sup.py
 	$(PY) bench/cut3d.py --sizes 4 8 16 32
 	$(PY) bench/cut3d.py --fuzz 10000 --sizes
 

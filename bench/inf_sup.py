@@ -1,11 +1,12 @@
 """The numerical inf-sup test of every 2D element: the discrete inf-sup constant
 (:func:`xfem_contact.mechanics.inf_sup.inf_sup_constant`) of P1-P1 and P2-P1 on triangles
-and quadrilaterals, for each LBB treatment (none, restriction, stabilized), on n = 8, 16,
+and quadrilaterals, for each LBB treatment (none, restriction, stabilized; stabilized
+with the ghost penalty raised to the stabilisation's weight, 0.1, too), on n = 8, 16,
 32, 64 cells per side of the unit square, over circles at random centres and radii (a
 third of them passing within 1e-6 h of a mesh node: tiny cuts on purpose). Prints, per
 element, treatment and n, the least and median beta and the count of indefinite pairs
 (beta^2 < 0), and the slope of the least beta in log n over the last pair. Writes
-``bench/results/inf_sup.{json,md}``.
+``bench/results/inf_sup.{json,md,png}``.
 
 Run: ``python bench/inf_sup.py [--circles 50] [--sizes 8 16 32 64]`` (``make bench``).
 """
@@ -32,7 +33,13 @@ from xfem_contact.mechanics.problem import Problem
 
 RESULTS = pathlib.Path(__file__).resolve().parent / "results"
 ELEMENTS = [("triangle", 1), ("triangle", 2), ("quadrilateral", 1), ("quadrilateral", 2)]
-TREATMENTS = ["none", "restriction", "stabilized"]
+#: label: (lbb, ghost penalty; None: the default)
+TREATMENTS = {
+    "none": ("none", None),
+    "restriction": ("restriction", None),
+    "stabilized": ("stabilized", None),
+    "stabilized, ghost 0.1": ("stabilized", 0.1),
+}
 
 
 def circles(count: int, n: int, rng) -> list[tuple[float, float, float]]:
@@ -77,7 +84,7 @@ def main() -> None:
     args = parser.parse_args()
     rows = []
     for cell, degree in ELEMENTS:
-        for lbb in TREATMENTS:
+        for lbb, (treatment, ghost_penalty) in TREATMENTS.items():
             for n in args.sizes:
                 mesh = dolfinx.mesh.create_unit_square(
                     MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType[cell]
@@ -86,7 +93,9 @@ def main() -> None:
                 for cx, cy, r in circles(args.circles, n, np.random.default_rng(n)):
                     circle = lambda x, c=(cx, cy), r=r: np.hypot(x[0] - c[0], x[1] - c[1]) - r  # noqa: E731
                     cut = CutMesh(mesh, circle, degree=2)
-                    problem = Problem(cut, degree, Material(100e6, 0.3), Bonded(lbb=lbb))
+                    law = Bonded(lbb=treatment)
+                    material = Material(100e6, 0.3)
+                    problem = Problem(cut, degree, material, law, ghost_penalty=ghost_penalty)
                     b2.append(inf_sup_constant(problem).beta_squared)
                 b = np.sqrt(np.maximum(b2, 0.0))
                 rows.append(
@@ -102,7 +111,7 @@ def main() -> None:
                     }
                 )
                 note(
-                    f"{cell:13s} P{degree}-P1 {lbb:11s} n={n:3d}: beta min {b.min():.3e} "
+                    f"{cell:13s} P{degree}-P1 {lbb:21s} n={n:3d}: beta min {b.min():.3e} "
                     f"median {np.median(b):.3e}, indefinite {rows[-1]['indefinite']}/"
                     f"{len(b2)} ({time.perf_counter() - start:.1f} s)"
                 )
