@@ -38,6 +38,7 @@ def vital_vertex_prolongation(
     comm = mesh.comm
     mesh.topology.create_connectivity(tdim, 1)
     mesh.topology.create_connectivity(1, 0)
+    mesh.topology.create_connectivity(0, tdim)  # entities_to_geometry of the vertices
     c2e = mesh.topology.connectivity(tdim, 1)
     e2v = mesh.topology.connectivity(1, 0)
     vmap = mesh.topology.index_map(0)
