@@ -62,26 +62,42 @@ HEXAHEDRA = _split()
 """Corners of the four hexahedra of the reference tetrahedron, shape ``(4, 8, 3)``."""
 
 
+def _trilinear() -> np.ndarray:
+    """Monomial coefficients ``(4, 8, 3)`` of the four hexahedron maps: row ``a + 2 b + 4 c``
+    of ``u^a v^b w^c``."""
+    P = np.transpose(HEXAHEDRA.reshape(4, 2, 2, 2, 3), (0, 3, 2, 1, 4))  # [k, u, v, w]
+    D = np.array([[1.0, 0.0], [-1.0, 1.0]])  # (1 - t, t) -> (1, t)
+    M = np.einsum("ai,bj,cl,kijlx->kcbax", D, D, D, P)  # [k, c, b, a]: w slowest
+    return M.reshape(4, 8, 3)
+
+
+_MONOMIALS = _trilinear()
+
+
 def hexahedron_map(U: npt.NDArray[np.float64], k: int) -> tuple[np.ndarray, np.ndarray]:
     """The trilinear map of hexahedron ``k`` at cube points ``U`` ``(N, 3)``: tetrahedron
     points ``(N, 3)`` and Jacobians ``dM/dU`` ``(N, 3, 3)``."""
-    P = np.transpose(HEXAHEDRA[k].reshape(2, 2, 2, 3), (2, 1, 0, 3)).reshape(8, 3)  # (u, v, w)
-    lin = [np.stack([1.0 - U[:, d], U[:, d]], axis=1) for d in range(3)]  # (N, 2) each
-    step = np.broadcast_to([-1.0, 1.0], lin[0].shape)
+    X, du, dv, dw = _trilinear_map(U, _MONOMIALS[k])
+    return X.T, np.stack([du.T, dv.T, dw.T], axis=2)
 
-    def corners(a, b, c):  # (N, 8) products, u slowest
-        return (a[:, :, None, None] * b[:, None, :, None] * c[:, None, None, :]).reshape(-1, 8)
 
-    X = corners(*lin) @ P
-    J = np.stack(
-        [
-            corners(step, lin[1], lin[2]) @ P,
-            corners(lin[0], step, lin[2]) @ P,
-            corners(lin[0], lin[1], step) @ P,
-        ],
-        axis=2,
+def _trilinear_map(U: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Values and the three columns ``dM/du, dM/dv, dM/dw`` of the Jacobian, each
+    ``(3, N)`` (coordinate first), at ``U`` ``(N, 3)`` of the trilinear map with monomial
+    coefficients ``c`` ``(8, 3)``."""
+    u, v, w = np.ascontiguousarray(U.T)
+    m = np.empty((8, u.size))  # 1, u, v, uv, w, uw, vw, uvw
+    m[0], m[1], m[2], m[4] = 1.0, u, v, w
+    np.multiply(u, v, out=m[3])
+    np.multiply(u, w, out=m[5])
+    np.multiply(v, w, out=m[6])
+    np.multiply(m[3], w, out=m[7])
+    return (
+        c.T @ m,
+        c[[1, 3, 5, 7]].T @ m[[0, 2, 4, 6]],
+        c[[2, 3, 6, 7]].T @ m[[0, 1, 4, 5]],
+        c[[4, 5, 6, 7]].T @ m[[0, 1, 2, 3]],
     )
-    return X, J
 
 
 @functools.cache
@@ -114,10 +130,29 @@ def classify_p2_tets(phi: npt.ArrayLike) -> npt.NDArray[np.int8]:
     Returns:
         ``int8`` array of shape ``(ncells,)``.
     """
-    sides = certified_sides(_cube_coefficients(phi)).reshape(-1, 4)
-    return np.where((sides == -1).all(axis=1), -1, np.where((sides == 1).all(axis=1), 1, 0)).astype(
-        np.int8
+    phi = nodal_values(phi, 10, "P2 tetrahedron", "tetrahedron")
+    B = phi @ _to_simplex_bernstein().T
+    side = np.where((B < 0).all(axis=1), -1, np.where((B >= 0).all(axis=1), 1, 0)).astype(np.int8)
+    rest = np.flatnonzero(side == 0)
+    sides = certified_sides(_cube_coefficients(phi[rest])).reshape(-1, 4)
+    side[rest] = np.where((sides == -1).all(axis=1), -1, np.where((sides == 1).all(axis=1), 1, 0))
+    return side
+
+
+@functools.cache
+def _to_simplex_bernstein() -> np.ndarray:
+    """Matrix ``(10, 10)``: P2 nodal values -> Bernstein coefficients on the tetrahedron
+    (a vertex's is its value, an edge's ``2 phi_mid - (phi_a + phi_b) / 2``)."""
+    p2 = basix.create_element(
+        basix.ElementFamily.P, basix.CellType.tetrahedron, 2, basix.LagrangeVariant.gll_warped
     )
+    x = p2.points
+    T = np.eye(10)
+    for node in range(4, 10):
+        ends = [(i, j) for i in range(4) for j in range(i) if np.allclose(2 * x[node], x[i] + x[j])]
+        a, b = ends[0]
+        T[node, node], T[node, a], T[node, b] = 2.0, -0.5, -0.5
+    return T
 
 
 def p2_tet_cut_rules(
@@ -125,6 +160,7 @@ def p2_tet_cut_rules(
     order: int = 4,
     *,
     max_depth: int = MAX_DEPTH,
+    min_depth: int = 0,
     jacobian: Jacobian | None = None,
 ) -> CutRules:
     """Rules of both sides and of the interface of tetrahedra with P2 level sets.
@@ -146,27 +182,47 @@ def p2_tet_cut_rules(
     """
     C = _cube_coefficients(phi)
     ncells = C.shape[0] // 4
-    points = saye_points(C, order, max_depth=max_depth, kind="tetrahedron")
-    sides = []
-    for rows, U, w in (points.minus, points.plus):
-        X, J = _mapped(rows, U)
-        weights = w * np.linalg.det(J)
-        sides.append(rules_from_points(rows // 4, X, weights, ncells))
-    rows, U, w, area = points.interface
-    X, J = _mapped(rows, U)
-    c0, c1, c2 = J[:, :, 0], J[:, :, 1], J[:, :, 2]
-    cofactor = np.stack([np.cross(c1, c2), np.cross(c2, c0), np.cross(c0, c1)], axis=2)
-    area = np.einsum("nij,nj->ni", cofactor, area)  # det(J) J^{-T} a
-    interface = surface_rules(X, area, w, rows // 4, ncells, jacobian)  # rows are sorted
-    reduced = np.unique(points.reduced // 4).astype(np.int64)
-    return CutRules(*sides, interface, reduced)
+    C = C.reshape(ncells, 4, *C.shape[1:])
+    found: dict[str, list[tuple[np.ndarray, ...]]] = {"minus": [], "plus": [], "interface": []}
+    reduced = []
+    for k in range(4):  # hexahedron k of every cell: one map, no scatter
+        points = saye_points(
+            np.ascontiguousarray(C[:, k]),
+            order,
+            max_depth=max_depth,
+            min_depth=min_depth,
+            kind="tetrahedron",
+        )
+        for side in ("minus", "plus"):
+            rows, U, w = getattr(points, side)
+            X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
+            found[side].append((rows, X, w * (c0 * _cross(c1, c2)).sum(axis=0)))  # det dM
+        rows, U, w, area = points.interface
+        X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
+        a0, a1, a2 = area.T
+        area = _cross(c1, c2) * a0 + _cross(c2, c0) * a1 + _cross(c0, c1) * a2  # cof(dM) a
+        found["interface"].append((rows, X, w, area))
+        reduced.append(points.reduced)
+    sides = [rules_from_points(*_merged(found[side]), ncells) for side in ("minus", "plus")]
+    rows, X, w, area = _merged(found["interface"])
+    interface = surface_rules(X, area, w, rows, ncells, jacobian)
+    return CutRules(*sides, interface, np.unique(np.concatenate(reduced)).astype(np.int64))
 
 
-def _mapped(rows: np.ndarray, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Tetrahedron points and ``dM/dU`` of cube points ``U`` of sub-hexahedra ``rows``
-    (row ``4 c + k``: hexahedron ``k`` of cell ``c``)."""
-    X, J = np.empty_like(U), np.empty((U.shape[0], 3, 3))
-    for k in range(4):
-        mine = rows % 4 == k
-        X[mine], J[mine] = hexahedron_map(U[mine], k)
-    return X, J
+def _merged(parts: list[tuple[np.ndarray, ...]]) -> list[np.ndarray]:
+    """Points of the four hexahedra ``(rows, X (3, N), w[, area (3, N)])`` in one list
+    sorted by cell (stable: hexahedron 0 first), vectors as ``(N, 3)``."""
+    rows = np.concatenate([p[0] for p in parts])
+    order = np.argsort(rows, kind="stable")
+    merged = [rows[order]]
+    for column in range(1, len(parts[0])):
+        values = np.concatenate([p[column] for p in parts], axis=-1)
+        merged.append(np.ascontiguousarray(values[..., order].T))
+    return merged
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross products of vectors stored coordinate first, ``(3, N)``."""
+    return np.stack(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )

@@ -180,7 +180,12 @@ class SayePoints:
 
 
 def saye_points(
-    C: np.ndarray, order: int, *, max_depth: int = MAX_DEPTH, kind: str = "hexahedron"
+    C: np.ndarray,
+    order: int,
+    *,
+    max_depth: int = MAX_DEPTH,
+    min_depth: int = 0,
+    kind: str = "hexahedron",
 ) -> SayePoints:
     """Saye's rules (see the module) of polynomials on the unit cube.
 
@@ -189,6 +194,9 @@ def saye_points(
             (:func:`~xfem_contact.geometry.tensor_levelset.coefficients`).
         order: Gauss-Legendre points per interval.
         max_depth: Box subdivision levels.
+        min_depth: Levels of boxes split whenever the interface may cross them, before
+            the axes are chosen (finer boxes for level sets that are not polynomials of
+            low degree in the cell's own coordinates).
         kind: The cells' name in error messages.
 
     Returns:
@@ -201,6 +209,10 @@ def saye_points(
         raise ValueError(f"order must be a positive int (Gauss points per interval), got {order!r}")
     if not (isinstance(max_depth, int) and max_depth >= 0):
         raise ValueError(f"max_depth must be a non-negative int, got {max_depth!r}")
+    if not (isinstance(min_depth, int) and 0 <= min_depth <= max_depth):
+        raise ValueError(
+            f"min_depth must be an int in 0 .. max_depth = {max_depth}, got {min_depth!r}"
+        )
     ncells = C.shape[0]
     gx, gw = np.polynomial.legendre.leggauss(order)
     gauss = (0.5 * (gx + 1.0), 0.5 * gw)
@@ -218,7 +230,10 @@ def saye_points(
         cell, lo, hi = cell[rest], lo[rest], hi[rest]
         if cell.size == 0:
             break
-        pair, height = _choose_axes(C[cell], lo, hi)
+        if depth < min_depth:  # split every box that the interface may cross
+            pair, height = np.full(cell.size, -1), np.full(cell.size, -1)
+        else:
+            pair, height = _choose_axes(C[cell], lo, hi)
         if depth == max_depth:
             bad = np.flatnonzero((pair < 0) & (height < 0))
             if bad.size:
