@@ -183,35 +183,49 @@ def p2_tet_cut_rules(
     C = _cube_coefficients(phi)
     ncells = C.shape[0] // 4
     C = C.reshape(ncells, 4, *C.shape[1:])
-    found: dict[str, list[tuple[np.ndarray, ...]]] = {"minus": [], "plus": [], "interface": []}
+    merged: dict[str, list[list[np.ndarray]]] = {"minus": [], "plus": [], "interface": []}
     reduced = []
-    for k in range(4):  # hexahedron k of every cell: one map, no scatter
-        points = saye_points(
-            np.ascontiguousarray(C[:, k]),
-            order,
-            max_depth=max_depth,
-            min_depth=min_depth,
-            kind="tetrahedron",
-        )
-        for side in ("minus", "plus"):
-            rows, U, w = getattr(points, side)
+    for start in range(0, ncells, _CHUNK):
+        found: dict[str, list[tuple[np.ndarray, ...]]] = {side: [] for side in merged}
+        for k in range(4):  # hexahedron k of every cell: one map, no scatter
+            points = saye_points(
+                np.ascontiguousarray(C[start : start + _CHUNK, k]),
+                order,
+                max_depth=max_depth,
+                min_depth=min_depth,
+                kind="tetrahedron",
+                first=start,
+            )
+            for side in ("minus", "plus"):
+                rows, U, w = getattr(points, side)
+                X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
+                found[side].append((rows + start, X, w * (c0 * _cross(c1, c2)).sum(axis=0)))
+            rows, U, w, area = points.interface
             X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
-            found[side].append((rows, X, w * (c0 * _cross(c1, c2)).sum(axis=0)))  # det dM
-        rows, U, w, area = points.interface
-        X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
-        a0, a1, a2 = area.T
-        area = _cross(c1, c2) * a0 + _cross(c2, c0) * a1 + _cross(c0, c1) * a2  # cof(dM) a
-        found["interface"].append((rows, X, w, area))
-        reduced.append(points.reduced)
-    sides = [rules_from_points(*_merged(found[side]), ncells) for side in ("minus", "plus")]
-    rows, X, w, area = _merged(found["interface"])
+            a0, a1, a2 = area.T
+            area = _cross(c1, c2) * a0 + _cross(c2, c0) * a1 + _cross(c0, c1) * a2  # cof(dM) a
+            found["interface"].append((rows + start, X, w, area))
+            reduced.append(points.reduced + start)
+        for side, parts in found.items():
+            merged[side].append(_merged(parts))
+    rules = {
+        side: [np.concatenate(column) for column in zip(*chunks, strict=True)]
+        for side, chunks in merged.items()
+    }
+    sides = [rules_from_points(*rules[side], ncells) for side in ("minus", "plus")]
+    rows, X, w, area = rules["interface"]
     interface = surface_rules(X, area, w, rows, ncells, jacobian)
     return CutRules(*sides, interface, np.unique(np.concatenate(reduced)).astype(np.int64))
 
 
+_CHUNK = 2048
+"""Cells per batch of :func:`p2_tet_cut_rules`: small batches keep the temporaries small
+enough for the allocator to reuse (fresh large arrays cost page faults)."""
+
+
 def _merged(parts: list[tuple[np.ndarray, ...]]) -> list[np.ndarray]:
-    """Points of the four hexahedra ``(rows, X (3, N), w[, area (3, N)])`` in one list
-    sorted by cell (stable: hexahedron 0 first), vectors as ``(N, 3)``."""
+    """Points of the four hexahedra ``(rows, X (3, N), w[, area (3, N)])`` of a batch in
+    one list sorted by cell (stable: hexahedron 0 first), vectors as ``(N, 3)``."""
     rows = np.concatenate([p[0] for p in parts])
     order = np.argsort(rows, kind="stable")
     merged = [rows[order]]

@@ -186,6 +186,7 @@ def saye_points(
     max_depth: int = MAX_DEPTH,
     min_depth: int = 0,
     kind: str = "hexahedron",
+    first: int = 0,
 ) -> SayePoints:
     """Saye's rules (see the module) of polynomials on the unit cube.
 
@@ -198,6 +199,7 @@ def saye_points(
             the axes are chosen (finer boxes for level sets that are not polynomials of
             low degree in the cell's own coordinates).
         kind: The cells' name in error messages.
+        first: The number of row 0 of ``C`` in error messages.
 
     Returns:
         A :class:`SayePoints`.
@@ -239,7 +241,7 @@ def saye_points(
             if bad.size:
                 b = bad[0]
                 raise ValueError(
-                    f"{kind} {cell[b]}: the level set has a singular point on its zero set "
+                    f"{kind} {first + cell[b]}: the level set has a singular point on its zero set "
                     f"in the box {lo[b].tolist()} .. {hi[b].tolist()} (unit-cube coordinates; "
                     f"no monotone axis after {max_depth} subdivisions); {bad.size} box(es)"
                 )
