@@ -67,7 +67,14 @@ def coefficients(phi: npt.ArrayLike, degree: int) -> npt.NDArray[np.float64]:
 
 
 def _powers(x: np.ndarray, p: int) -> np.ndarray:
-    return x[..., None] ** np.arange(p + 1)
+    """``x^0 .. x^p`` along a new last axis (``p <= 2``; products, as exact as ``**``)."""
+    powers = np.empty((*x.shape, p + 1))
+    powers[..., 0] = 1.0
+    if p >= 1:
+        powers[..., 1] = x
+    if p >= 2:
+        np.multiply(x, x, out=powers[..., 2])
+    return powers
 
 
 def evaluate(C: np.ndarray, X: np.ndarray) -> np.ndarray:
