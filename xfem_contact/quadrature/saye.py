@@ -23,7 +23,8 @@ On a box ``U = [lo, hi]`` of the reference cube, with ``psi`` the cell's level s
    ``grad psi / |d psi / d x_k3|`` (reference coordinates) and the weight of its line.
    Every integrand is smooth between the breakpoints, so the rules converge at the rate
    of Gauss-Legendre rules; all weights are positive.
-4. When no pair is valid the box is split in eight, down to ``max_depth`` levels; a box
+4. When no pair is valid (or above ``min_depth``, for every box the interface may
+   cross) the box is split in eight, down to ``max_depth`` levels; a box
    at that depth that still has none uses the best monotone height axis alone (a
    lower-order rule on a box of size ``2^-max_depth``; the cell is reported in
    :attr:`CutRules.reduced`), and one with no monotone axis at all (a singular
