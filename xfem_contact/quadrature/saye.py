@@ -226,17 +226,18 @@ def saye_points(
     for depth in range(max_depth + 1):
         if cell.size == 0:
             break
-        B = bernstein(C[cell], lo, hi).reshape(cell.size, -1)
-        for side, whole in (("minus", (B < 0).all(axis=1)), ("plus", (B >= 0).all(axis=1))):
+        B = bernstein(C[cell], lo, hi)
+        flat = B.reshape(cell.size, -1)
+        for side, whole in (("minus", (flat < 0).all(axis=1)), ("plus", (flat >= 0).all(axis=1))):
             parts[side].append(_tensor_rule(cell[whole], lo[whole], hi[whole], gauss))
-        rest = ~((B < 0).all(axis=1) | (B >= 0).all(axis=1))
-        cell, lo, hi = cell[rest], lo[rest], hi[rest]
+        rest = ~((flat < 0).all(axis=1) | (flat >= 0).all(axis=1))
+        cell, lo, hi, B = cell[rest], lo[rest], hi[rest], B[rest]
         if cell.size == 0:
             break
         if depth < min_depth:  # split every box that the interface may cross
             pair, height = np.full(cell.size, -1), np.full(cell.size, -1)
         else:
-            pair, height = _choose_axes(C[cell], lo, hi)
+            pair, height = _choose_axes(C[cell], lo, hi, B)
         if depth == max_depth:
             bad = np.flatnonzero((pair < 0) & (height < 0))
             if bad.size:
@@ -269,11 +270,13 @@ def _certain(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (flat > 0).all(axis=1) | (flat < 0).all(axis=1), (flat == 0).all(axis=1)
 
 
-def _choose_axes(C: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _choose_axes(
+    C: np.ndarray, lo: np.ndarray, hi: np.ndarray, B: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Index into ``_PAIRS`` of the best valid ``(k3, k2)`` per box (-1: none) and the best
-    monotone height axis alone (-1: none)."""
+    monotone height axis alone (-1: none); ``B`` are the Bernstein coefficients of ``C``
+    on the boxes."""
     m = C.shape[0]
-    B = bernstein(C, lo, hi)
     D = [bernstein(derivative(C, k), lo, hi) for k in range(3)]
     size = [np.abs(d).reshape(m, -1) for d in D]
     steepest = np.maximum.reduce([a.max(axis=1) for a in size])
@@ -361,25 +364,25 @@ def _box_rules(C, cell, lo, hi, k3, k2, gauss, parts):
     m = cell.size
     # level 1: along k1, split at the roots of psi on the four edges parallel to k1
     roots = []
+    C1 = C[cell]
     for v, w in itertools.product((lo[:, k2], hi[:, k2]), (lo[:, k3], hi[:, k3])):
         X = np.zeros((m, 3))
         X[:, k2], X[:, k3] = v, w
-        roots.append(line_roots(line_coefficients(C[cell], k1, X), lo[:, k1], hi[:, k1]))
+        roots.append(line_roots(line_coefficients(C1, k1, X), lo[:, k1], hi[:, k1]))
     box1, u, w1, _, _ = _pieces(np.concatenate(roots, axis=1), lo[:, k1], hi[:, k1], gauss)
     # level 2: along k2 at each u, split at the roots of the two face functions
     roots = []
+    C1 = C1[box1]
     for end in (lo, hi):
         X = np.zeros((u.size, 3))
         X[:, k1], X[:, k3] = u, end[box1, k3]
-        roots.append(
-            line_roots(line_coefficients(C[cell[box1]], k2, X), lo[box1, k2], hi[box1, k2])
-        )
+        roots.append(line_roots(line_coefficients(C1, k2, X), lo[box1, k2], hi[box1, k2]))
     p1, v, w2, _, _ = _pieces(np.concatenate(roots, axis=1), lo[box1, k2], hi[box1, k2], gauss)
     box2 = box1[p1]
     W = w1[p1] * w2
     X = np.zeros((v.size, 3))
     X[:, k1], X[:, k2] = u[p1], v
-    C2 = C[cell[box2]]
+    C2 = C1[p1]
     lo3, hi3 = lo[box2, k3], hi[box2, k3]
     # level 3: along k3 at each (u, v), split at the roots of psi
     r = line_roots(line_coefficients(C2, k3, X), lo3, hi3)
