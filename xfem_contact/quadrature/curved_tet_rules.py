@@ -98,11 +98,12 @@ def _trilinear_map(U: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, ...]:
     np.multiply(u, w, out=m[5])
     np.multiply(v, w, out=m[6])
     np.multiply(m[3], w, out=m[7])
+    # einsum, not BLAS: a threaded BLAS spends more on these thin products than it saves
     return (
-        c.T @ m,
-        c[[1, 3, 5, 7]].T @ m[[0, 2, 4, 6]],
-        c[[2, 3, 6, 7]].T @ m[[0, 1, 4, 5]],
-        c[[4, 5, 6, 7]].T @ m[[0, 1, 2, 3]],
+        np.einsum("kd,kn->dn", c, m),
+        np.einsum("kd,kn->dn", c[[1, 3, 5, 7]], m[[0, 2, 4, 6]]),
+        np.einsum("kd,kn->dn", c[[2, 3, 6, 7]], m[[0, 1, 4, 5]]),
+        np.einsum("kd,kn->dn", c[[4, 5, 6, 7]], m[:4]),
     )
 
 
