@@ -128,8 +128,8 @@ def _cube_coefficients(phi: npt.ArrayLike) -> np.ndarray:
 
 
 def classify_p2_tets(phi: npt.ArrayLike) -> npt.NDArray[np.int8]:
-    """Side of each tetrahedron certified by the Bernstein coefficients on its four
-    hexahedra: -1, +1, or 0 (possibly cut).
+    """Side of each tetrahedron certified by its own Bernstein coefficients, else by those
+    on its four hexahedra: -1, +1, or 0 (possibly cut).
 
     Args:
         phi: P2 nodal values, shape ``(ncells, 10)`` (Basix order).
