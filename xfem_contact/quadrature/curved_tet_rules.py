@@ -35,13 +35,8 @@ import numpy.typing as npt
 
 from xfem_contact.geometry.cut_topology import nodal_values
 from xfem_contact.geometry.tensor_levelset import coefficients
-from xfem_contact.quadrature.saye import (
-    MAX_DEPTH,
-    CutRules,
-    certified_sides,
-    rules_from_points,
-    saye_points,
-)
+from xfem_contact.quadrature.rules import RuleSet
+from xfem_contact.quadrature.saye import MAX_DEPTH, CutRules, certified_sides, saye_points
 from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
 
 __all__ = ["HEXAHEDRA", "classify_p2_tets", "hexahedron_map", "p2_tet_cut_rules"]
@@ -139,7 +134,7 @@ def classify_p2_tets(phi: npt.ArrayLike) -> npt.NDArray[np.int8]:
     """
     phi = nodal_values(phi, 10, "P2 tetrahedron", "tetrahedron")
     B = phi @ _to_simplex_bernstein().T
-    side = np.where((B < 0).all(axis=1), -1, np.where((B >= 0).all(axis=1), 1, 0)).astype(np.int8)
+    side = np.where(B.max(axis=1) < 0, -1, np.where(B.min(axis=1) >= 0, 1, 0)).astype(np.int8)
     rest = np.flatnonzero(side == 0)
     sides = certified_sides(_cube_coefficients(phi[rest])).reshape(-1, 4)
     side[rest] = np.where((sides == -1).all(axis=1), -1, np.where((sides == 1).all(axis=1), 1, 0))
@@ -217,13 +212,15 @@ def p2_tet_cut_rules(
             found["interface"].append((rows + start, X, w, area))
             reduced.append(points.reduced + start)
         for side, parts in found.items():
-            merged[side].append(_merged(parts))
-    rules = {
-        side: [np.concatenate(column) for column in zip(*chunks, strict=True)]
-        for side, chunks in merged.items()
-    }
-    sides = [rules_from_points(*rules[side], ncells) for side in ("minus", "plus")]
-    rows, X, w, area = rules["interface"]
+            rows, *columns = _merged(parts)
+            if side != "interface":  # keep counts, not rows: offsets need no more
+                rows = np.bincount(rows - start, minlength=min(_CHUNK, ncells - start))
+            merged[side].append([rows, *columns])
+    sides = []
+    for side in ("minus", "plus"):
+        counts, X, w = (np.concatenate(column) for column in zip(*merged[side], strict=True))
+        sides.append(RuleSet(X, w, np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)))
+    rows, X, w, area = (np.concatenate(column) for column in zip(*merged["interface"], strict=True))
     interface = surface_rules(X, area, w, rows, ncells, jacobian)
     return CutRules(*sides, interface, np.unique(np.concatenate(reduced)).astype(np.int64))
 
