@@ -171,3 +171,12 @@ def test_bad_input(phi, match):
 def test_bad_min_depth():
     with pytest.raises(ValueError, match=r"min_depth must be an int in 0 \.\. max_depth = 2"):
         p2_tet_cut_rules(nodes()[:, :1].T - 0.5, min_depth=3, max_depth=2)
+
+
+def test_no_cell_left_open_and_no_cells():
+    """Every cell certified by its own coefficients, and empty input."""
+    phi = np.concatenate([np.ones((2, 10)), -np.ones((1, 10))])
+    np.testing.assert_array_equal(classify_p2_tets(phi), [1, 1, -1])
+    rules = p2_tet_cut_rules(np.zeros((0, 10)))
+    assert rules.minus.offsets.tolist() == [0] and rules.interface.points.shape == (0, 3)
+    assert rules.reduced.dtype == np.int64 and rules.reduced.size == 0

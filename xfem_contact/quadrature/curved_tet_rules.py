@@ -216,13 +216,14 @@ def p2_tet_cut_rules(
             if side != "interface":  # keep counts, not rows: offsets need no more
                 rows = np.bincount(rows - start, minlength=min(_CHUNK, ncells - start))
             merged[side].append([rows, *columns])
+    empty = [np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3))]
     sides = []
     for side in ("minus", "plus"):
-        counts, X, w = (np.concatenate(column) for column in zip(*merged[side], strict=True))
+        counts, X, w = (np.concatenate(c) for c in zip(*merged[side], empty[:3], strict=True))
         sides.append(RuleSet(X, w, np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)))
-    rows, X, w, area = (np.concatenate(column) for column in zip(*merged["interface"], strict=True))
+    rows, X, w, area = (np.concatenate(c) for c in zip(*merged["interface"], empty, strict=True))
     interface = surface_rules(X, area, w, rows, ncells, jacobian)
-    return CutRules(*sides, interface, np.unique(np.concatenate(reduced)).astype(np.int64))
+    return CutRules(*sides, interface, np.unique(np.concatenate([*reduced, empty[0]])))
 
 
 _CHUNK = 2048
