@@ -239,7 +239,7 @@ def _merged(parts: list[tuple[np.ndarray, ...]]) -> list[np.ndarray]:
     merged = [rows[order]]
     for column in range(1, len(parts[0])):
         values = np.concatenate([p[column] for p in parts], axis=-1)
-        merged.append(np.ascontiguousarray(values[..., order].T))
+        merged.append(np.take(values.T, order, axis=0))
     return merged
 
 
