@@ -188,7 +188,12 @@ def p2_tet_cut_rules(
     C = _cube_coefficients(phi)
     ncells = C.shape[0] // 4
     C = C.reshape(ncells, 4, *C.shape[1:])
-    merged: dict[str, list[list[np.ndarray]]] = {"minus": [], "plus": [], "interface": []}
+    merged = {
+        "minus": _Buffer([(3,), ()], [np.float64] * 2),
+        "plus": _Buffer([(3,), ()], [np.float64] * 2),
+        "interface": _Buffer([(), (3,), (), (3,)], [np.int64] + [np.float64] * 3),
+    }
+    counts: dict[str, list[np.ndarray]] = {"minus": [], "plus": []}
     reduced = []
     for start in range(0, ncells, _CHUNK):
         found: dict[str, list[tuple[np.ndarray, ...]]] = {side: [] for side in merged}
@@ -213,22 +218,54 @@ def p2_tet_cut_rules(
             reduced.append(points.reduced + start)
         for side, parts in found.items():
             rows, *columns = _merged(parts)
-            if side != "interface":  # keep counts, not rows: offsets need no more
-                rows = np.bincount(rows - start, minlength=min(_CHUNK, ncells - start))
-            merged[side].append([rows, *columns])
-    empty = [np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3))]
+            if side == "interface":
+                columns = [rows, *columns]
+            else:  # keep counts, not rows: offsets need no more
+                counts[side].append(
+                    np.bincount(rows - start, minlength=min(_CHUNK, ncells - start))
+                )
+            merged[side].append(columns, batches=-(-ncells // _CHUNK))
     sides = []
     for side in ("minus", "plus"):
-        counts, X, w = (np.concatenate(c) for c in zip(*merged[side], empty[:3], strict=True))
-        sides.append(RuleSet(X, w, np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)))
-    rows, X, w, area = (np.concatenate(c) for c in zip(*merged["interface"], empty, strict=True))
+        X, w = merged[side].arrays()
+        offsets = np.concatenate([[0], *counts[side]]).cumsum().astype(np.int64)
+        sides.append(RuleSet(X, w, offsets))
+    rows, X, w, area = merged["interface"].arrays()
     interface = surface_rules(X, area, w, rows, ncells, jacobian)
-    return CutRules(*sides, interface, np.unique(np.concatenate([*reduced, empty[0]])))
+    return CutRules(*sides, interface, np.unique(np.concatenate([*reduced, rows[:0]])))
 
 
 _CHUNK = 2048
 """Cells per batch of :func:`p2_tet_cut_rules`: small batches keep the temporaries small
 enough for the allocator to reuse (fresh large arrays cost page faults)."""
+
+
+class _Buffer:
+    """Columns of points appended batch by batch into arrays that grow by doubling; pages
+    beyond the points written are never touched (no copy of every batch at the end)."""
+
+    def __init__(self, shapes: list[tuple[int, ...]], dtypes: list[type]):
+        self.columns = [
+            np.empty((0, *shape), dtype) for shape, dtype in zip(shapes, dtypes, strict=True)
+        ]
+        self.size = 0
+
+    def append(self, columns: list[np.ndarray], batches: int) -> None:
+        """Append ``columns`` (same lengths); ``batches``: the number of batches, to size
+        the arrays at the first append."""
+        n = columns[0].shape[0]
+        if self.size + n > self.columns[0].shape[0]:
+            capacity = max(2 * (self.size + n), 2 * n * batches)
+            grown = [np.empty((capacity, *c.shape[1:]), c.dtype) for c in self.columns]
+            for new, old in zip(grown, self.columns, strict=True):
+                new[: self.size] = old[: self.size]
+            self.columns = grown
+        for target, column in zip(self.columns, columns, strict=True):
+            target[self.size : self.size + n] = column
+        self.size += n
+
+    def arrays(self) -> list[np.ndarray]:
+        return [c[: self.size] for c in self.columns]
 
 
 def _merged(parts: list[tuple[np.ndarray, ...]]) -> list[np.ndarray]:
