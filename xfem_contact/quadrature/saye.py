@@ -120,7 +120,7 @@ def certified_sides(C: np.ndarray) -> npt.NDArray[np.int8]:
     """-1 / +1 / 0 per polynomial ``C`` ``(n, p+1, p+1, p+1)`` on the unit cube by its
     Bernstein coefficients (see :func:`classify_hexes`)."""
     n = C.shape[0]
-    B = bernstein(C, np.zeros((n, 3)), np.ones((n, 3))).reshape(n, C[0].size if n else 1)
+    B = bernstein(C, np.zeros((n, 3)), np.ones((n, 3))).reshape(n, int(np.prod(C.shape[1:])))
     return np.where((B < 0).all(axis=1), -1, np.where((B >= 0).all(axis=1), 1, 0)).astype(np.int8)
 
 
