@@ -1,12 +1,25 @@
-"""Sphere volume and area by the 3D cut rules on structured meshes of the unit cube, and a
-fuzz of random cuts of single cells.
+"""Volumes and areas of a sphere, a torus and an ellipsoid by the 3D cut rules on
+structured meshes of the unit cube, and a fuzz of random cuts of single cells.
 
-Relative errors of the volume and area of the sphere of radius ``R = 0.3`` centred at
-``(0.5, 0.5, 0.5)``, whose level set is the signed distance interpolated per cell (P1 / P2
-on tetrahedra, six per cube; Q1 / Q2 on hexahedra), with the rates of consecutive sizes,
-the number of cut cells and the time of cut + rules::
+Relative errors of the volume and area of three surfaces centred at ``(0.5, 0.5, 0.5)``,
+whose level sets are interpolated per cell (P1 / P2 on tetrahedra, six per cube; Q1 / Q2
+on hexahedra), with the rates of consecutive sizes, the number of cut cells and the CPU
+time (``time.process_time``) of classification + cut + rules (not of the mesh and the
+nodal values):
+
+- sphere, ``R = 0.3``: the signed distance ``|x - c| - R``;
+- torus about the z axis, ``R = 0.3``, ``r = 0.12``: the smooth quartic
+  ``((rho - R)^2 + z^2 - r^2) ((rho + R)^2 + z^2 - r^2) / (4 R^2)`` (``rho`` the distance to
+  the axis; the second factor is positive, so its zero set is the torus only);
+- ellipsoid, semi-axes ``0.35, 0.25, 0.15``: ``|(x - c) / a| - 1`` (exact area by a
+  spectrally converging double integral);
+- quadric (on request): the sphere as ``|x - c|^2 - R^2``, interpolated exactly by P2 / Q2,
+  so that only the rules err::
 
     python bench/cut3d.py --sizes 4 8 16 32
+
+``--min-depth 1`` splits every sub-box of the P2 tetrahedra's hexahedra that the interface
+may cross before Saye's rules (:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`).
 
 The fuzz (``--fuzz N``) cuts ``N`` reference cells per kind by random spheres, ellipsoids,
 tori and planes (a third of them moved to pass exactly through a node) and counts the
@@ -31,7 +44,48 @@ from xfem_contact.quadrature.cut_tet_rules import tet_interface_rule, tet_side_r
 from xfem_contact.quadrature.saye import classify_hexes, hex_cut_rules
 
 R, CENTRE = 0.3, np.array([0.5, 0.5, 0.5])
-VOLUME, AREA = 4.0 / 3.0 * np.pi * R**3, 4.0 * np.pi * R**2
+TORUS = (0.3, 0.12)
+AXES = np.array([0.35, 0.25, 0.15])
+
+
+def _ellipsoid_area(a: float, b: float, c: float, m: int = 200) -> float:
+    """Area of the ellipsoid with semi-axes ``a, b, c``: Gauss-Legendre in ``cos theta``
+    (``m`` points) times the trapezoidal rule in ``phi`` (``2 m``), both spectrally
+    convergent for this analytic, periodic integrand."""
+    t, wt = np.polynomial.legendre.leggauss(m)
+    phi = np.arange(2 * m) * np.pi / m
+    T, P = np.meshgrid(t, phi, indexing="ij")
+    s2 = 1.0 - T**2
+    f = np.sqrt(
+        (b * c) ** 2 * s2 * np.cos(P) ** 2 + (a * c) ** 2 * s2 * np.sin(P) ** 2 + (a * b * T) ** 2
+    )
+    return float(wt @ f.sum(axis=1) * np.pi / m)
+
+
+def _torus(x: np.ndarray) -> np.ndarray:
+    big, small = TORUS
+    y = x - CENTRE
+    rho2, z2 = y[..., 0] ** 2 + y[..., 1] ** 2, y[..., 2] ** 2
+    return ((rho2 + z2 + big**2 - small**2) ** 2 - 4 * big**2 * rho2) / (4 * big**2)
+
+
+def _ellipsoid(x: np.ndarray) -> np.ndarray:
+    return np.linalg.norm((x - CENTRE) / AXES, axis=-1) - 1.0
+
+
+#: name -> (level set on points (..., 3), exact volume, exact area)
+SHAPES = {
+    "sphere": (lambda x: level_set(x), 4.0 / 3.0 * np.pi * R**3, 4.0 * np.pi * R**2),
+    "torus": (_torus, 2 * np.pi**2 * TORUS[0] * TORUS[1] ** 2, 4 * np.pi**2 * TORUS[0] * TORUS[1]),
+    "ellipsoid": (_ellipsoid, 4.0 / 3.0 * np.pi * AXES.prod(), _ellipsoid_area(*AXES)),
+    # the sphere as |x - c|^2 - R^2: P2 and Q2 interpolate it exactly, so only the rules err
+    "quadric": (
+        lambda x: ((x - CENTRE) ** 2).sum(axis=-1) - R**2,
+        4.0 / 3.0 * np.pi * R**3,
+        4.0 * np.pi * R**2,
+    ),
+}
+
 
 #: The six tetrahedra of the cube [0, 1]^3 around its diagonal (0, 0, 0) - (1, 1, 1).
 KUHN = [
@@ -45,6 +99,7 @@ KUHN = [
 
 
 def level_set(x: np.ndarray) -> np.ndarray:
+    """The sphere's signed distance."""
     return np.linalg.norm(x - CENTRE, axis=-1) - R
 
 
@@ -74,25 +129,33 @@ PERTURB = 0.0
 """Vertex perturbation of the tetrahedral meshes (``--perturb``)."""
 
 
-def sphere_tets(n: int, degree: int = 4) -> tuple[float, float, int]:
-    """Volume, area and cut-cell count on ``6 n^3`` tetrahedra (P1 level set)."""
+MIN_DEPTH = 0
+"""Forced box splits of the P2 tetrahedra's rules (``--min-depth``)."""
+
+
+def sphere_tets(n: int, degree: int = 4, shape: str = "sphere") -> tuple[float, float, int, float]:
+    """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P1 level set)."""
     vertices = kuhn_mesh(n, PERTURB)
     J = np.transpose(vertices[:, 1:] - vertices[:, :1], (0, 2, 1))
     detJ = np.abs(np.linalg.det(J))
-    phi = level_set(vertices)
+    phi = SHAPES[shape][0](vertices)
+    start = time.process_time()
     side = classify_tets(phi)
     cut = np.flatnonzero(side == 0)
     geometry = cut_tets(phi[cut])
     minus = tet_side_rules(geometry, -1, degree)
     gamma = tet_interface_rule(geometry, degree, lambda rows, X: J[cut[rows]])
+    elapsed = time.process_time() - start
     volume = detJ[side == -1].sum() / 6.0 + (minus.weights * detJ[cut[minus.point_rows]]).sum()
     area = (gamma.weights * detJ[cut[gamma.point_rows]]).sum()
-    return volume, area, cut.size
+    return volume, area, cut.size, elapsed
 
 
-def sphere_p2_tets(n: int, order: int = 4) -> tuple[float, float, int]:
-    """Volume, area and cut-cell count on ``6 n^3`` tetrahedra (P2 level set, Saye's
-    rules on its four hexahedra)."""
+def sphere_p2_tets(
+    n: int, order: int = 4, shape: str = "sphere"
+) -> tuple[float, float, int, float]:
+    """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P2 level set,
+    Saye's rules on its four hexahedra)."""
     vertices = kuhn_mesh(n, PERTURB)
     J = np.transpose(vertices[:, 1:] - vertices[:, :1], (0, 2, 1))
     detJ = np.abs(np.linalg.det(J))
@@ -100,30 +163,38 @@ def sphere_p2_tets(n: int, order: int = 4) -> tuple[float, float, int]:
         basix.ElementFamily.P, basix.CellType.tetrahedron, 2, basix.LagrangeVariant.gll_warped
     )
     x = vertices[:, :1] + np.einsum("qk,ndk->nqd", element.points, J)
-    phi = level_set(x)
+    phi = SHAPES[shape][0](x)
+    start = time.process_time()
     side = classify_p2_tets(phi)
     cut = np.flatnonzero(side == 0)
-    rules = p2_tet_cut_rules(phi[cut], order, jacobian=lambda rows, X: J[cut[rows]])
+    rules = p2_tet_cut_rules(
+        phi[cut], order, min_depth=MIN_DEPTH, jacobian=lambda rows, X: J[cut[rows]]
+    )
+    elapsed = time.process_time() - start
     volume = detJ[side == -1].sum() / 6.0
     volume += (rules.minus.weights * detJ[cut[rules.minus.point_rows]]).sum()
     area = (rules.interface.weights * detJ[cut[rules.interface.point_rows]]).sum()
-    return volume, area, cut.size
+    return volume, area, cut.size, elapsed
 
 
-def sphere_hexes(n: int, degree: int, order: int = 4) -> tuple[float, float, int]:
-    """Volume, area and cut-cell count on ``n^3`` hexahedra (Q``degree`` level set)."""
+def sphere_hexes(
+    n: int, degree: int, order: int = 4, shape: str = "sphere"
+) -> tuple[float, float, int, float]:
+    """Volume, area, cut-cell count and CPU seconds on ``n^3`` hexahedra (Q``degree``)."""
     h = 1.0 / n
     element = basix.create_element(
         basix.ElementFamily.P, basix.CellType.hexahedron, degree, basix.LagrangeVariant.gll_warped
     )
-    phi = level_set(origins(n)[:, None] + h * element.points[None])
+    phi = SHAPES[shape][0](origins(n)[:, None] + h * element.points[None])
+    start = time.process_time()
     side = classify_hexes(phi, degree)
     cut = np.flatnonzero(side == 0)
     J = np.broadcast_to(h * np.eye(3), (cut.size, 3, 3))
     rules = hex_cut_rules(phi[cut], degree, order, jacobian=lambda rows, X: J[rows])
+    elapsed = time.process_time() - start
     volume = ((side == -1).sum() + rules.minus.weights.sum()) * h**3
     area = rules.interface.weights.sum() * h**3
-    return volume, area, cut.size
+    return volume, area, cut.size, elapsed
 
 
 def random_level_set(rng: np.random.Generator):
@@ -240,9 +311,22 @@ def main() -> None:
         default=0.0,
         help="random vertex moves of the tetrahedral meshes, in units of h",
     )
+    parser.add_argument(
+        "--shapes",
+        nargs="+",
+        default=["sphere", "torus", "ellipsoid"],
+        choices=list(SHAPES),
+        help="surfaces to measure",
+    )
+    parser.add_argument(
+        "--min-depth",
+        type=int,
+        default=0,
+        help="forced box splits of the P2 tetrahedra's rules (p2_tet_cut_rules min_depth)",
+    )
     args = parser.parse_args()
-    global PERTURB
-    PERTURB = args.perturb
+    global PERTURB, MIN_DEPTH
+    PERTURB, MIN_DEPTH = args.perturb, args.min_depth
     for kind in args.kinds if args.fuzz else []:
         start = time.perf_counter()
         counts = fuzz_cells(kind, args.fuzz)
@@ -253,21 +337,21 @@ def main() -> None:
     runs = {
         "tet-P1": sphere_tets,
         "tet-P2": sphere_p2_tets,
-        "hex-Q1": lambda n: sphere_hexes(n, 1),
-        "hex-Q2": lambda n: sphere_hexes(n, 2),
+        "hex-Q1": lambda n, shape: sphere_hexes(n, 1, shape=shape),
+        "hex-Q2": lambda n, shape: sphere_hexes(n, 2, shape=shape),
     }
-    for kind in args.kinds if args.sizes else []:
-        print(f"\n{kind}: sphere R = {R}")
+    for shape, kind in itertools.product(args.shapes, args.kinds if args.sizes else []):
+        _, exact_volume, exact_area = SHAPES[shape]
+        print(f"\n{kind}: {shape}")
         print(
             f"{'n':>5} {'cut cells':>10} {'volume err':>11} {'rate':>5} {'area err':>11} "
-            f"{'rate':>5} {'time s':>7}"
+            f"{'rate':>5} {'cpu s':>7}"
         )
         previous = None
         for n in args.sizes:
-            start = time.perf_counter()
-            volume, area, ncut = runs[kind](n)
-            elapsed = time.perf_counter() - start
-            ev, ea = abs(volume - VOLUME) / VOLUME, abs(area - AREA) / AREA
+            volume, area, ncut, elapsed = runs[kind](n, shape=shape)
+            ev = abs(volume - exact_volume) / exact_volume
+            ea = abs(area - exact_area) / exact_area
             rates = ["", ""]
             if previous is not None:
                 ratio = n / previous[0]
@@ -277,7 +361,8 @@ def main() -> None:
                 ]
             print(
                 f"{n:5d} {ncut:10d} {ev:11.3e} {rates[0]:>5} {ea:11.3e} {rates[1]:>5} "
-                f"{elapsed:7.2f}"
+                f"{elapsed:7.2f}",
+                flush=True,
             )
             previous = (n, ev, ea)
 

@@ -67,7 +67,14 @@ def coefficients(phi: npt.ArrayLike, degree: int) -> npt.NDArray[np.float64]:
 
 
 def _powers(x: np.ndarray, p: int) -> np.ndarray:
-    return x[..., None] ** np.arange(p + 1)
+    """``x^0 .. x^p`` along a new last axis (``p <= 2``; products, as exact as ``**``)."""
+    powers = np.empty((*x.shape, p + 1))
+    powers[..., 0] = 1.0
+    if p >= 1:
+        powers[..., 1] = x
+    if p >= 2:
+        np.multiply(x, x, out=powers[..., 2])
+    return powers
 
 
 def evaluate(C: np.ndarray, X: np.ndarray) -> np.ndarray:
@@ -112,13 +119,12 @@ def bernstein(C: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     p = C.shape[1] - 1
     t = np.arange(p + 1) / p
     grid = lo[:, None, :] + (hi - lo)[:, None, :] * t[None, :, None]  # (m, p+1, 3)
-    values = np.einsum("mijk,mck->mijc", C, _powers(grid[:, :, 2], p))
-    values = np.einsum("mijc,mbj->mibc", values, _powers(grid[:, :, 1], p))
-    values = np.einsum("mibc,mai->mabc", values, _powers(grid[:, :, 0], p))
     T = _to_bernstein(p)
-    values = np.einsum("ia,mabc->mibc", T, values)
-    values = np.einsum("jb,mibc->mijc", T, values)
-    return np.einsum("kc,mijc->mijk", T, values)
+    # per axis: monomial coefficients -> values at the grid -> Bernstein coefficients
+    A = [np.einsum("ia,mak->mik", T, _powers(grid[:, :, d], p)) for d in range(3)]
+    values = np.einsum("mijk,mck->mijc", C, A[2])
+    values = np.einsum("mijc,mbj->mibc", values, A[1])
+    return np.einsum("mibc,mai->mabc", values, A[0])
 
 
 def line_coefficients(C: np.ndarray, axis: int, X: np.ndarray) -> np.ndarray:

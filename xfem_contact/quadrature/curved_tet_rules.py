@@ -11,8 +11,14 @@ Saye's rules of those polynomials (:func:`~xfem_contact.quadrature.saye.saye_poi
 map back through ``M``: volume weights times ``det dM``, interface area vectors by
 Nanson's formula ``cof(dM) a``. Nothing is triangulated along the interface, so
 nothing can tangle, and all weights are positive. The rules are not exact for planes
-(the composed level set is not planar) but converge as Saye's rules do as ``order``
-grows.
+(the composed level set is not planar: along a height line its root is a rational
+function of the outer coordinates) but converge as Saye's rules do as ``order`` grows or
+as the boxes shrink (``min_depth`` forced splits). Their relative error on a cell depends
+only on where the interface crosses the reference cell, not on the cell's size.
+
+A tetrahedron is classified first by its own Bernstein coefficients (the four
+hexahedra's are convex combinations of them), then, if still open, by the hexahedra's.
+Cells are processed in batches, one Saye call per hexahedron index and batch.
 
 Tolerance policy and refusals are Saye's (:mod:`xfem_contact.quadrature.saye`): side -1 is
 ``phi < 0``, side +1 ``phi >= 0``; a zero set with a singular point is refused naming the
@@ -29,13 +35,8 @@ import numpy.typing as npt
 
 from xfem_contact.geometry.cut_topology import nodal_values
 from xfem_contact.geometry.tensor_levelset import coefficients
-from xfem_contact.quadrature.saye import (
-    MAX_DEPTH,
-    CutRules,
-    certified_sides,
-    rules_from_points,
-    saye_points,
-)
+from xfem_contact.quadrature.rules import RuleSet
+from xfem_contact.quadrature.saye import MAX_DEPTH, CutRules, certified_sides, saye_points
 from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
 
 __all__ = ["HEXAHEDRA", "classify_p2_tets", "hexahedron_map", "p2_tet_cut_rules"]
@@ -62,26 +63,43 @@ HEXAHEDRA = _subdivision()
 """Corners of the four hexahedra of the reference tetrahedron, shape ``(4, 8, 3)``."""
 
 
+def _trilinear() -> np.ndarray:
+    """Monomial coefficients ``(4, 8, 3)`` of the four hexahedron maps: row ``a + 2 b + 4 c``
+    of ``u^a v^b w^c``."""
+    P = np.transpose(HEXAHEDRA.reshape(4, 2, 2, 2, 3), (0, 3, 2, 1, 4))  # [k, u, v, w]
+    D = np.array([[1.0, 0.0], [-1.0, 1.0]])  # (1 - t, t) -> (1, t)
+    M = np.einsum("ai,bj,cl,kijlx->kcbax", D, D, D, P)  # [k, c, b, a]: w slowest
+    return M.reshape(4, 8, 3)
+
+
+_MONOMIALS = _trilinear()
+
+
 def hexahedron_map(U: npt.NDArray[np.float64], k: int) -> tuple[np.ndarray, np.ndarray]:
     """The trilinear map of hexahedron ``k`` at cube points ``U`` ``(N, 3)``: tetrahedron
     points ``(N, 3)`` and Jacobians ``dM/dU`` ``(N, 3, 3)``."""
-    P = np.transpose(HEXAHEDRA[k].reshape(2, 2, 2, 3), (2, 1, 0, 3)).reshape(8, 3)  # (u, v, w)
-    lin = [np.stack([1.0 - U[:, d], U[:, d]], axis=1) for d in range(3)]  # (N, 2) each
-    step = np.broadcast_to([-1.0, 1.0], lin[0].shape)
+    X, du, dv, dw = _trilinear_map(U, _MONOMIALS[k])
+    return X.T, np.stack([du.T, dv.T, dw.T], axis=2)
 
-    def corners(a, b, c):  # (N, 8) products, u slowest
-        return (a[:, :, None, None] * b[:, None, :, None] * c[:, None, None, :]).reshape(-1, 8)
 
-    X = corners(*lin) @ P
-    J = np.stack(
-        [
-            corners(step, lin[1], lin[2]) @ P,
-            corners(lin[0], step, lin[2]) @ P,
-            corners(lin[0], lin[1], step) @ P,
-        ],
-        axis=2,
+def _trilinear_map(U: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Values and the three columns ``dM/du, dM/dv, dM/dw`` of the Jacobian, each
+    ``(3, N)`` (coordinate first), at ``U`` ``(N, 3)`` of the trilinear map with monomial
+    coefficients ``c`` ``(8, 3)``."""
+    u, v, w = np.ascontiguousarray(U.T)
+    m = np.empty((8, u.size))  # 1, u, v, uv, w, uw, vw, uvw
+    m[0], m[1], m[2], m[4] = 1.0, u, v, w
+    np.multiply(u, v, out=m[3])
+    np.multiply(u, w, out=m[5])
+    np.multiply(v, w, out=m[6])
+    np.multiply(m[3], w, out=m[7])
+    # einsum, not BLAS: a threaded BLAS spends more on these thin products than it saves
+    return (
+        np.einsum("kd,kn->dn", c, m),
+        np.einsum("kd,kn->dn", c[[1, 3, 5, 7]], m[[0, 2, 4, 6]]),
+        np.einsum("kd,kn->dn", c[[2, 3, 6, 7]], m[[0, 1, 4, 5]]),
+        np.einsum("kd,kn->dn", c[[4, 5, 6, 7]], m[:4]),
     )
-    return X, J
 
 
 @functools.cache
@@ -105,8 +123,8 @@ def _cube_coefficients(phi: npt.ArrayLike) -> np.ndarray:
 
 
 def classify_p2_tets(phi: npt.ArrayLike) -> npt.NDArray[np.int8]:
-    """Side of each tetrahedron certified by the Bernstein coefficients on its four
-    hexahedra: -1, +1, or 0 (possibly cut).
+    """Side of each tetrahedron certified by its own Bernstein coefficients, else by those
+    on its four hexahedra: -1, +1, or 0 (possibly cut).
 
     Args:
         phi: P2 nodal values, shape ``(ncells, 10)`` (Basix order).
@@ -114,10 +132,29 @@ def classify_p2_tets(phi: npt.ArrayLike) -> npt.NDArray[np.int8]:
     Returns:
         ``int8`` array of shape ``(ncells,)``.
     """
-    sides = certified_sides(_cube_coefficients(phi)).reshape(-1, 4)
-    return np.where((sides == -1).all(axis=1), -1, np.where((sides == 1).all(axis=1), 1, 0)).astype(
-        np.int8
+    phi = nodal_values(phi, 10, "P2 tetrahedron", "tetrahedron")
+    B = phi @ _to_simplex_bernstein().T
+    side = np.where(B.max(axis=1) < 0, -1, np.where(B.min(axis=1) >= 0, 1, 0)).astype(np.int8)
+    rest = np.flatnonzero(side == 0)
+    sides = certified_sides(_cube_coefficients(phi[rest])).reshape(-1, 4)
+    side[rest] = np.where((sides == -1).all(axis=1), -1, np.where((sides == 1).all(axis=1), 1, 0))
+    return side
+
+
+@functools.cache
+def _to_simplex_bernstein() -> np.ndarray:
+    """Matrix ``(10, 10)``: P2 nodal values -> Bernstein coefficients on the tetrahedron
+    (a vertex's is its value, an edge's ``2 phi_mid - (phi_a + phi_b) / 2``)."""
+    p2 = basix.create_element(
+        basix.ElementFamily.P, basix.CellType.tetrahedron, 2, basix.LagrangeVariant.gll_warped
     )
+    x = p2.points
+    T = np.eye(10)
+    for node in range(4, 10):
+        ends = [(i, j) for i in range(4) for j in range(i) if np.allclose(2 * x[node], x[i] + x[j])]
+        a, b = ends[0]
+        T[node, node], T[node, a], T[node, b] = 2.0, -0.5, -0.5
+    return T
 
 
 def p2_tet_cut_rules(
@@ -125,6 +162,7 @@ def p2_tet_cut_rules(
     order: int = 4,
     *,
     max_depth: int = MAX_DEPTH,
+    min_depth: int = 0,
     jacobian: Jacobian | None = None,
 ) -> CutRules:
     """Rules of both sides and of the interface of tetrahedra with P2 level sets.
@@ -133,6 +171,9 @@ def p2_tet_cut_rules(
         phi: P2 nodal values, shape ``(ncells, 10)`` (Basix ``gll_warped`` order).
         order: Gauss-Legendre points per interval of Saye's rules.
         max_depth: Box subdivision levels on the cube.
+        min_depth: Levels of forced splits of the boxes the interface may cross (0 ..
+            ``max_depth``); each level lowers the rules' error on a cell and multiplies
+            the points of the cut boxes by about four.
         jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule;
             ``None``: reference cells.
 
@@ -146,27 +187,101 @@ def p2_tet_cut_rules(
     """
     C = _cube_coefficients(phi)
     ncells = C.shape[0] // 4
-    points = saye_points(C, order, max_depth=max_depth, kind="tetrahedron")
+    C = C.reshape(ncells, 4, *C.shape[1:])
+    merged = {
+        "minus": _Buffer([(3,), ()], [np.float64] * 2),
+        "plus": _Buffer([(3,), ()], [np.float64] * 2),
+        "interface": _Buffer([(), (3,), (), (3,)], [np.int64] + [np.float64] * 3),
+    }
+    counts: dict[str, list[np.ndarray]] = {"minus": [], "plus": []}
+    reduced = []
+    for start in range(0, ncells, _CHUNK):
+        found: dict[str, list[tuple[np.ndarray, ...]]] = {side: [] for side in merged}
+        for k in range(4):  # hexahedron k of every cell: one map, no scatter
+            points = saye_points(
+                np.ascontiguousarray(C[start : start + _CHUNK, k]),
+                order,
+                max_depth=max_depth,
+                min_depth=min_depth,
+                kind="tetrahedron",
+                first=start,
+            )
+            for side in ("minus", "plus"):
+                rows, U, w = getattr(points, side)
+                X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
+                found[side].append((rows + start, X, w * (c0 * _cross(c1, c2)).sum(axis=0)))
+            rows, U, w, area = points.interface
+            X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
+            a0, a1, a2 = area.T
+            area = _cross(c1, c2) * a0 + _cross(c2, c0) * a1 + _cross(c0, c1) * a2  # cof(dM) a
+            found["interface"].append((rows + start, X, w, area))
+            reduced.append(points.reduced + start)
+        for side, parts in found.items():
+            rows, *columns = _merged(parts)
+            if side == "interface":
+                columns = [rows, *columns]
+            else:  # keep counts, not rows: offsets need no more
+                counts[side].append(
+                    np.bincount(rows - start, minlength=min(_CHUNK, ncells - start))
+                )
+            merged[side].append(columns, batches=-(-ncells // _CHUNK))
     sides = []
-    for rows, U, w in (points.minus, points.plus):
-        X, J = _mapped(rows, U)
-        weights = w * np.linalg.det(J)
-        sides.append(rules_from_points(rows // 4, X, weights, ncells))
-    rows, U, w, area = points.interface
-    X, J = _mapped(rows, U)
-    c0, c1, c2 = J[:, :, 0], J[:, :, 1], J[:, :, 2]
-    cofactor = np.stack([np.cross(c1, c2), np.cross(c2, c0), np.cross(c0, c1)], axis=2)
-    area = np.einsum("nij,nj->ni", cofactor, area)  # det(J) J^{-T} a
-    interface = surface_rules(X, area, w, rows // 4, ncells, jacobian)  # rows are sorted
-    reduced = np.unique(points.reduced // 4).astype(np.int64)
-    return CutRules(*sides, interface, reduced)
+    for side in ("minus", "plus"):
+        X, w = merged[side].arrays()
+        offsets = np.concatenate([[0], *counts[side]]).cumsum().astype(np.int64)
+        sides.append(RuleSet(X, w, offsets))
+    rows, X, w, area = merged["interface"].arrays()
+    interface = surface_rules(X, area, w, rows, ncells, jacobian)
+    return CutRules(*sides, interface, np.unique(np.concatenate([*reduced, rows[:0]])))
 
 
-def _mapped(rows: np.ndarray, U: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Tetrahedron points and ``dM/dU`` of cube points ``U`` of sub-hexahedra ``rows``
-    (row ``4 c + k``: hexahedron ``k`` of cell ``c``)."""
-    X, J = np.empty_like(U), np.empty((U.shape[0], 3, 3))
-    for k in range(4):
-        mine = rows % 4 == k
-        X[mine], J[mine] = hexahedron_map(U[mine], k)
-    return X, J
+_CHUNK = 2048
+"""Cells per batch of :func:`p2_tet_cut_rules`: small batches keep the temporaries small
+enough for the allocator to reuse (fresh large arrays cost page faults)."""
+
+
+class _Buffer:
+    """Columns of points appended batch by batch into arrays that grow by doubling; pages
+    beyond the points written are never touched (no copy of every batch at the end)."""
+
+    def __init__(self, shapes: list[tuple[int, ...]], dtypes: list[type]):
+        self.columns = [
+            np.empty((0, *shape), dtype) for shape, dtype in zip(shapes, dtypes, strict=True)
+        ]
+        self.size = 0
+
+    def append(self, columns: list[np.ndarray], batches: int) -> None:
+        """Append ``columns`` (same lengths); ``batches``: the number of batches, to size
+        the arrays at the first append."""
+        n = columns[0].shape[0]
+        if self.size + n > self.columns[0].shape[0]:
+            capacity = max(2 * (self.size + n), 2 * n * batches)
+            grown = [np.empty((capacity, *c.shape[1:]), c.dtype) for c in self.columns]
+            for new, old in zip(grown, self.columns, strict=True):
+                new[: self.size] = old[: self.size]
+            self.columns = grown
+        for target, column in zip(self.columns, columns, strict=True):
+            target[self.size : self.size + n] = column
+        self.size += n
+
+    def arrays(self) -> list[np.ndarray]:
+        return [c[: self.size] for c in self.columns]
+
+
+def _merged(parts: list[tuple[np.ndarray, ...]]) -> list[np.ndarray]:
+    """Points of the four hexahedra ``(rows, X (3, N), w[, area (3, N)])`` of a batch in
+    one list sorted by cell (stable: hexahedron 0 first), vectors as ``(N, 3)``."""
+    rows = np.concatenate([p[0] for p in parts])
+    order = np.argsort(rows, kind="stable")
+    merged = [rows[order]]
+    for column in range(1, len(parts[0])):
+        values = np.concatenate([p[column] for p in parts], axis=-1)
+        merged.append(np.take(values.T, order, axis=0))
+    return merged
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross products of vectors stored coordinate first, ``(3, N)``."""
+    return np.stack(
+        [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    )

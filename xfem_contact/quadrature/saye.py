@@ -23,7 +23,8 @@ On a box ``U = [lo, hi]`` of the reference cube, with ``psi`` the cell's level s
    ``grad psi / |d psi / d x_k3|`` (reference coordinates) and the weight of its line.
    Every integrand is smooth between the breakpoints, so the rules converge at the rate
    of Gauss-Legendre rules; all weights are positive.
-4. When no pair is valid the box is subdivided into eight, down to ``max_depth`` levels; a box
+4. When no pair is valid (or above ``min_depth``, for every box the interface may
+   cross) the box is subdivided into eight, down to ``max_depth`` levels; a box
    at that depth that still has none uses the best monotone height axis alone (a
    lower-order rule on a box of size ``2^-max_depth``; the cell is reported in
    :attr:`CutRules.reduced`), and one with no monotone axis at all (a singular
@@ -119,7 +120,7 @@ def certified_sides(C: np.ndarray) -> npt.NDArray[np.int8]:
     """-1 / +1 / 0 per polynomial ``C`` ``(n, p+1, p+1, p+1)`` on the unit cube by its
     Bernstein coefficients (see :func:`classify_hexes`)."""
     n = C.shape[0]
-    B = bernstein(C, np.zeros((n, 3)), np.ones((n, 3))).reshape(n, -1)
+    B = bernstein(C, np.zeros((n, 3)), np.ones((n, 3))).reshape(n, int(np.prod(C.shape[1:])))
     return np.where((B < 0).all(axis=1), -1, np.where((B >= 0).all(axis=1), 1, 0)).astype(np.int8)
 
 
@@ -180,7 +181,13 @@ class SayePoints:
 
 
 def saye_points(
-    C: np.ndarray, order: int, *, max_depth: int = MAX_DEPTH, kind: str = "hexahedron"
+    C: np.ndarray,
+    order: int,
+    *,
+    max_depth: int = MAX_DEPTH,
+    min_depth: int = 0,
+    kind: str = "hexahedron",
+    first: int = 0,
 ) -> SayePoints:
     """Saye's rules (see the module) of polynomials on the unit cube.
 
@@ -189,7 +196,11 @@ def saye_points(
             (:func:`~xfem_contact.geometry.tensor_levelset.coefficients`).
         order: Gauss-Legendre points per interval.
         max_depth: Box subdivision levels.
+        min_depth: Levels of boxes split whenever the interface may cross them, before
+            the axes are chosen (finer boxes for level sets that are not polynomials of
+            low degree in the cell's own coordinates).
         kind: The cells' name in error messages.
+        first: The number of row 0 of ``C`` in error messages.
 
     Returns:
         A :class:`SayePoints`.
@@ -201,6 +212,10 @@ def saye_points(
         raise ValueError(f"order must be a positive int (Gauss points per interval), got {order!r}")
     if not (isinstance(max_depth, int) and max_depth >= 0):
         raise ValueError(f"max_depth must be a non-negative int, got {max_depth!r}")
+    if not (isinstance(min_depth, int) and 0 <= min_depth <= max_depth):
+        raise ValueError(
+            f"min_depth must be an int in 0 .. max_depth = {max_depth}, got {min_depth!r}"
+        )
     ncells = C.shape[0]
     gx, gw = np.polynomial.legendre.leggauss(order)
     gauss = (0.5 * (gx + 1.0), 0.5 * gw)
@@ -211,20 +226,24 @@ def saye_points(
     for depth in range(max_depth + 1):
         if cell.size == 0:
             break
-        B = bernstein(C[cell], lo, hi).reshape(cell.size, -1)
-        for side, whole in (("minus", (B < 0).all(axis=1)), ("plus", (B >= 0).all(axis=1))):
+        B = bernstein(C[cell], lo, hi)
+        flat = B.reshape(cell.size, -1)
+        for side, whole in (("minus", (flat < 0).all(axis=1)), ("plus", (flat >= 0).all(axis=1))):
             parts[side].append(_tensor_rule(cell[whole], lo[whole], hi[whole], gauss))
-        rest = ~((B < 0).all(axis=1) | (B >= 0).all(axis=1))
-        cell, lo, hi = cell[rest], lo[rest], hi[rest]
+        rest = ~((flat < 0).all(axis=1) | (flat >= 0).all(axis=1))
+        cell, lo, hi, B = cell[rest], lo[rest], hi[rest], B[rest]
         if cell.size == 0:
             break
-        pair, height = _choose_axes(C[cell], lo, hi)
+        if depth < min_depth:  # split every box that the interface may cross
+            pair, height = np.full(cell.size, -1), np.full(cell.size, -1)
+        else:
+            pair, height = _choose_axes(C[cell], lo, hi, B)
         if depth == max_depth:
             bad = np.flatnonzero((pair < 0) & (height < 0))
             if bad.size:
                 b = bad[0]
                 raise ValueError(
-                    f"{kind} {cell[b]}: the level set has a singular point on its zero set "
+                    f"{kind} {first + cell[b]}: the level set has a singular point on its zero set "
                     f"in the box {lo[b].tolist()} .. {hi[b].tolist()} (unit-cube coordinates; "
                     f"no monotone axis after {max_depth} subdivisions); {bad.size} box(es)"
                 )
@@ -251,11 +270,13 @@ def _certain(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (flat > 0).all(axis=1) | (flat < 0).all(axis=1), (flat == 0).all(axis=1)
 
 
-def _choose_axes(C: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _choose_axes(
+    C: np.ndarray, lo: np.ndarray, hi: np.ndarray, B: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Index into ``_PAIRS`` of the best valid ``(k3, k2)`` per box (-1: none) and the best
-    monotone height axis alone (-1: none)."""
+    monotone height axis alone (-1: none); ``B`` are the Bernstein coefficients of ``C``
+    on the boxes."""
     m = C.shape[0]
-    B = bernstein(C, lo, hi)
     D = [bernstein(derivative(C, k), lo, hi) for k in range(3)]
     size = [np.abs(d).reshape(m, -1) for d in D]
     steepest = np.maximum.reduce([a.max(axis=1) for a in size])
@@ -343,25 +364,25 @@ def _box_rules(C, cell, lo, hi, k3, k2, gauss, parts):
     m = cell.size
     # level 1: along k1, breakpoints at the roots of psi on the four edges parallel to k1
     roots = []
+    C1 = C[cell]
     for v, w in itertools.product((lo[:, k2], hi[:, k2]), (lo[:, k3], hi[:, k3])):
         X = np.zeros((m, 3))
         X[:, k2], X[:, k3] = v, w
-        roots.append(line_roots(line_coefficients(C[cell], k1, X), lo[:, k1], hi[:, k1]))
+        roots.append(line_roots(line_coefficients(C1, k1, X), lo[:, k1], hi[:, k1]))
     box1, u, w1, _, _ = _pieces(np.concatenate(roots, axis=1), lo[:, k1], hi[:, k1], gauss)
     # level 2: along k2 at each u, breakpoints at the roots of the two face functions
     roots = []
+    C1 = C1[box1]
     for end in (lo, hi):
         X = np.zeros((u.size, 3))
         X[:, k1], X[:, k3] = u, end[box1, k3]
-        roots.append(
-            line_roots(line_coefficients(C[cell[box1]], k2, X), lo[box1, k2], hi[box1, k2])
-        )
+        roots.append(line_roots(line_coefficients(C1, k2, X), lo[box1, k2], hi[box1, k2]))
     p1, v, w2, _, _ = _pieces(np.concatenate(roots, axis=1), lo[box1, k2], hi[box1, k2], gauss)
     box2 = box1[p1]
     W = w1[p1] * w2
     X = np.zeros((v.size, 3))
     X[:, k1], X[:, k2] = u[p1], v
-    C2 = C[cell[box2]]
+    C2 = C1[p1]
     lo3, hi3 = lo[box2, k3], hi[box2, k3]
     # level 3: along k3 at each (u, v), breakpoints at the roots of psi
     r = line_roots(line_coefficients(C2, k3, X), lo3, hi3)
