@@ -13,7 +13,7 @@ Nanson's formula ``cof(dM) a``. Nothing is triangulated along the interface, so
 nothing can tangle, and all weights are positive. The rules are not exact for planes
 (the composed level set is not planar: along a height line its root is a rational
 function of the outer coordinates) but converge as Saye's rules do as ``order`` grows or
-as the boxes shrink (``min_depth`` forced splits). Their relative error on a cell depends
+as the boxes shrink (``min_depth`` forced subdivisions). Their relative error on a cell depends
 only on where the interface crosses the reference cell, not on the cell's size.
 
 A tetrahedron is classified first by its own Bernstein coefficients (the four
@@ -171,7 +171,7 @@ def p2_tet_cut_rules(
         phi: P2 nodal values, shape ``(ncells, 10)`` (Basix ``gll_warped`` order).
         order: Gauss-Legendre points per interval of Saye's rules.
         max_depth: Box subdivision levels on the cube.
-        min_depth: Levels of forced splits of the boxes the interface may cross (0 ..
+        min_depth: Levels of forced subdivisions of the boxes the interface may cross (0 ..
             ``max_depth``); each level lowers the rules' error on a cell and multiplies
             the points of the cut boxes by about four.
         jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule;

@@ -196,7 +196,7 @@ def saye_points(
             (:func:`~xfem_contact.geometry.tensor_levelset.coefficients`).
         order: Gauss-Legendre points per interval.
         max_depth: Box subdivision levels.
-        min_depth: Levels of boxes split whenever the interface may cross them, before
+        min_depth: Levels of boxes subdivided whenever the interface may cross them, before
             the axes are chosen (finer boxes for level sets that are not polynomials of
             low degree in the cell's own coordinates).
         kind: The cells' name in error messages.
@@ -234,7 +234,7 @@ def saye_points(
         cell, lo, hi, B = cell[rest], lo[rest], hi[rest], B[rest]
         if cell.size == 0:
             break
-        if depth < min_depth:  # split every box that the interface may cross
+        if depth < min_depth:  # subdivide every box that the interface may cross
             pair, height = np.full(cell.size, -1), np.full(cell.size, -1)
         else:
             pair, height = _choose_axes(C[cell], lo, hi, B)
