@@ -5,7 +5,8 @@ with the ghost penalty raised to the stabilisation's weight, 0.1, too), on n = 8
 32, 64 cells per side of the unit square, over circles at random centres and radii (a
 third of them passing within 1e-6 h of a mesh node: tiny cuts on purpose). Prints, per
 element, treatment and n, the least and median beta and the count of indefinite pairs
-(beta^2 < 0), and the slope of the least beta in log n over the last pair. Writes
+(beta^2 < 0), and the slope of the least beta in log n over the last pair; then P1-P1
+on tetrahedra cut by a sphere (``--tet-sizes``). Writes
 ``bench/results/inf_sup.{json,md,png}``.
 
 Run: ``python bench/inf_sup.py [--circles 50] [--sizes 8 16 32 64]`` (``make bench``).
@@ -77,10 +78,39 @@ def plot(rows: list[dict], path: pathlib.Path) -> None:
     plt.close(fig)
 
 
+def tetrahedra(sizes: list[int]) -> list[str]:
+    """P1-P1 on the unit cube's tetrahedra (6 n^3) cut by the sphere of radius 0.2 about
+    its centre, without LBB treatment and stabilised (the restriction is 2D only):
+    lines of a Markdown table of beta^2."""
+    if not sizes:
+        return []
+    lines = [
+        "",
+        "P1-P1 tetrahedra, sphere R = 0.2 in the unit cube (beta^2; multipliers):",
+        "",
+        "| lbb | " + " | ".join(f"n={n}" for n in sizes) + " |",
+        "|---|" + "---|" * len(sizes),
+    ]
+    for lbb in ("none", "stabilized"):
+        cells = []
+        for n in sizes:
+            mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, n, n, n)
+            sphere = lambda x: np.sqrt(((x.T - 0.5) ** 2).sum(axis=1)) - 0.2  # noqa: E731
+            cut = CutMesh(mesh, sphere, degree=2)
+            result = inf_sup_constant(Problem(cut, 1, Material(100e6, 0.3), Bonded(lbb=lbb)))
+            cells.append(f"{result.beta_squared:.3e} ({result.multipliers})")
+            note(f"tetrahedra P1-P1 {lbb:11s} n={n:3d}: beta^2 {result.beta_squared:.3e}")
+        lines.append(f"| {lbb} | " + " | ".join(cells) + " |")
+    return lines
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--circles", type=int, default=12, help="circles per mesh")
     parser.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32, 64], help="n")
+    parser.add_argument(
+        "--tet-sizes", type=int, nargs="*", default=[4, 8, 12], help="n of the P1-P1 tetrahedra"
+    )
     args = parser.parse_args()
     rows = []
     for cell, degree in ELEMENTS:
@@ -135,6 +165,7 @@ def main() -> None:
                 f"| {cell} | P{degree}-P1 | {lbb} | {cells} | {slope:.2f} | "
                 f"{sum(r['indefinite'] for r in sel)}/{args.circles * len(sel)} |"
             )
+    lines += tetrahedra(args.tet_sizes)
     RESULTS.mkdir(exist_ok=True)
     plot(rows, RESULTS / "inf_sup.png")
     (RESULTS / "inf_sup.md").write_text("\n".join(lines) + "\n")
