@@ -22,6 +22,7 @@ The peer is optional and never a dependency of the package: ``make bench-peer`` 
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import pathlib
@@ -62,6 +63,7 @@ def ellipsoid_area(axes: tuple[float, float, float], n: int = 2000) -> float:
     return float(0.5 * np.pi * (w @ norm.sum(axis=1)) * (2.0 * np.pi / (2 * n)))
 
 
+@functools.cache
 def exact(shape: str) -> tuple[float, float]:
     """Volume (m^3) and area (m^2) of ``shape``."""
     if shape == "sphere":
@@ -129,7 +131,7 @@ def make_mesh(kind: str, n: int, folder: pathlib.Path) -> pathlib.Path:
     cell = dolfinx.mesh.CellType.hexahedron if kind == "structured-hex" else None
     cell = cell or dolfinx.mesh.CellType.tetrahedron
     mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_SELF, n, n, n, cell)
-    cells = mesh.geometry.dofmap
+    cells = mesh.geometry.dofmaps[0]
     if kind == "structured-hex":
         write_msh(path, mesh.geometry.x, cells[:, GMSH_HEX], 5)
     else:
@@ -281,6 +283,38 @@ def table(rows: list[dict]) -> list[str]:
     return lines
 
 
+def tangled(rows: list[dict]) -> list[str]:
+    """Markdown lines: the order-2 rows where the peer's deformation tangles
+    (``det(I + grad d) <= 0``), the peer fails or misses half the volume, with both
+    codes' volumes."""
+    lines = [
+        "Order 2 where the peer's deformation tangles (`det(I + grad d) <= 0`), the peer",
+        "fails or it misses half of the volume (volumes in m^3):",
+        "",
+        "| mesh | shape | h | exact volume | ours volume | peer volume | peer min det | "
+        "peer max d/h |",
+        "|" + " --- |" * 8,
+    ]
+    for row in rows:
+        peer = row["peer"]
+        lost = "volume" in peer and peer["volume"] < 0.5 * exact(row["shape"])[0]
+        if row["order"] != 2 or (peer.get("min_det", 0.0) > 0.0 and not lost):
+            continue
+
+        def volume(result):
+            return f"{result['volume']:.4g}" if "volume" in result else "failed"
+
+        lines.append(
+            f"| {row['mesh']} | {row['shape']} | 1/{row['n']} | {exact(row['shape'])[0]:.4g} | "
+            f"{volume(row['ours'])} | {volume(peer)} | {peer.get('min_det', '-'):.3g} | "
+            f"{peer.get('max_d_over_h', '-'):.3g} |"
+            if "min_det" in peer
+            else f"| {row['mesh']} | {row['shape']} | 1/{row['n']} | "
+            f"{exact(row['shape'])[0]:.4g} | {volume(row['ours'])} | {volume(peer)} | - | - |"
+        )
+    return [*lines, ""]
+
+
 def failures(rows: list[dict]) -> list[str]:
     """Markdown lines: the runs that failed or timed out, one each."""
     lines = []
@@ -303,6 +337,9 @@ def main() -> None:
     parser.add_argument("--orders", type=int, nargs="+", default=[2, 1], choices=[1, 2])
     parser.add_argument("--timeout", type=float, default=600.0, help="per process (s)")
     parser.add_argument("--name", default="peer_cut3d", help="bench/results/NAME.{json,md}")
+    parser.add_argument(
+        "--add", action="store_true", help="add the rows to (or replace them in) NAME.json"
+    )
     parser.add_argument("--worker", nargs=5, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
@@ -314,6 +351,8 @@ def main() -> None:
     if not pathlib.Path(args.peer_python).is_file():
         raise SystemExit(f"--peer-python: {args.peer_python} not found; run `make bench-peer`")
     rows = []
+    if args.add:
+        rows = json.loads((RESULTS / f"{args.name}.json").read_text())
     with tempfile.TemporaryDirectory() as folder:
         for n in args.sizes:
             for kind in args.kinds:
@@ -321,6 +360,7 @@ def main() -> None:
                 for shape in args.shapes:
                     for order in args.orders:
                         row = {"mesh": kind, "n": n, "shape": shape, "order": order}
+                        rows = [r for r in rows if {k: r[k] for k in row} != row]
                         for side, python in (("ours", sys.executable), ("peer", args.peer_python)):
                             row[side] = worker(
                                 python, side, path, shape, order, 1.0 / n, args.timeout
@@ -336,7 +376,25 @@ def save(rows: list[dict], name: str) -> None:
     rows = sorted(rows, key=lambda r: (r["mesh"], r["shape"], -r["order"], r["n"]))
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / f"{name}.json").write_text(json.dumps(rows, indent=1) + "\n")
-    (RESULTS / f"{name}.md").write_text("\n".join(table(rows) + [""] + failures(rows)) + "\n")
+    text = legend() + table(rows) + [""] + tangled(rows) + failures(rows)
+    (RESULTS / f"{name}.md").write_text("\n".join(text) + "\n")
+
+
+def legend() -> list[str]:
+    """Markdown lines: what the columns of :func:`table` hold."""
+    values = [f"{s} {exact(s)[0]:.10g} m^3 / {exact(s)[1]:.10g} m^2" for s in SHAPES]
+    return [
+        f"Exact volumes / areas: {', '.join(values)}",
+        "(the ellipsoid's area by a 2000 x 4000-point",
+        "product rule). Errors are relative. A ratio is ours / peer's (below 1: ours is",
+        "closer). Rates are from the previous h of the same mesh, shape and order. The",
+        "peer's order 2 deforms the mesh by `d`; a negative smallest `det(I + grad d)`",
+        "means tangled cells, and `max d/h` is its largest displacement in cell sizes.",
+        "Times are wall times of each whole process (start-up, reading the mesh, the cut",
+        f"and both integrals; the peer integrates with its degree {QUADRATURE_DEGREE}),",
+        "on a shared host. A row without a result failed; the reason is listed below it.",
+        "",
+    ]
 
 
 if __name__ == "__main__":
