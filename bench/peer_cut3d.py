@@ -1,4 +1,4 @@
-"""Volume and area of a sphere, a torus and an ellipsoid: our 3D cut rules against the
+"""Volume and area of a sphere, a torus and an ellipsoid by our 3D cut rules and by the
 isoparametric peer (ngsxfem), on the same meshes.
 
 Relative errors of the volume and area of a sphere (``R = 0.3``), a torus (``R = 0.3``,
@@ -10,13 +10,11 @@ cube, on unstructured tetrahedra (gmsh), structured tetrahedra and structured he
 (P2 level set, uncapped deformation of the mesh) and its order 1 the cut of the P1 level
 set. Each code runs in its own process, timed as a whole (start-up, mesh, cut, integrals).
 For the peer, the smallest ``det(I + grad d)`` of its deformation ``d`` at the points of
-a degree-6 rule in every cell, and the largest ``|d| / h``, show where it tangles::
-
-    make bench-peer
-
-The peer is optional and never a dependency of the package: ``make bench-peer`` creates
+a degree-6 rule in every cell, and the largest ``|d| / h``, show where it tangles. The
+peer is optional and never a dependency of the package: ``make bench-peer`` creates
 ``bench/.peer-venv`` (``pip install xfem ngsolve``) and runs
-``python bench/peer_cut3d.py --peer-python bench/.peer-venv/bin/python``.
+``python bench/peer_cut3d.py --peer-python bench/.peer-venv/bin/python``; ``make bench``
+runs it when that environment exists.
 """
 
 from __future__ import annotations
