@@ -329,11 +329,11 @@ def failures(rows: list[dict]) -> list[str]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--peer-python", default="bench/.peer-venv/bin/python")
-    parser.add_argument("--sizes", type=int, nargs="+", default=[4, 8, 16, 32])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[4, 8, 16, 32, 64])
     parser.add_argument("--kinds", nargs="+", default=list(KINDS), choices=KINDS)
     parser.add_argument("--shapes", nargs="+", default=list(SHAPES), choices=SHAPES)
     parser.add_argument("--orders", type=int, nargs="+", default=[2, 1], choices=[1, 2])
-    parser.add_argument("--timeout", type=float, default=600.0, help="per process (s)")
+    parser.add_argument("--timeout", type=float, default=900.0, help="per process (s)")
     parser.add_argument("--name", default="peer_cut3d", help="bench/results/NAME.{json,md}")
     parser.add_argument(
         "--add", action="store_true", help="add the rows to (or replace them in) NAME.json"
