@@ -7,7 +7,7 @@ MPIEXEC := $(VENV)/bin/mpiexec
 PYTHON ?= $(shell for p in python3.12 $$HOME/.pyenv/versions/3.12*/bin/python3.12 python3.13 python3; do \
 	$$p -c 'import sys; assert sys.version_info >= (3, 12)' >/dev/null 2>&1 && { echo $$p; break; }; done)
 
-.PHONY: demo test test-serial test-mpi test-notebooks docs bench lint clean bytecode
+.PHONY: demo test test-serial test-mpi test-notebooks docs bench bench-peer lint clean bytecode
 
 $(VENV)/.installed: pyproject.toml setup.py xfem_contact/_bootstrap.py
 	@test -n "$(PYTHON)" || { echo "error: no Python >= 3.12 found (set PYTHON=...)"; exit 1; }
@@ -62,6 +62,21 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/cut3d.py --sizes 4 8 16 32
 	$(PY) bench/cut3d.py --fuzz 10000 --sizes
 	$(PY) bench/cut3d_assembly.py --sizes 16 --quadrature-degrees 2 4 6
+	@if test -x $(PEER_PY); then $(PY) bench/peer_cut3d.py --peer-python $(PEER_PY); \
+	else echo "skipped bench/peer_cut3d.py (the ngsxfem peer): 'make bench-peer' creates $(PEER_VENV) and runs it"; fi
+
+# The optional peer (ngsxfem) in its own venv, never a dependency of the package
+PEER_VENV := bench/.peer-venv
+PEER_PY := $(PEER_VENV)/bin/python
+
+$(PEER_VENV)/.installed:
+	@test -n "$(PYTHON)" || { echo "error: no Python >= 3.12 found (set PYTHON=...)"; exit 1; }
+	@test -x $(PEER_PY) || $(PYTHON) -m venv $(PEER_VENV)
+	$(PEER_PY) -m pip install --quiet xfem ngsolve
+	touch $@
+
+bench-peer: $(VENV)/.installed bytecode $(PEER_VENV)/.installed
+	$(PY) bench/peer_cut3d.py --peer-python $(PEER_PY)
 
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check xfem_contact tests demos bench

@@ -109,6 +109,8 @@ SOURCES = sorted(
     for folder in ("xfem_contact", "bench", "tests", "docs")
     for p in (ROOT / folder).rglob("*.py")
     if p.name != "test_docs.py"
+    # not hidden folders: bench/.peer-venv holds the optional peer's installed packages
+    and not any(part.startswith(".") for part in p.relative_to(ROOT).parts)
 )
 
 #: The nodes that carry a docstring besides the module
