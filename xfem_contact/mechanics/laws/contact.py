@@ -12,7 +12,7 @@ closed surface; docs' mechanics page). With the jump ``[u] = u_+ - u_-``, gap
 ``g_n = [u].n`` and slip ``g_t`` the tangential part of ``[u]`` (sticking: the
 tangential jump from the reference state) or of ``[u - u_old]`` (Coulomb, path
 dependent: ``u_old`` the last accepted load step), the Alart-Curnier augmented
-multipliers are (:meth:`ContactLaw.augmented`)
+multipliers are (:meth:`ContactLaw.augmented`)::
 
     P_n = min(0, lambda_n + r g_n)
     P_t = lambda_t + r g_t                                 (sticking)
