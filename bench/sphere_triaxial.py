@@ -3,7 +3,8 @@ the contact pressure and tangential traction errors of the multiplier against th
 ``sigma n`` (uniform stress ``diag(-1, -2, -3)`` Pa, one material), with their rates.
 
 Run: ``python bench/sphere_triaxial.py [--sizes 4 8] [--degree 2] [--law sticking]
-[--cell tetrahedron]``; prints one row per size (dofs, Newton iterations, time).
+[--cell tetrahedron] [--levelset distance|quadric]``; prints one row per size (dofs,
+Newton iterations, time).
 """
 
 import argparse
@@ -27,13 +28,21 @@ def main() -> None:
     parser.add_argument("--law", default="sticking", help="sticking, bonded, coulomb, ...")
     parser.add_argument("--cell", default="tetrahedron", help="tetrahedron or hexahedron")
     parser.add_argument("--friction", type=float, default=None, help="coulomb's mu")
+    parser.add_argument(
+        "--levelset",
+        default="distance",
+        choices=["distance", "quadric"],
+        help="the sphere's level set: signed distance, or the quadric P2 holds exactly",
+    )
     args = parser.parse_args()
     options = {} if args.friction is None else {"friction": args.friction}
     comm = MPI.COMM_WORLD
     rows = []
     for n in args.sizes:
         start = time.perf_counter()
-        problem = sphere_problem(n, args.degree, args.law, args.cell, comm, **options)
+        problem = sphere_problem(
+            n, args.degree, args.law, args.cell, comm, levelset=args.levelset, **options
+        )
         report = problem.solve()
         e_n, e_t = sphere_errors(problem)
         elapsed = time.perf_counter() - start

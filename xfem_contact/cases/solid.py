@@ -110,6 +110,7 @@ def sphere_problem(
     cell: str = "tetrahedron",
     comm: MPI.Comm = MPI.COMM_WORLD,
     stress: tuple[float, float, float] = TRIAXIAL,
+    levelset: str = "distance",
     **options,
 ) -> ElasticityProblem:
     """A sphere (``SPHERE_RADIUS``) in the unit cube (``n`` cells per edge, even),
@@ -118,16 +119,20 @@ def sphere_problem(
     (``u_i = 0`` where ``x_i = 1/2``): the exact stress is ``diag(stress)``
     everywhere, the exact contact traction ``sigma n``. ``law``: ``bonded``,
     ``sticking`` (a contact law stays closed: every ``n.sigma.n < 0``), ...;
-    ``options`` go to the problem."""
+    ``levelset``: ``"distance"`` (the signed distance, whose P2 interpolant's zero set
+    is a sphere to O(h^3)) or ``"quadric"`` (``(|x - c|^2 - R^2) / (2 R)``, which P2
+    represents exactly: the exact sphere and normal); ``options`` go to the problem."""
     if n % 2:
         raise ValueError(f"n must be even (the point constraints are mesh nodes), got {n}")
     mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
     c, R = np.asarray(SPHERE_CENTRE), SPHERE_RADIUS
-    cut = CutMesh(
-        mesh,
-        lambda x: np.sqrt((x[0] - c[0]) ** 2 + (x[1] - c[1]) ** 2 + (x[2] - c[2]) ** 2) - R,
-        degree=2,
-    )
+    shapes = {
+        "distance": lambda x: np.sqrt(((x.T - c) ** 2).sum(axis=1)) - R,
+        "quadric": lambda x: (((x.T - c) ** 2).sum(axis=1) - R**2) / (2 * R),
+    }
+    if levelset not in shapes:
+        raise ValueError(f"levelset must be one of {sorted(shapes)}, got {levelset!r}")
+    cut = CutMesh(mesh, shapes[levelset], degree=2)
     cls = ContactProblem if law in ContactProblem.LAWS else ElasticityProblem
     problem = cls(cut, degree, SOLID, law, **options)
     problem.stress = tuple(stress)
