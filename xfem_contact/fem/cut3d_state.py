@@ -11,11 +11,9 @@ hexahedra and P2 tetrahedra. There are no sub-cells to keep: ``geometry`` is ``N
 from __future__ import annotations
 
 import re
-import types
 
 import dolfinx.mesh
 import numpy as np
-from mpi4py import MPI
 
 from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.cut_state import (
@@ -23,6 +21,7 @@ from xfem_contact.fem.cut_state import (
     SIDE_MINUS,
     SIDE_PLUS,
     CutState,
+    frozen_state,
     interpolate_named,
 )
 from xfem_contact.fem.interface_cells import cell_interfaces, without_slivers
@@ -81,22 +80,10 @@ def cut_state_3d(
         INTERFACE: without_slivers(mesh, cut_cells, cut.interface, maps),
     }
     cell_interface = cell_interfaces(maps, cut_cells, rules[INTERFACE], components)
-    for array in (side, cut_cells, cell_interface):
-        array.setflags(write=False)
-    return CutState(
-        revision=0 if previous is None else previous.revision + 1,
-        levelset=phi,
-        maps=maps,
-        interface_names=names,
-        components=components,
-        cell_sides=side,
-        cut_cells=cut_cells,
-        geometry=None,
-        rules=types.MappingProxyType(rules),
-        cell_interface=cell_interface,
-        crack=None,
-        num_cut_cells_global=mesh.comm.allreduce(cut_cells.size, op=MPI.SUM),
-        timings=types.MappingProxyType({"cut": cut_time, "quadrature": seconds(timer)}),
+    timings = {"cut": cut_time, "quadrature": seconds(timer)}
+    fields = dict(levelset=phi, maps=maps, interface_names=names, components=components)
+    return frozen_state(
+        mesh.comm, previous, fields, side, cut_cells, rules, cell_interface, timings
     )
 
 

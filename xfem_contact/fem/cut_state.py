@@ -161,20 +161,48 @@ def cut_state(
     cell_interface = cell_interfaces(maps, cut_cells, rules[INTERFACE], components)
     if union is not None and len(names) > 1:
         cell_interface = union.cell_crack[cut_cells]
+    timings = {"cut": cut_time, "quadrature": seconds(timer)}
+    return frozen_state(
+        mesh.comm,
+        previous,
+        dict(levelset=phi, maps=maps, interface_names=names, components=components),
+        side,
+        cut_cells,
+        rules,
+        cell_interface,
+        timings,
+        geometry=geometry,
+        crack=crack,
+    )
+
+
+def frozen_state(
+    comm: MPI.Comm,
+    previous: CutState | None,
+    fields: dict,
+    side: np.ndarray,
+    cut_cells: np.ndarray,
+    rules: dict,
+    cell_interface: np.ndarray,
+    timings: dict,
+    geometry=None,
+    crack: Crack | None = None,
+) -> CutState:
+    """The :class:`CutState` after ``previous`` (None: revision 0): ``fields`` (its
+    ``levelset``, ``maps``, ``interface_names``, ``components``), the arrays ``side``,
+    ``cut_cells`` and ``cell_interface`` made read-only, ``rules`` and ``timings`` (s) as
+    read-only mappings. Collective (the global count of cut cells)."""
     for array in (side, cut_cells, cell_interface):
         array.setflags(write=False)
     return CutState(
         revision=0 if previous is None else previous.revision + 1,
-        levelset=phi,
-        maps=maps,
-        interface_names=names,
-        components=components,
+        **fields,
         cell_sides=side,
         cut_cells=cut_cells,
         geometry=geometry,
         rules=types.MappingProxyType(rules),
         cell_interface=cell_interface,
         crack=crack,
-        num_cut_cells_global=mesh.comm.allreduce(ncut, op=MPI.SUM),
-        timings=types.MappingProxyType({"cut": cut_time, "quadrature": seconds(timer)}),
+        num_cut_cells_global=comm.allreduce(cut_cells.size, op=MPI.SUM),
+        timings=types.MappingProxyType(timings),
     )
