@@ -895,13 +895,17 @@ def test_gmsh_scene_errors(mesh, load, key, fragment):
     one_line_error(data, key, fragment, folder=SCENES)
 
 
-def test_gmsh_scene_refuses_a_3d_file(tmp_path):
+def test_gmsh_3d_file_takes_3d_keys(tmp_path):
+    """A 3D .geo makes a 3D scene: 2D cells and 2D shapes refused, naming the 3D ones."""
     ball = tmp_path / "ball.geo"
     ball.write_text(
         'SetFactory("OpenCASCADE");\nSphere(1) = {0, 0, 0, 0.5};\n'
         'Physical Volume("ball", 7) = {1};\nPhysical Surface("hole", 3) = {1};\n'
     )
-    one_line_error(gmsh_scene(file=str(ball)), "mesh.file", "is a 3D geometry (it has volumes)")
+    data = gmsh_scene(file=str(ball))
+    one_line_error(data, "mesh.cell", "choose one of ['tetrahedron', 'hexahedron']")
+    data["mesh"]["cell"] = "tetrahedron"
+    one_line_error(data, "interfaces[0].shape", "'circle' is a 2D shape and the mesh is 3D")
 
 
 def test_msh_file_takes_its_own_cells(tmp_path):

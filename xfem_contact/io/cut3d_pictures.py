@@ -22,6 +22,7 @@ import pyvista
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.io.pictures import SIDE_COLOURS
 from xfem_contact.io.render import _legend, _plotter, _save, _title
+from xfem_contact.io.solid_grids import reference_subcells
 
 __all__ = ["plot_cut_3d"]
 
@@ -32,47 +33,17 @@ EDGE_COLOUR = "#404040"
 MAX_POINTS = 1500
 
 
-def _red_refinement(tets: np.ndarray) -> np.ndarray:
-    """Each tetrahedron ``(n, 4, 3)`` split in eight by its edge midpoints (the faces in
-    four triangles each, so neighbours' refinements match), shape ``(8 n, 4, 3)``."""
-    v = [tets[:, k] for k in range(4)]
-    m = {(i, j): 0.5 * (v[i] + v[j]) for i in range(4) for j in range(i + 1, 4)}
-    children = [
-        (v[0], m[0, 1], m[0, 2], m[0, 3]),
-        (m[0, 1], v[1], m[1, 2], m[1, 3]),
-        (m[0, 2], m[1, 2], v[2], m[2, 3]),
-        (m[0, 3], m[1, 3], m[2, 3], v[3]),
-    ]  # the octahedron around its diagonal m02 - m13, ring m01, m12, m23, m03
-    ring = [m[0, 1], m[1, 2], m[2, 3], m[0, 3]]
-    children += [(m[0, 2], m[1, 3], ring[k], ring[(k + 1) % 4]) for k in range(4)]
-    return np.stack([np.stack(c, axis=1) for c in children], axis=1).reshape(-1, 4, 3)
-
-
-def _reference_subcells(cell: str, levels: int) -> tuple[np.ndarray, pyvista.CellType]:
-    """Sub-cells of the reference cell, ``2^levels`` per edge, vertices ``(m, nv, 3)`` in
-    VTK order, and their VTK type."""
-    if cell == "tetrahedron":
-        tets = np.array([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]])
-        for _ in range(levels):
-            tets = _red_refinement(tets)
-        return tets, pyvista.CellType.TETRA
-    k = 2**levels
-    square = [[0, 0], [1, 0], [1, 1], [0, 1]]
-    corners = np.array([[x, y, z] for z in (0, 1) for x, y in square], dtype=float)
-    origins = np.stack(np.meshgrid(*[np.arange(k)] * 3, indexing="ij"), -1).reshape(-1, 1, 3)
-    return (origins + corners) / k, pyvista.CellType.HEXAHEDRON
-
-
 def _cut_cell_grid(cut: CutMesh, levels: int) -> pyvista.UnstructuredGrid:
     """The cut cells refined ``2^levels`` times per edge into linear cells, with
     ``phi_h`` at their vertices (the same values at the vertices two cells share)."""
-    sub, vtk_type = _reference_subcells(cut.mesh.topology.cell_name(), levels)
+    sub, vtk_type = reference_subcells(cut.mesh.topology.cell_name(), levels)
     m, nv = sub.shape[:2]
     X = np.tile(sub.reshape(-1, 3), (cut.cut_cells.size, 1))
     cells = np.repeat(cut.cut_cells, m * nv)
     connectivity = np.arange(X.shape[0]).reshape(-1, nv)
     grid = pyvista.UnstructuredGrid(
-        {vtk_type: connectivity}, cut.maps.push_forward(cells, X).astype(np.float64)
+        {pyvista.CellType(vtk_type): connectivity},
+        cut.maps.push_forward(cells, X).astype(np.float64),
     )
     grid.point_data["phi"] = cut.maps.values(cells, X)
     return grid

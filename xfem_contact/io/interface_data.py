@@ -1,13 +1,15 @@
 """The interface laws' state at the nodes of ``interface.vtu`` (point data per lip node).
 
 The nodes are those of :func:`~xfem_contact.io.vtu.interface_arrays` (three per curved
-piece: end ``a``, end ``b``, mid-node). For a law acting on one cell (small sliding) its
-``state`` is evaluated at these nodes with the same definitions and normal as at its
-rule points; a law that pairs two cells (large sliding) is sampled at the nearest of its
-own points in the same cut cell. Point data (each ``(npoints,)``): ``lambda_n``,
-``lambda_t`` (multipliers, Pa), ``gap``, ``slip`` (m) and ``status`` (0 open, 1 stick,
-2 slip; frictionless contact is slip, a bonded interface stick, a free one open).
-Local to each process.
+piece: end ``a``, end ``b``, mid-node) in 2D, of
+:func:`~xfem_contact.io.solid_grids.interface_arrays_3d` (three per triangle) in 3D. For a
+law acting on one cell (small sliding) its ``state`` is evaluated at these nodes with
+the same definitions and normal as at its rule points; a law that pairs two cells (large
+sliding) is sampled at the nearest of its own points in the same cut cell. Point data
+(each ``(npoints,)``): ``lambda_n``, ``lambda_t`` (multipliers, Pa), ``gap``, ``slip``
+(m) and ``status`` (0 open, 1 stick, 2 slip; frictionless contact is slip, a bonded
+interface stick, a free one open); in 3D ``lambda_t`` and ``slip`` are Cartesian vectors
+``(npoints, 3)``. Local to each process.
 """
 
 from __future__ import annotations
@@ -23,14 +25,24 @@ from xfem_contact.quadrature.rules import RuleSet
 KEYS = ("lambda_n", "lambda_t", "gap", "slip")
 
 
-def _node_rules(cut, pieces: np.ndarray) -> RuleSet:
-    """Rules (rows ``cut.cut_cells``) whose points are the nodes of the pieces ``pieces``."""
-    g = cut.geometry
-    rows = g.seg_cell[pieces]  # sorted, as g.seg_cell
+def _interface_pieces(cut) -> tuple[np.ndarray, np.ndarray]:
+    """The pieces of ``interface.vtu``: their rows of ``cut.cut_cells`` ``(P,)`` (sorted)
+    and reference nodes ``(P, 3, tdim)``."""
+    if cut.geometry is not None:
+        return cut.geometry.seg_cell, cut.geometry.seg
+    from xfem_contact.io.solid_grids import cut_pieces
+
+    cells, X = cut_pieces(cut).interface
+    return np.searchsorted(cut.cut_cells, cells), X
+
+
+def _node_rules(cut, rows: np.ndarray, nodes: np.ndarray) -> RuleSet:
+    """Rules (rows ``cut.cut_cells``) whose points are the ``nodes`` ``(P, 3, tdim)`` of
+    pieces in the cut cells ``rows`` ``(P,)`` (sorted)."""
     counts = np.bincount(rows, minlength=cut.cut_cells.size) * 3
     offsets = np.zeros(cut.cut_cells.size + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
-    points = np.ascontiguousarray(g.seg[pieces].reshape(-1, 2))
+    points = np.ascontiguousarray(nodes.reshape(-1, nodes.shape[-1]))
     return RuleSet(points, np.zeros(points.shape[0]), offsets)
 
 
@@ -61,26 +73,30 @@ def interface_point_data(problem) -> dict[str, np.ndarray]:
     :func:`~xfem_contact.io.vtu.interface_arrays`). Collective (large-sliding laws
     pair their points across processes)."""
     cut = problem.cut
-    g = cut.geometry
-    npoints = 3 * g.seg_cell.size
+    piece_rows, piece_nodes = _interface_pieces(cut)
+    npoints = 3 * piece_rows.size
     data = {k: np.zeros(npoints) for k in KEYS} | {"status": np.zeros(npoints, dtype=np.int8)}
-    interface_of_piece = cut.cell_interface[g.seg_cell] if g.seg_cell.size else g.seg_cell
+    interface_of_piece = cut.cell_interface[piece_rows] if piece_rows.size else piece_rows
     couplings = getattr(problem, "couplings", {}) or {}
     for name, law in problem.laws.items():
         ctx = problem.contexts[name]
         k = list(cut.interface_names).index(name) if len(problem.laws) > 1 else None
         pieces = (
-            np.flatnonzero(interface_of_piece == k) if k is not None else np.arange(g.seg_cell.size)
+            np.flatnonzero(interface_of_piece == k) if k is not None else np.arange(piece_rows.size)
         )
         if name in couplings:
             state = _nearest(cut, ctx.rules, law.state(ctx, problem.w), pieces)
         else:
-            nodes = dataclasses.replace(ctx, rules=_node_rules(cut, pieces), _cache={})
+            rules = _node_rules(cut, piece_rows[pieces], piece_nodes[pieces])
+            nodes = dataclasses.replace(ctx, rules=rules, _cache={})
             state = law.state(nodes, problem.w)
         rows = (3 * pieces[:, None] + np.arange(3)).ravel()
         for key in KEYS:
             if key in state:
-                data[key][rows] = state[key]
+                values = np.asarray(state[key])
+                if data[key].shape != (npoints, *values.shape[1:]):  # vectors in 3D
+                    data[key] = np.zeros((npoints, *values.shape[1:]))
+                data[key][rows] = values
         data["status"][rows] = law.point_status(state, rows.size)
     return data
 

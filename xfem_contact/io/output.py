@@ -106,9 +106,16 @@ def write_cut_geometry(
 
 
 def interface_grid_arrays(cut: CutMesh, interface_data: dict | None = None):
-    """:func:`~xfem_contact.io.vtu.interface_arrays` with point data ``interface_data``
-    (name to an array over its nodes)."""
-    return interface_arrays(cut)._replace(point_data=dict(interface_data or {}))
+    """:func:`~xfem_contact.io.vtu.interface_arrays` (in 3D
+    :func:`~xfem_contact.io.solid_grids.interface_arrays_3d`) with point data
+    ``interface_data`` (name to an array over its nodes)."""
+    if cut.geometry is None:
+        from xfem_contact.io.solid_grids import interface_arrays_3d
+
+        arrays = interface_arrays_3d(cut)
+    else:
+        arrays = interface_arrays(cut)
+    return arrays._replace(point_data=dict(interface_data or {}))
 
 
 def _jsonable(value):

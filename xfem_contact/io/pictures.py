@@ -265,7 +265,8 @@ def render_folder(
     ``summary.json``) and, for friction laws, ``traction.png`` (the tangential traction
     with each point's stick / slip status); one plot per interface when there are
     several (``pressure_NAME.png``, ``traction_NAME.png``); for a crack ``lips.png``
-    (opening, slip and multipliers along its lips). A picture whose data is
+    (opening, slip and multipliers along its lips). A 3D run's pictures are
+    :func:`~xfem_contact.io.solid_pictures.render_solid`'s. A picture whose data is
     missing is skipped with an INFO record on this module's logger, as is each file
     written.
 
@@ -278,6 +279,7 @@ def render_folder(
         plot_pressure,
         plot_traction,
     )
+    from xfem_contact.io.solid_pictures import is_solid, render_solid
 
     say = logger.info
     folder = pathlib.Path(folder)
@@ -292,6 +294,11 @@ def render_folder(
     quiet_vtk()
     written = []
     grid = merge_grids([pyvista.read(p) for p in results])
+    if is_solid(grid):  # a 3D run
+        written = render_solid(folder, grid, summary, name)
+        for path in written:
+            say(f"wrote {path}")
+        return written
     # large kinematics: the true deformed configuration (a magnified rotation shrinks)
     large = summary.get("effects", {}).get("kinematics") == "large"
     written.append(

@@ -42,6 +42,7 @@ from xfem_contact.fem.evaluation import cell_dofs, evaluate_lattice, evaluate_re
 QUADRATIC_EDGE, QUADRATIC_TRIANGLE, BIQUADRATIC_QUAD = 21, 22, 28
 LAGRANGE_TRIANGLE, LAGRANGE_QUADRILATERAL = 69, 70
 _NODES = {QUADRATIC_EDGE: 3, QUADRATIC_TRIANGLE: 6, BIQUADRATIC_QUAD: 9}
+_NODES |= {5: 3, 10: 4, 12: 8, 13: 6}  # linear triangle, tetrahedron, hexahedron, wedge
 
 # Reference nodes of the uncut cells' quadratic lattice, in VTK node order
 _LATTICE = {

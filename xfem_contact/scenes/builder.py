@@ -18,7 +18,7 @@ from xfem_contact.geometry.levelset import InterfaceError
 from xfem_contact.io.gmsh import GmshMesh, facets, read_gmsh
 from xfem_contact.io.meshes import annulus
 from xfem_contact.mechanics.laws import make_law
-from xfem_contact.mechanics.loads import annulus_parts, rectangle_parts
+from xfem_contact.mechanics.loads import annulus_parts, box_parts
 from xfem_contact.mechanics.plain import PlainElasticityProblem
 from xfem_contact.mechanics.problem import Problem
 from xfem_contact.scenes.crack_builder import crack_cut, problem_error
@@ -27,9 +27,27 @@ from xfem_contact.scenes.load_kinds import LOAD_KINDS
 from xfem_contact.scenes.scene import InterfaceSpec, Scene, SceneError
 
 
-def levelset(spec: InterfaceSpec) -> Callable[[np.ndarray], np.ndarray]:
-    """The level set of an interface, negative on its side -1 (``inside``)."""
+def levelset(spec: InterfaceSpec, gdim: int = 2) -> Callable[[np.ndarray], np.ndarray]:
+    """The level set of an interface on a mesh of dimension ``gdim``, negative on its side
+    -1 (``inside``). The curved 3D shapes are quadrics scaled to unit slope on the surface
+    (a P2 level set holds them exactly): ``(|x - c|^2 - R^2) / (2 R)`` for a sphere."""
     p = spec.params
+    if spec.shape in ("sphere", "ellipsoid"):
+        axes = np.full(3, float(p["radius"])) if spec.shape == "sphere" else np.array(p["axes"])
+        c, scale = np.asarray(p["centre"], dtype=float), axes.min()
+        return lambda x: 0.5 * scale * (((x.T - c) / axes) ** 2).sum(axis=1) - 0.5 * scale
+    if spec.shape == "cylinder":
+        a, r = np.asarray(p["axis"], dtype=float), float(p["radius"])
+        a, c = a / np.linalg.norm(a), np.asarray(p["point"], dtype=float)
+
+        def phi(x):
+            d = x.T - c
+            return (np.sum(d * d, axis=1) - (d @ a) ** 2 - r * r) / (2.0 * r)
+
+        return phi
+    if spec.shape == "plane":
+        n, c = np.asarray(p["normal"], dtype=float), np.asarray(p["point"], dtype=float)
+        return lambda x: (x.T - c) @ (n / np.linalg.norm(n))
     if spec.shape == "circle":
         (cx, cy), r = p["centre"], float(p["radius"])
         return lambda x: np.hypot(x[0] - cx, x[1] - cy) - r
@@ -47,15 +65,15 @@ def levelset(spec: InterfaceSpec) -> Callable[[np.ndarray], np.ndarray]:
         (px, py), (nx, ny) = p["point"], p["normal"]
         norm = np.hypot(nx, ny)
         return lambda x: ((x[0] - px) * nx + (x[1] - py) * ny) / norm
-    return numpy_field(p["expression"], "interface expression")
+    return numpy_field(p["expression"], "interface expression", gdim)
 
 
 def scene_parts(scene: Scene, meshed: MeshedDomain) -> dict:
     """The boundary parts a scene can name: the built-in ones of its mesh kind, the
     named physical groups of a gmsh file (local facet indices), the scene's own
     (locators of ``x``)."""
-    if scene.kind == "rectangle":
-        parts = rectangle_parts(scene.corners)
+    if scene.kind in ("rectangle", "box"):
+        parts = box_parts(scene.corners)
     elif scene.kind == "annulus":
         parts = annulus_parts(*scene.radii)
     else:
@@ -63,16 +81,17 @@ def scene_parts(scene: Scene, meshed: MeshedDomain) -> dict:
     if meshed.gmsh is not None:
         parts |= {name: facets(meshed.gmsh, name) for name in meshed.gmsh.parts}
     for name, where in scene.parts.items():
-        f = compile_expression(where, f"parts.{name}.where")
+        f = compile_expression(where, f"parts.{name}.where", dim=scene.gdim)
         parts[name] = lambda x, f=f: np.broadcast_to(np.asarray(f(x), dtype=bool), x[0].shape)
     return parts
 
 
-def _value(value):
-    """A load value: number, [a, b], or expression string(s) -> number, tuple or callable
-    (of the UFL ``x`` for loads on forms, of numpy points for displacements)."""
+def _value(value, gdim: int = 2):
+    """A load value: number, [a, b] ([a, b, c] in 3D), or expression string(s) -> number,
+    tuple or callable (of the UFL ``x`` for loads on forms, of numpy points for
+    displacements)."""
     if isinstance(value, list | tuple):
-        comps = [_value(v) for v in value]
+        comps = [_value(v, gdim) for v in value]
 
         def vector_value(x):
             if isinstance(x, ufl.core.expr.Expr):
@@ -83,7 +102,7 @@ def _value(value):
 
         return vector_value if any(callable(c) for c in comps) else tuple(comps)
     if isinstance(value, str):
-        f = compile_expression(value, "load value")
+        f = compile_expression(value, "load value", dim=gdim)
         return lambda x: (
             f(x)
             if isinstance(x, ufl.core.expr.Expr)
@@ -100,7 +119,12 @@ class MeshedDomain(NamedTuple):
 
 
 def create_mesh(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> MeshedDomain:
-    """The mesh a scene names: rectangle, annulus (curved cells) or a gmsh file. Collective."""
+    """The mesh a scene names: rectangle, annulus (curved cells), box or a gmsh file.
+    Collective."""
+    if scene.kind == "box":
+        cell = dolfinx.mesh.CellType[scene.cell]
+        box = [list(scene.corners[0]), list(scene.corners[1])]
+        return MeshedDomain(dolfinx.mesh.create_box(comm, box, list(scene.cells), cell))
     if scene.kind == "gmsh":
         meshed = read_gmsh(scene.file, comm, scene.geometry_degree, scene.cell, scene.size)
         return MeshedDomain(meshed.mesh, meshed)
@@ -118,7 +142,7 @@ def create_mesh(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD) -> MeshedDomain:
 def interface_levelsets(scene: Scene) -> dict[str, Callable]:
     """The level sets of the scene's interfaces by name (a :class:`CutMesh` cuts
     several as one, checked apart: see :func:`xfem_contact.geometry.levelset.union`)."""
-    return {spec.name: levelset(spec) for spec in scene.interfaces}
+    return {spec.name: levelset(spec, scene.gdim) for spec in scene.interfaces}
 
 
 def interface_error(scene: Scene, error: InterfaceError) -> SceneError:
@@ -206,14 +230,14 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD, petsc_options_prefix: s
         loads.add_stage(name, start, end)
     for k, load in enumerate(scene.loads):
         try:
-            _apply(loads, load)
+            _apply(loads, load, scene.gdim)
         except ValueError as error:
             raise SceneError(f"loads[{k}]", str(error)) from None
     return problem, effects
 
 
-def _apply(loads, load) -> None:
+def _apply(loads, load, gdim: int) -> None:
     """Add one scene load to a problem's :class:`~xfem_contact.mechanics.loads.Loads`
     (its type's row of :data:`~xfem_contact.scenes.load_kinds.LOAD_KINDS`)."""
-    value = None if load.value is None else _value(load.value)
+    value = None if load.value is None else _value(load.value, gdim)
     LOAD_KINDS[load.type].add(loads, load, value, {"path": load.path})

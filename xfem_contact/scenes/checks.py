@@ -122,13 +122,15 @@ class Vector:
 
 @dataclasses.dataclass(frozen=True)
 class Scalar:
-    """A number or an expression of x, y for ``target`` (see :func:`check_expression`)."""
+    """A number or an expression of x, y (and z: ``dim`` 3) for ``target`` (see
+    :func:`check_expression`)."""
 
     target: str = "number"
+    dim: int = 2
 
     def __call__(self, value, key: str):
         if isinstance(value, str):
-            check_expression(value, key, self.target)
+            check_expression(value, key, self.target, self.dim)
             return value
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             message = f"expected a number or an expression string, got {describe(value)}"
@@ -138,14 +140,16 @@ class Scalar:
 
 @dataclasses.dataclass(frozen=True)
 class Expression:
-    """An expression string of x, y for ``target`` (see :func:`check_expression`)."""
+    """An expression string of x, y (and z: ``dim`` 3) for ``target`` (see
+    :func:`check_expression`)."""
 
     target: str = "number"
+    dim: int = 2
 
     def __call__(self, value, key: str):
         if not isinstance(value, str):
             raise SceneError(key, f"expected an expression string, got {describe(value)}")
-        check_expression(value, key, self.target)
+        check_expression(value, key, self.target, self.dim)
         return value
 
 

@@ -1,6 +1,7 @@
 """User expressions of the coordinates given as text (scene files).
 
-An expression is Python arithmetic in ``x`` and ``y`` (m) with the functions
+An expression is Python arithmetic in ``x`` and ``y`` (and ``z`` on a 3D mesh) (m) with the
+functions
 ``sin cos tan exp log sqrt abs hypot arctan2 minimum maximum where isclose`` and
 the constant ``pi``. It evaluates on numpy arrays (level sets, boundary
 locators, Dirichlet data) and, for the functions UFL knows, on UFL coordinates
@@ -58,7 +59,9 @@ _NUMPY = {
     "where": np.where,
     "isclose": np.isclose,
 }
-ALLOWED_NAMES = frozenset({"x", "y", "pi", *_NUMPY})
+ALLOWED_NAMES = frozenset({"x", "y", "z", "pi", *_NUMPY})
+#: The coordinates an expression may use on a mesh of each geometric dimension
+COORDINATES = {2: ("x", "y"), 3: ("x", "y", "z")}
 #: Number of arguments of each function (numpy would read more as ``out=``)
 _ARITY = dict.fromkeys(_NUMPY, 1) | dict.fromkeys(("hypot", "arctan2", "isclose"), 2)
 _ARITY |= {"minimum": 2, "maximum": 2, "where": 3}
@@ -87,8 +90,9 @@ def _short(text: str) -> str:
     return quoted if len(quoted) <= 60 else quoted[:56] + "...'"
 
 
-def _refusal(node: ast.AST, loads: bool) -> str | None:
-    """Why ``node`` is not allowed in an expression (``loads``: evaluated by UFL), or None."""
+def _refusal(node: ast.AST, loads: bool, dim: int = 2) -> str | None:
+    """Why ``node`` is not allowed in an expression (``loads``: evaluated by UFL) on a mesh
+    of dimension ``dim``, or None."""
     functions = _UFL if loads else _NUMPY
     operators = _ARITHMETIC if loads else _ARITHMETIC | _LOGICAL
     if isinstance(node, ast.Constant):
@@ -102,11 +106,14 @@ def _refusal(node: ast.AST, loads: bool) -> str | None:
             return f"uses the non-finite number {node.value}"
         return None
     if isinstance(node, ast.Name):
-        if node.id in ("x", "y", "pi"):
+        names = (*COORDINATES[dim], "pi")
+        if node.id in names:
             return None
         if node.id in functions:
             return f"uses the function {node.id} without calling it"
-        return f"uses the unknown name {node.id!r}; allowed: {sorted({'x', 'y', 'pi', *functions})}"
+        if node.id == "z":
+            return "uses z, the third coordinate, on a 2D mesh (coordinates there: x, y)"
+        return f"uses the unknown name {node.id!r}; allowed: {sorted({*names, *functions})}"
     if isinstance(node, ast.Call):
         name = node.func.id if isinstance(node.func, ast.Name) else None
         if name not in functions:
@@ -171,14 +178,14 @@ class _Floats(ast.NodeTransformer):
         return node
 
 
-def _check_tree(tree: ast.Expression, text: str, what: str, loads: bool) -> None:
+def _check_tree(tree: ast.Expression, text: str, what: str, loads: bool, dim: int) -> None:
     """Refuse disallowed syntax and too deep nesting (iterative: no recursion limit)."""
     stack = [(tree.body, 1)]
     while stack:
         node, depth = stack.pop()
         if depth > MAX_DEPTH:
             raise ValueError(f"{what}: {_short(text)} nests deeper than {MAX_DEPTH} levels")
-        problem = _refusal(node, loads)
+        problem = _refusal(node, loads, dim)
         if problem:
             raise ValueError(f"{what}: {_short(text)} {problem}")
         children = [c for c in ast.iter_child_nodes(node) if not isinstance(c, _OPERATOR_NODES)]
@@ -193,7 +200,7 @@ def _check_constants(node: ast.AST, text: str, what: str) -> bool:
     children = node.args if isinstance(node, ast.Call) else list(ast.iter_child_nodes(node))
     children = [c for c in children if not isinstance(c, _OPERATOR_NODES)]
     flags = [_check_constants(child, text, what) for child in children]
-    constant = all(flags) and not (isinstance(node, ast.Name) and node.id in ("x", "y"))
+    constant = all(flags) and not (isinstance(node, ast.Name) and node.id in COORDINATES[3])
     if not constant:
         for child, flag in zip(children, flags, strict=True):
             if flag and not isinstance(child, ast.Constant | ast.Name):
@@ -217,11 +224,14 @@ def _finite_constant(node: ast.expr, text: str, what: str) -> None:
 _FUNCTIONS = {name: _dispatch(name) for name in _NUMPY}
 
 
-def compile_expression(text: str, what: str = "expression", loads: bool = False) -> Callable:
-    """Turn ``text`` into ``f(x)``, ``x`` of shape (>=2, n) (numpy) or a UFL coordinate.
+def compile_expression(
+    text: str, what: str = "expression", loads: bool = False, dim: int = 2
+) -> Callable:
+    """Turn ``text`` into ``f(x)``, ``x`` of shape (>=dim, n) (numpy) or a UFL coordinate.
 
     ``what`` names the expression in errors (its scene key); ``loads``: only what
-    UFL evaluates (no comparisons, no ``& | ~``, the functions UFL knows).
+    UFL evaluates (no comparisons, no ``& | ~``, the functions UFL knows); ``dim``: the
+    mesh's geometric dimension (``z`` is a coordinate in 3D only).
 
     Raises:
         ValueError: ``WHAT: message`` (one line) on a syntax error, a name outside
@@ -237,23 +247,25 @@ def compile_expression(text: str, what: str = "expression", loads: bool = False)
     except (SyntaxError, ValueError, RecursionError, MemoryError) as err:
         reason = err.msg if isinstance(err, SyntaxError) else str(err) or "nested too deeply"
         raise ValueError(f"{what}: cannot read {_short(text)}: {reason}") from None
-    _check_tree(tree, text, what, loads)
+    _check_tree(tree, text, what, loads, dim)
     tree = ast.fix_missing_locations(_Floats().visit(tree))
     if _check_constants(tree.body, text, what) and not isinstance(tree.body, ast.Constant):
         _finite_constant(tree.body, text, what)
     code = compile(tree, f"<{what}>", "eval")
 
     def f(x):
-        return eval(code, {"__builtins__": {}}, {**_FUNCTIONS, "pi": np.pi, "x": x[0], "y": x[1]})
+        coordinates = {name: x[k] for k, name in enumerate(COORDINATES[dim])}
+        return eval(code, {"__builtins__": {}}, {**_FUNCTIONS, "pi": np.pi, **coordinates})
 
     return f
 
 
 @functools.cache
-def _ufl_coordinate():
+def _ufl_coordinate(dim: int = 2):
     import basix.ufl
 
-    return ufl.SpatialCoordinate(ufl.Mesh(basix.ufl.element("Lagrange", "triangle", 1, shape=(2,))))
+    cell = {2: "triangle", 3: "tetrahedron"}[dim]
+    return ufl.SpatialCoordinate(ufl.Mesh(basix.ufl.element("Lagrange", cell, 1, shape=(dim,))))
 
 
 #: Sample points of a trial evaluation (shape (3, n), as DOLFINx interpolation passes)
@@ -261,15 +273,16 @@ _SAMPLES = np.vstack([np.repeat([-1.0, 0.0, 0.5, 1.0], 4), np.tile([-1.0, 0.0, 0
 _SAMPLES = np.vstack([_SAMPLES, np.zeros(_SAMPLES.shape[1])])
 
 
-def check_expression(text, what: str, target: str = "number") -> Callable:
+def check_expression(text, what: str, target: str = "number", dim: int = 2) -> Callable:
     """Compile ``text`` and evaluate it once on sample points: ``target`` ``"number"``
     (numpy values, e.g. level sets, Dirichlet data), ``"boolean"`` (boundary parts) or
-    ``"load"`` (UFL, a scalar). Returns the compiled ``f``; raises ``WHAT: message``."""
-    f = compile_expression(text, what, loads=target == "load")
+    ``"load"`` (UFL, a scalar); ``dim`` the mesh's geometric dimension. Returns the
+    compiled ``f``; raises ``WHAT: message``."""
+    f = compile_expression(text, what, loads=target == "load", dim=dim)
     try:
         with np.errstate(all="ignore"):
             if target == "load":
-                value = ufl.as_ufl(f(_ufl_coordinate()))
+                value = ufl.as_ufl(f(_ufl_coordinate(dim)))
                 if value.ufl_shape != ():
                     raise ValueError(f"the value has shape {value.ufl_shape}, not a scalar")
             else:
@@ -281,8 +294,11 @@ def check_expression(text, what: str, target: str = "number") -> Callable:
     return f
 
 
-def numpy_field(text: str, what: str = "expression") -> Callable[[np.ndarray], np.ndarray]:
-    """``text`` as a level set or a nodal field: ``f(x)``, ``x`` of shape (>=2, n), returning
-    a float array ``(n,)`` (a constant broadcast). Raises as :func:`compile_expression`."""
-    f = compile_expression(text, what)
+def numpy_field(
+    text: str, what: str = "expression", dim: int = 2
+) -> Callable[[np.ndarray], np.ndarray]:
+    """``text`` as a level set or a nodal field: ``f(x)``, ``x`` of shape (>=dim, n),
+    returning a float array ``(n,)`` (a constant broadcast). Raises as
+    :func:`compile_expression`."""
+    f = compile_expression(text, what, dim=dim)
     return lambda x: np.broadcast_to(np.asarray(f(x), dtype=float), x[0].shape).copy()

@@ -13,32 +13,37 @@ import typing
 from xfem_contact.scenes.checks import Number, Scalar, SceneError, Vector
 
 
-def _number(value, component: bool, key: str) -> None:
+def _number(value, component: bool, key: str, gdim: int = 2) -> None:
     Number()(value, key)
 
 
-def _stiffness(value, component: bool, key: str) -> None:
+def _stiffness(value, component: bool, key: str, gdim: int = 2) -> None:
     Number(0.0, open=True)(value, key)
 
 
-def _scalar_load(value, component: bool, key: str) -> None:
-    Scalar("load")(value, key)
+def _scalar_load(value, component: bool, key: str, gdim: int = 2) -> None:
+    Scalar("load", gdim)(value, key)
 
 
-def _vector_load(value, component: bool, key: str) -> None:
-    Vector(2, Scalar("load"))(value, key)
+def _vector_load(value, component: bool, key: str, gdim: int = 2) -> None:
+    Vector(gdim, Scalar("load", gdim))(value, key)
 
 
-def _displacement(value, component: bool, key: str) -> None:
-    """A component's value, or [vx, vy]; a single expression needs a component."""
+def _displacement(value, component: bool, key: str, gdim: int = 2) -> None:
+    """A component's value, or [vx, vy] ([vx, vy, vz] in 3D); a single expression needs a
+    component."""
     if component:
-        Scalar("number")(value, key)
+        Scalar("number", gdim)(value, key)
     elif isinstance(value, list | tuple):
-        Vector(2, Scalar("number"))(value, key)
+        Vector(gdim, Scalar("number", gdim))(value, key)
     elif isinstance(value, str):
-        raise SceneError(key, "an expression needs component = 0 or 1; for both give [vx, vy]")
+        if gdim == 2:
+            message = "an expression needs component = 0 or 1; for both give [vx, vy]"
+        else:
+            message = "an expression needs component = 0, 1 or 2; for all give [vx, vy, vz]"
+        raise SceneError(key, message)
     else:
-        Scalar("number")(value, key)
+        Scalar("number", gdim)(value, key)
 
 
 def _rotation(loads, load, value, path: dict) -> None:
@@ -52,8 +57,9 @@ class LoadKind(typing.NamedTuple):
     Attributes:
         required: The keys a load of this type must have (besides ``type``).
         optional: The keys it may have.
-        check: ``check(value, component, key)``: raises :class:`SceneError` unless the
-            value has this type's form (``component``: whether the table gives one).
+        check: ``check(value, component, key, gdim=2)``: raises :class:`SceneError` unless
+            the value has this type's form (``component``: whether the table gives one;
+            ``gdim``: the mesh's geometric dimension).
         add: ``add(loads, spec, value, path)``: adds the load of the checked ``spec``
             (:class:`~xfem_contact.scenes.records.LoadSpec`) to ``loads``; ``value`` is
             the spec's value made a number, tuple or callable, ``path`` the keyword
@@ -62,7 +68,7 @@ class LoadKind(typing.NamedTuple):
 
     required: tuple[str, ...]
     optional: tuple[str, ...]
-    check: typing.Callable[[object, bool, str], None]
+    check: typing.Callable[[object, bool, str, int], None]
     add: typing.Callable[..., None]
 
 

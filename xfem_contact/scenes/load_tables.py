@@ -6,8 +6,10 @@ from __future__ import annotations
 
 from xfem_contact.scenes.load_kinds import LOAD_KINDS
 from xfem_contact.scenes.schema import (
-    FIELDS,
+    BOX_FACES,
+    FIELDS_BY_DIM,
     LOAD_KEYS,
+    PLANE_LOAD_TYPES,
     LoadSpec,
     SceneError,
     check_table,
@@ -15,12 +17,18 @@ from xfem_contact.scenes.schema import (
 )
 
 
-def load_spec(table, where: str, known_parts: set, stages: dict) -> LoadSpec:
-    """A load from its checked table: the keys of its type, its part, the form of its
-    value, the stage its load path names."""
+def load_spec(table, where: str, known_parts: set, stages: dict, gdim: int = 2) -> LoadSpec:
+    """A load from its checked table on a mesh of dimension ``gdim``: the keys of its type,
+    its part, the form of its value, the stage its load path names."""
     table = renamed(table, "load", where)
-    check_table(table, FIELDS["load"], where)
+    check_table(table, FIELDS_BY_DIM[gdim]["load"], where)
     kind = table["type"]
+    if gdim == 3 and kind in PLANE_LOAD_TYPES:
+        message = (
+            f"{kind!r} is a load of 2D meshes (in the plane); on a 3D mesh give a "
+            "'displacement' (of expressions of x, y, z) instead"
+        )
+        raise SceneError(f"{where}.type", message)
     required, optional = LOAD_KEYS[kind]
     for key in required:
         if key not in table:
@@ -33,11 +41,13 @@ def load_spec(table, where: str, known_parts: set, stages: dict) -> LoadSpec:
     part = table.get("part")
     if "part" in required and part not in known_parts:
         message = f"{part!r}: no such boundary part; known: {sorted(known_parts)}"
+        if gdim == 2 and part in BOX_FACES[2]:
+            message += " (front and back are the z faces of a 3D box)"
         raise SceneError(f"{where}.part", message)
     if kind == "rotation" and ("value" in table) == ("angle_deg" in table):
         raise SceneError(f"{where}.value", "give the angle once: value (rad) or angle_deg")
     if "value" in table:
-        LOAD_KINDS[kind].check(table["value"], "component" in table, f"{where}.value")
+        LOAD_KINDS[kind].check(table["value"], "component" in table, f"{where}.value", gdim)
     path = table.get("path")
     if isinstance(path, str) and path not in stages:
         message = f"{path!r}: no such stage; known: {sorted(stages)}"

@@ -95,3 +95,5 @@ class Scene:
     petsc_options: dict = dataclasses.field(default_factory=dict)
     #: The cracks (one at most today; not with interfaces)
     cracks: tuple[CrackSpec, ...] = ()
+    #: The geometric dimension of the mesh: 2, or 3 (a box, a 3D gmsh file)
+    gdim: int = 2

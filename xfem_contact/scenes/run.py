@@ -315,6 +315,7 @@ class StepGrids:
         """The grids of the current state (name to :class:`~xfem_contact.io.vtu.GridArrays`)."""
         from xfem_contact.io.interface_data import interface_point_data
         from xfem_contact.io.output import interface_grid_arrays
+        from xfem_contact.io.solid_grids import lips_arrays_3d
         from xfem_contact.io.vtu import lips_arrays, plain_arrays
 
         problem, fields, stress = self.problem, self.result.fields, self.result.stress
@@ -325,8 +326,9 @@ class StepGrids:
             "stress": dict(zip((-1, 1), stress.stress, strict=True)),
             "von_mises": dict(zip((-1, 1), stress.von_mises, strict=True)),
         }
+        lips = lips_arrays if problem.mesh.geometry.dim == 2 else lips_arrays_3d
         return {
-            "result": lips_arrays(problem.cut, fields[0], fields[1], named),
+            "result": lips(problem.cut, fields[0], fields[1], named),
             "interface": interface_grid_arrays(problem.cut, interface_point_data(problem)),
         }
 
@@ -340,11 +342,14 @@ class StepGrids:
         """``result.vtu``, ``interface.vtu`` of the last step written, ``subcells.vtu``."""
         from xfem_contact.io.output import VTU_COMPRESSION
         from xfem_contact.io.series import write_grid
+        from xfem_contact.io.solid_grids import subcell_arrays_3d
         from xfem_contact.io.vtu import subcell_arrays
 
         comm = self.problem.mesh.comm
         grids = dict(self.last)
-        if self.problem.cut is not None:
+        if self.problem.cut is not None and self.problem.mesh.geometry.dim == 2:
             grids["subcells"] = subcell_arrays(self.problem.cut, uncut=False)
+        elif self.problem.cut is not None:
+            grids["subcells"] = subcell_arrays_3d(self.problem.cut)
         for name, arrays in grids.items():
             write_grid(self.out / f"{name}.vtu", arrays, comm, VTU_COMPRESSION)

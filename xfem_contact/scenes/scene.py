@@ -49,15 +49,20 @@ from xfem_contact.scenes.schema import (  # noqa: F401  (re-exported)
     BUILTIN_PARTS,
     CELLS,
     FIELDS,
+    FIELDS_BY_DIM,
     KINEMATICS,
     LAWS,
     LOAD_KEYS,
     LOAD_TYPES,
+    MATERIAL_MODES,
+    MESH_DIMENSION,
     MESH_KEYS,
     MESH_KINDS,
     SCHEMA,
+    SHAPE_ANALOGUES,
     SHAPE_KEYS,
     SHAPES,
+    SHAPES_BY_DIM,
     SHARED_INTERFACE_KEYS,
     TOP_LEVEL,
     InterfaceSpec,
@@ -133,18 +138,20 @@ def load_scene(
         raise SceneError(join("", unknown[0]), f"unknown key; valid: {list(TOP_LEVEL)}")
     head = check_table(data.get("scene", {}), FIELDS["scene"], "scene")
     mesh = _mesh(data.get("mesh", {}), folder)
+    gdim = mesh["gdim"]
+    fields = FIELDS_BY_DIM[gdim]
     disc = check_table(data.get("discretisation", {}), FIELDS["discretisation"], "discretisation")
 
     materials = {}
     for where, name, table in _tables(data.get("materials", {}), "materials", listed=False):
         check_table(table, FIELDS["material"], where)
         materials[name] = Material(
-            float(table["E"]), float(table["nu"]), table.get("plane", "strain")
+            float(table["E"]), float(table["nu"]), _material_mode(table, where, gdim)
         )
     if not materials:
         raise SceneError("materials", "the scene defines no material ([materials.NAME] E, nu)")
     interfaces = [
-        _interface(table, k, materials)
+        _interface(table, k, materials, gdim)
         for _, k, table in _tables(data.get("interfaces", []), "interfaces", listed=True)
     ]
     _check_shared(interfaces)
@@ -152,27 +159,24 @@ def load_scene(
         crack_spec(table, k, materials)
         for _, k, table in _tables(data.get("cracks", []), "cracks", listed=True)
     ]
+    if cracks and gdim == 3:
+        raise NotImplementedError("cracks: a scene's cracks are 2D; this mesh is 3D")
     shared_crack_keys(cracks, interfaces)
 
     parts = {}
     for where, name, table in _tables(data.get("parts", {}), "parts", listed=False):
-        parts[name] = check_table(table, FIELDS["part"], where)["where"]
+        parts[name] = check_table(table, fields["part"], where)["where"]
     known_parts = set(BUILTIN_PARTS[mesh["kind"]]) | set(parts)
     if mesh["file"] is not None:
-        from xfem_contact.io.gmsh import dimension, physical_parts
+        from xfem_contact.io.gmsh import physical_parts
 
         try:
             known_parts |= set(physical_parts(mesh["file"]))
-            three_d = dimension(mesh["file"]) == 3
         except (OSError, ValueError) as error:
             raise SceneError("mesh.file", " ".join(str(error).split())) from None
-        if three_d:
-            raise SceneError(
-                "mesh.file", f"{mesh['file']} is a 3D geometry (it has volumes); scenes are 2D"
-            )
     stages = stages_table(data.get("stages", {}), "stages")
     loads = [
-        load_spec(table, where, known_parts, stages)
+        load_spec(table, where, known_parts, stages, gdim)
         for where, _, table in _tables(data.get("loads", []), "loads", listed=True)
     ]
 
@@ -199,48 +203,81 @@ def load_scene(
 
 
 def _mesh(mesh, folder: pathlib.Path) -> dict:
-    """The mesh fields of a :class:`Scene` from the checked [mesh] table."""
-    check_table(mesh, FIELDS["mesh"], "mesh")
-    kind = mesh.get("kind", "rectangle")
+    """The mesh fields of a :class:`Scene` from the checked [mesh] table, with its
+    geometric dimension ``gdim`` (its kind's, or a gmsh file's)."""
+    if not isinstance(mesh, dict):
+        check_table(mesh, FIELDS["mesh"], "mesh")  # raises
+    kind = FIELDS["mesh"]["kind"].check(mesh.get("kind", "rectangle"), "mesh.kind")
+    if "file" in mesh:
+        FIELDS["mesh"]["file"].check(mesh["file"], "mesh.file")
+    path, gdim = _gmsh_source(mesh, kind, folder), MESH_DIMENSION.get(kind)
+    if gdim is None:
+        from xfem_contact.io.gmsh import dimension
+
+        try:
+            gdim = dimension(path)
+        except (OSError, ValueError) as error:
+            raise SceneError("mesh.file", " ".join(str(error).split())) from None
+    check_table(mesh, FIELDS_BY_DIM[gdim]["mesh"], "mesh")
     for key in mesh:
         if key != "kind" and key not in MESH_KEYS[kind]:
             kinds = [k for k, keys in MESH_KEYS.items() if key in keys]
             message = f"is for mesh.kind = {' or '.join(map(repr, kinds))}, not {kind!r}"
             raise SceneError(f"mesh.{key}", message)
-    corners = tuple(tuple(map(float, c)) for c in mesh.get("corners", [[0, 0], [1, 1]]))
-    (x0, y0), (x1, y1) = corners
-    if not (x1 > x0 and y1 > y0):
-        message = f"the second corner must lie right of and above the first, got {mesh['corners']}"
+    unit = [[0.0] * gdim, [1.0] * gdim]
+    corners = tuple(tuple(map(float, c)) for c in mesh.get("corners", unit))
+    if not all(high > low for low, high in zip(*corners, strict=True)):
+        where = "right of and above" if gdim == 2 else "beyond (along x, y and z)"
+        message = f"the second corner must lie {where} the first, got {mesh['corners']}"
         raise SceneError("mesh.corners", message)
     radii = tuple(map(float, mesh.get("radii", [1.0, 2.0])))
     if not radii[0] < radii[1]:
         raise SceneError("mesh.radii", f"r_inner must be < r_outer, got {list(radii)}")
-    path, size = _gmsh_source(mesh, kind, folder)
+    size = mesh.get("size")
     return {
         "kind": kind,
         "file": path,
-        "size": size,
+        "size": None if size is None else float(size),
         "corners": corners,
         "radii": radii,
         "geometry_degree": mesh.get("geometry_degree", 1),
-        "cells": tuple(mesh.get("cells", [20, 20])),
-        "cell": mesh.get("cell", "quadrilateral"),
+        "cells": tuple(mesh.get("cells", [20, 20] if gdim == 2 else [8, 8, 8])),
+        "cell": mesh.get("cell", "quadrilateral" if gdim == 2 else "tetrahedron"),
+        "gdim": gdim,
     }
 
 
-def _interface(table, k: int, materials: dict) -> InterfaceSpec:
-    """Interface ``k`` from its checked table: the parameters of its shape, its law's."""
+def _material_mode(table: dict, where: str, gdim: int) -> str:
+    """The mode of a checked material table on a mesh of dimension ``gdim`` (default:
+    plane strain in 2D, 3d in 3D); a mode of the other dimension is refused."""
+    mode = table.get("plane", MATERIAL_MODES[gdim][0])
+    if mode not in MATERIAL_MODES[gdim]:
+        message = (
+            f"{mode!r} is not a mode of a {gdim}D mesh; valid there: "
+            f"{list(MATERIAL_MODES[gdim])} (the default {MATERIAL_MODES[gdim][0]!r})"
+        )
+        raise SceneError(f"{where}.plane", message)
+    return mode
+
+
+def _interface(table, k: int, materials: dict, gdim: int = 2) -> InterfaceSpec:
+    """Interface ``k`` from its checked table on a mesh of dimension ``gdim``: the
+    parameters of its shape, its law's."""
     where = f"interfaces[{k}]"
-    check_table(table, FIELDS["interface"], where)
+    _check_shape(table, where, gdim)
+    check_table(table, FIELDS_BY_DIM[gdim]["interface"], where)
     shape = table["shape"]
     params = shape_parameters(table, where, SHAPE_KEYS)
+    if gdim == 3:
+        _check_in_3d(table, where)
     if "angle" in table and "angle_deg" in table:
         raise SceneError(f"{where}.angle_deg", "give the angle once: angle (rad) or angle_deg")
     if abs(table.get("angle", 0.0)) > 2.0 * math.pi:
         message = f"is in radians ({table['angle']} rad is more than a turn); use angle_deg"
         raise SceneError(f"{where}.angle", message)
-    if "normal" in table and not 0.0 < math.hypot(*table["normal"]) < math.inf:
-        raise SceneError(f"{where}.normal", f"must be a non-zero vector, got {table['normal']}")
+    for key in ("normal", "axis"):
+        if key in table and not 0.0 < math.hypot(*table[key]) < math.inf:
+            raise SceneError(f"{where}.{key}", f"must be a non-zero vector, got {table[key]}")
     law = table.get("law", "bonded")
     options = law_options(table, where, law)
     kinematics = table.get("kinematics", "small")
@@ -268,6 +305,35 @@ def _interface(table, k: int, materials: dict) -> InterfaceSpec:
         slave=slave,
         pairing=table.get("pairing", "iterate"),
     )
+
+
+def _check_shape(table, where: str, gdim: int) -> None:
+    """Refuse a shape of the other dimension (``circle`` on a 3D mesh, ``sphere`` on a 2D
+    one), naming its analogues and the valid shapes."""
+    shape = table.get("shape") if isinstance(table, dict) else None
+    valid = SHAPES_BY_DIM[gdim]
+    if not isinstance(shape, str) or shape not in SHAPES or shape in valid:
+        return  # checked with the table
+    other = 5 - gdim
+    analogues = " or ".join(repr(s) for s in SHAPE_ANALOGUES[shape])
+    message = (
+        f"{shape!r} is a {other}D shape and the mesh is {gdim}D: use {analogues}; the "
+        f"shapes of a {gdim}D mesh: {list(valid)}"
+    )
+    raise SceneError(f"{where}.shape", message)
+
+
+def _check_in_3d(table, where: str) -> None:
+    """Refuse the law options and kinematics of an interface that exist in 2D only."""
+    if table.get("lbb") == "restriction":
+        message = (
+            "'restriction' is not available on 3D meshes (its vital vertices are proven "
+            "stable on triangles only); valid there: ['stabilized', 'none']"
+        )
+        raise SceneError(f"{where}.lbb", message)
+    if table.get("kinematics") == "large":
+        message = "'large' (large sliding) is 2D only; valid on a 3D mesh: ['small']"
+        raise SceneError(f"{where}.kinematics", message)
 
 
 def _sides(table, kinematics: str, where: str) -> int:
@@ -302,10 +368,10 @@ def _check_shared(interfaces: list[InterfaceSpec]) -> None:
             raise SceneError(f"interfaces[{k}].name", message)
 
 
-def _gmsh_source(mesh: dict, kind: str, folder: pathlib.Path):
-    """(file, size) of a gmsh mesh, checked; (None, None) for built-in meshes."""
+def _gmsh_source(mesh: dict, kind: str, folder: pathlib.Path) -> pathlib.Path | None:
+    """The file of a gmsh mesh, checked; None for built-in meshes."""
     if kind != "gmsh":
-        return None, None
+        return None
     if "file" not in mesh:
         raise SceneError("mesh.file", "required for mesh.kind = 'gmsh' (a .geo or .msh file)")
     path = (folder / mesh["file"]).resolve()
@@ -318,8 +384,7 @@ def _gmsh_source(mesh: dict, kind: str, folder: pathlib.Path):
         if given:
             message = "is read from the .msh file itself; give it only with a .geo"
             raise SceneError(f"mesh.{given[0]}", message)
-    size = mesh.get("size")
-    return path, None if size is None else float(size)
+    return path
 
 
 def _petsc_options(solver: dict) -> dict:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import warnings
 
 from xfem_contact.mechanics.laws import CONTACT_LAWS, LBB_OPTIONS, LINEAR_LAWS
+from xfem_contact.mechanics.loads import BOX_FACES
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
 from xfem_contact.scenes.checks import (  # noqa: F401  (re-exported)
     NAME,
@@ -39,16 +40,40 @@ from xfem_contact.solvers.options import LINEAR_PRESETS, defaults
 _NEWTON = defaults("newton")  # the [solver] defaults are the Newton solver's
 
 LAWS = LINEAR_LAWS + CONTACT_LAWS
-SHAPES = ("circle", "ellipse", "line", "half-plane", "expression")
+#: The interface shapes of a scene on a mesh of each geometric dimension
+SHAPES_BY_DIM = {
+    2: ("circle", "ellipse", "line", "half-plane", "expression"),
+    3: ("sphere", "ellipsoid", "plane", "cylinder", "expression"),
+}
+SHAPES = SHAPES_BY_DIM[2] + SHAPES_BY_DIM[3][:-1]
+#: The shapes of the other dimension a shape stands for (named when it is refused)
+SHAPE_ANALOGUES = {
+    "circle": ("sphere", "cylinder"),
+    "ellipse": ("ellipsoid",),
+    "line": ("plane",),
+    "half-plane": ("plane",),
+    "sphere": ("circle",),
+    "ellipsoid": ("ellipse",),
+    "plane": ("line", "half-plane"),
+    "cylinder": ("circle",),
+}
 LOAD_TYPES = tuple(LOAD_KINDS)
+#: Load types of 2D meshes only (a rotation in the plane, a spring along the boundary's tangent)
+PLANE_LOAD_TYPES = ("rotation", "tangential_spring")
 KINEMATICS = ("small", "large")
 CELLS = ("quadrilateral", "triangle")
-MESH_KINDS = ("rectangle", "annulus", "gmsh")
+CELLS_3D = ("tetrahedron", "hexahedron")
+MESH_KINDS = ("rectangle", "annulus", "box", "gmsh")
+#: The geometric dimension of each built-in mesh kind (a gmsh file's is the file's)
+MESH_DIMENSION = {"rectangle": 2, "annulus": 2, "box": 3}
 BUILTIN_PARTS = {
     "rectangle": ("left", "right", "bottom", "top", "boundary"),
     "annulus": ("inner", "outer", "boundary"),
-    "gmsh": ("boundary",),  # plus the file's named 1-D physical groups
+    "box": (*(name for pair in BOX_FACES for name in pair), "boundary"),
+    "gmsh": ("boundary",),  # plus the file's named (d-1)-D physical groups
 }
+#: Material modes on a mesh of each geometric dimension (the first is the default)
+MATERIAL_MODES = {2: ("strain", "stress"), 3: ("3d",)}
 #: Keys in which the interfaces of one scene must agree: they lie in one body (the
 #: outside material) and share the kinematics; laws and inside materials may differ
 SHARED_INTERFACE_KEYS = ("kinematics", "outside", "slave", "pairing")
@@ -56,6 +81,7 @@ SHARED_INTERFACE_KEYS = ("kinematics", "outside", "slave", "pairing")
 MESH_KEYS = {
     "rectangle": ("corners", "cells", "cell"),
     "annulus": ("radii", "cells", "geometry_degree"),
+    "box": ("corners", "cells", "cell"),
     "gmsh": ("file", "size", "cell", "geometry_degree"),
 }
 #: The parameters of each interface shape: (required, optional)
@@ -65,6 +91,10 @@ SHAPE_KEYS = {
     "line": (("point", "normal"), ()),
     "half-plane": (("point", "normal"), ()),
     "expression": (("expression",), ()),
+    "sphere": (("centre", "radius"), ()),
+    "ellipsoid": (("centre", "axes"), ()),
+    "plane": (("point", "normal"), ()),
+    "cylinder": (("point", "axis", "radius"), ()),
 }
 #: The shapes of a crack and their parameters: (required, optional)
 CRACK_SHAPES = ("segment", "polyline", "arc", "expression")
@@ -83,6 +113,7 @@ LOAD_KEYS = {name: (kind.required, kind.optional) for name, kind in LOAD_KINDS.i
 
 _POSITIVE = Number(0.0, open=True)
 _POINT = Vector(2, Number())
+_POINT_3D = Vector(3, Number())
 _DEGREE = Choice((1, 2))
 
 
@@ -151,7 +182,7 @@ FIELDS = {
         "description": Field(Text(), "free text"),
     },
     "mesh": {
-        "kind": Field(Choice(MESH_KINDS), f"one of {MESH_KINDS}"),
+        "kind": Field(Choice(MESH_KINDS), f"one of {MESH_KINDS} (box: 3D)"),
         "file": Field(Text(), "a gmsh .geo or .msh file, relative to the scene file (gmsh)"),
         "size": Field(_POSITIVE, "target cell size (m) when meshing a .geo file (gmsh)"),
         "corners": Field(Vector(2, _POINT), "[[x0, y0], [x1, y1]] (m, rectangle)"),
@@ -176,7 +207,7 @@ FIELDS = {
         "name": Field(NAME, "label (names the multiplier field)"),
         "shape": Field(Choice(SHAPES), f"one of {SHAPES}", required=True),
         "centre": Field(_POINT, "[x, y] (m), centre of a circle or an ellipse"),
-        "radius": Field(_POSITIVE, "(m) > 0, radius of a circle"),
+        "radius": Field(_POSITIVE, "(m) > 0, radius of a circle (sphere, cylinder in 3D)"),
         "axes": Field(
             Vector(2, _POSITIVE),
             "[a, b] (m) > 0, the semi-axes of an ellipse: a along the direction at angle "
@@ -189,6 +220,9 @@ FIELDS = {
         ),
         "angle_deg": Field(Number(), "(degrees), instead of angle"),
         "point": Field(_POINT, "[x, y] (m), a point of a line or half-plane's boundary"),
+        "axis": Field(
+            _POINT_3D, "[ax, ay, az], non-zero, any length: the direction of a cylinder's axis (3D)"
+        ),
         "normal": Field(
             _POINT,
             "[nx, ny], non-zero, any length: the normal of a line, pointing to side +1 (outside)",
@@ -258,7 +292,10 @@ FIELDS = {
     "material": {
         "E": Field(_POSITIVE, "Young's modulus (Pa) > 0", required=True),
         "nu": Field(Number(-1.0, 0.5, open=True), "Poisson ratio in (-1, 0.5)", required=True),
-        "plane": Field(Choice(("strain", "stress")), "strain | stress"),
+        "plane": Field(
+            Choice(MATERIAL_MODES[2] + MATERIAL_MODES[3]),
+            "strain | stress (2D meshes, default strain) | 3d (3D meshes, the default there)",
+        ),
     },
     "solver": {
         "load_steps": Field(
@@ -310,6 +347,46 @@ FIELDS = {
         "vtx": Field(flag, "write VTX fields (bool)"),
         "png": Field(flag, "write pictures (bool)"),
     },
+}
+#: What differs in 3D: the keys of :data:`FIELDS` that hold points, vectors, components
+#: or expressions of the coordinates
+_FIELDS_3D = {
+    "mesh": {
+        "corners": Field(Vector(2, _POINT_3D), "[[x0, y0, z0], [x1, y1, z1]] (m, box)"),
+        "cells": Field(Vector(3, Number(1, integer=True)), "cells along x, y and z (box)"),
+        "cell": Field(Choice(CELLS_3D), f"one of {CELLS_3D}"),
+    },
+    "interface": {
+        "centre": Field(_POINT_3D, "[x, y, z] (m), centre of a sphere or an ellipsoid"),
+        "axes": Field(
+            Vector(3, _POSITIVE), "[a, b, c] (m) > 0, the semi-axes of an ellipsoid along x, y, z"
+        ),
+        "point": Field(_POINT_3D, "[x, y, z] (m), a point of a plane or of a cylinder's axis"),
+        "normal": Field(
+            _POINT_3D,
+            "[nx, ny, nz], non-zero, any length: the normal of a plane, pointing to side +1",
+        ),
+        "expression": Field(
+            Expression(dim=3),
+            "phi(x, y, z) of x, y, z in m: the interface is phi = 0, side -1 (inside) phi < 0",
+        ),
+    },
+    "part": {
+        "where": Field(
+            Expression("boolean", dim=3),
+            "boolean expression of x, y, z selecting boundary facets",
+            True,
+        )
+    },
+    "load": {
+        "component": Field(Choice((0, 1, 2)), "0 (x), 1 (y) or 2 (z): the one prescribed"),
+        "point": Field(_POINT_3D, "[x, y, z] (m), the node held (point_displacement)"),
+    },
+}
+#: The tables of keys on a mesh of each geometric dimension
+FIELDS_BY_DIM = {
+    2: FIELDS,
+    3: {table: fields | _FIELDS_3D.get(table, {}) for table, fields in FIELDS.items()},
 }
 #: The meaning of every key of every table (the text of :data:`FIELDS`)
 SCHEMA = {table: {key: f.doc for key, f in fields.items()} for table, fields in FIELDS.items()}

@@ -19,9 +19,11 @@ from xfem_contact.mechanics.loads.handles import (
 from xfem_contact.mechanics.loads.load_path import LoadPath, load_steps
 from xfem_contact.mechanics.loads.loads import Loads
 from xfem_contact.mechanics.loads.parts import (
+    BOX_FACES,
     Part,
     annulus_parts,
     boundary_facets,
+    box_parts,
     named_parts,
     rectangle_parts,
 )
@@ -37,7 +39,9 @@ __all__ = [
     "RotationLoad",
     "SideFields",
     "TangentialSpring",
+    "BOX_FACES",
     "annulus_parts",
+    "box_parts",
     "boundary_facets",
     "load_steps",
     "named_parts",

@@ -2,9 +2,10 @@
 
 A problem's :class:`~xfem_contact.mechanics.loads.Loads` holds a ``parts`` mapping
 (name -> locator or facet array). :func:`named_parts` fills it for the meshes the
-package builds: ``left``, ``right``, ``bottom``, ``top`` on a rectangle, ``inner`` and
-``outer`` on an annulus centred at the origin, ``boundary`` on every mesh (the names
-of the scenes' ``rectangle`` and ``annulus`` kinds).
+package builds: ``left``, ``right``, ``bottom``, ``top`` on a rectangle (and ``back``,
+``front`` on a box), ``inner`` and ``outer`` on an annulus centred at the origin,
+``boundary`` on every mesh (the names of the scenes' ``rectangle``, ``box`` and
+``annulus`` kinds).
 """
 
 from __future__ import annotations
@@ -19,22 +20,32 @@ from mpi4py import MPI
 Part = str | np.ndarray | Callable[[np.ndarray], np.ndarray]
 
 
+#: The faces of a box, ``(low, high)`` along x, y and z (a rectangle has the first two):
+#: ``front`` is the face of largest z, towards a viewer looking down the z axis
+BOX_FACES = (("left", "right"), ("bottom", "top"), ("back", "front"))
+
+
 def _everywhere(x: np.ndarray) -> np.ndarray:
     return np.ones(x.shape[1], dtype=bool)
+
+
+def box_parts(corners, tol: float | None = None) -> dict[str, Callable]:
+    """Locators of the faces (:data:`BOX_FACES`) of the box ``[[x0, y0, z0], [x1, y1,
+    z1]]`` or of the rectangle ``[[x0, y0], [x1, y1]]`` (m), and of the whole boundary,
+    within ``tol`` (m; default 1e-8 of the largest side)."""
+    low, high = (np.asarray(c, dtype=float) for c in corners)
+    tol = 1e-8 * float(np.max(np.abs(high - low))) if tol is None else tol
+    parts = {}
+    for k, names in enumerate(BOX_FACES[: len(low)]):
+        for name, at in zip(names, (low[k], high[k]), strict=True):
+            parts[name] = lambda x, k=k, at=at: np.abs(x[k] - at) <= tol
+    return parts | {"boundary": _everywhere}
 
 
 def rectangle_parts(corners, tol: float | None = None) -> dict[str, Callable]:
     """Locators of the sides of the rectangle ``[[x0, y0], [x1, y1]]`` (m) and of the
     whole boundary, within ``tol`` (m; default 1e-8 of the larger side)."""
-    (x0, y0), (x1, y1) = corners
-    tol = 1e-8 * max(abs(x1 - x0), abs(y1 - y0)) if tol is None else tol
-    return {
-        "left": lambda x: np.abs(x[0] - x0) <= tol,
-        "right": lambda x: np.abs(x[0] - x1) <= tol,
-        "bottom": lambda x: np.abs(x[1] - y0) <= tol,
-        "top": lambda x: np.abs(x[1] - y1) <= tol,
-        "boundary": _everywhere,
-    }
+    return box_parts(corners, tol)
 
 
 def annulus_parts(r_inner: float, r_outer: float) -> dict[str, Callable]:
@@ -49,17 +60,18 @@ def annulus_parts(r_inner: float, r_outer: float) -> dict[str, Callable]:
 
 
 def named_parts(mesh: dolfinx.mesh.Mesh) -> dict[str, Callable]:
-    """The built-in parts of a mesh: ``boundary``, plus the rectangle's sides when every
-    boundary node lies on the sides of the mesh's bounding box, or ``inner`` and
-    ``outer`` when every boundary node lies on one of two circles about the origin.
-    Collective."""
+    """The built-in parts of a mesh: ``boundary``, plus the rectangle's sides (the box's
+    faces in 3D) when every boundary node lies on the sides of the mesh's bounding box,
+    or ``inner`` and ``outer`` when every boundary node of a 2D mesh lies on one of two
+    circles about the origin. Collective."""
     fdim = mesh.topology.dim - 1
     mesh.topology.create_connectivity(fdim, fdim + 1)
     facets = dolfinx.mesh.exterior_facet_indices(mesh.topology)
     nodes = dolfinx.mesh.entities_to_geometry(mesh, fdim, facets).ravel()
-    x = mesh.geometry.x[np.unique(nodes), :2]
+    gdim = mesh.geometry.dim
+    x = mesh.geometry.x[np.unique(nodes), :gdim]
     comm = mesh.comm
-    low, high = np.full(2, np.inf), np.full(2, -np.inf)
+    low, high = np.full(gdim, np.inf), np.full(gdim, -np.inf)
     comm.Allreduce(x.min(axis=0) if x.size else low.copy(), low, op=MPI.MIN)
     comm.Allreduce(x.max(axis=0) if x.size else high.copy(), high, op=MPI.MAX)
     size = float(np.max(high - low))
@@ -68,7 +80,9 @@ def named_parts(mesh: dolfinx.mesh.Mesh) -> dict[str, Callable]:
         | np.isclose(x, high, rtol=0, atol=1e-8 * size).any(axis=1)
     )
     if comm.allreduce(bool(on_box), op=MPI.LAND):
-        return rectangle_parts((low, high))
+        return box_parts((low, high))
+    if gdim == 3:
+        return {"boundary": _everywhere}
     r = np.hypot(x[:, 0], x[:, 1])
     r0 = comm.allreduce(float(r.min()) if r.size else np.inf, op=MPI.MIN)
     r1 = comm.allreduce(float(r.max()) if r.size else -np.inf, op=MPI.MAX)
