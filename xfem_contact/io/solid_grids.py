@@ -4,13 +4,14 @@
 A 3D cut keeps no sub-cells (its rules come from the level set itself), so the grids are
 drawn from the level-set interpolant ``phi_h``: each cut cell is split into linear
 sub-tetrahedra (``2^levels`` per edge; a hexahedron's sub-cubes into six tetrahedra
-each), ``phi_h`` is taken at their vertices, and each sub-tetrahedron is clipped at the
-zero of the linear interpolant of these values (marching tetrahedra): on each side a
-tetrahedron or a wedge, and the triangles of the interface between them. The zero set
-drawn is within ``O((h / 2^levels)^2)`` of ``phi_h = 0``; the rules of the cut do not use
-it. Uncut cells are the mesh's linear cells. Fields are evaluated at every node of every
-piece in its parent cell (the exact P2/Q2 values there), each side with its own field,
-so the lips are separate. Coordinates in m; every grid holds this process's owned cells.
+each), ``phi_h`` is taken at their vertices, and each sub-tetrahedron is clipped where
+``phi_h`` vanishes on its edges (marching tetrahedra): on each side a tetrahedron or a
+wedge, and the triangles of the interface between them, whose nodes lie on ``phi_h = 0``
+(the surface drawn is within ``O((h / 2^levels)^2)`` of it between them; the rules of the
+cut do not use it). Uncut cells are the mesh's linear cells. Fields are evaluated at
+every node of every piece in its parent cell (the exact P2/Q2 values there), each side
+with its own field, so the lips are separate. Coordinates in m; every grid holds this
+process's owned cells.
 
 Cell data: ``side`` (-1, +1; 0 on the interface), ``cut`` (1 in cut cells), ``cell``
 (local index of the parent cell).
@@ -89,21 +90,44 @@ class Pieces:
     interface: tuple
 
 
-def _edge_points(X: np.ndarray, phi: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
-    """Where the linear ``phi`` vanishes on the edges ``(i, j)`` of each tetrahedron:
-    ``X (n, 4, 3)``, ``phi (n, 4)``, ``i, j (n,)`` -> ``(n, 3)``."""
+#: Regula falsi steps (Illinois) that move an edge point onto the zero of the level set
+ROOT_STEPS = 10
+
+
+def _edge_points(
+    X: np.ndarray, phi: np.ndarray, i: np.ndarray, j: np.ndarray, value=None
+) -> np.ndarray:
+    """Where ``phi`` vanishes on the edges ``(i, j)`` of each tetrahedron: ``X (n, 4, 3)``,
+    ``phi (n, 4)`` its values at the vertices, ``i, j (n,)`` -> ``(n, 3)``. The zero of
+    the linear interpolant, or with ``value`` (the field at points ``(n, 3)`` of the
+    tetrahedra, ``(n,)``) the zero of the field itself on the edge, by
+    :data:`ROOT_STEPS` steps of the Illinois regula falsi."""
     rows = np.arange(X.shape[0])
-    a, b = phi[rows, i], phi[rows, j]
-    t = (a / (a - b))[:, None]
-    return X[rows, i] + t * (X[rows, j] - X[rows, i])
+    fa, fb = phi[rows, i], phi[rows, j]
+    a, b = np.zeros(rows.size), np.ones(rows.size)
+    t = fa / (fa - fb)
+    start, step = X[rows, i], X[rows, j] - X[rows, i]
+    last = np.zeros(rows.size, dtype=np.int8)  # the end moved last: -1 a, +1 b
+    for _ in range(ROOT_STEPS if value is not None else 0):
+        ft = value(start + t[:, None] * step)
+        left = np.sign(ft) == np.sign(fa)  # the root is in (t, b): a moves
+        fb = np.where(left & (last == -1), 0.5 * fb, fb)  # the same end twice: Illinois
+        fa = np.where(~left & (last == 1), 0.5 * fa, fa)
+        a, fa = np.where(left, t, a), np.where(left, ft, fa)
+        b, fb = np.where(left, b, t), np.where(left, fb, ft)
+        last = np.where(left, -1, 1).astype(np.int8)
+        t = np.clip(a - fa * (b - a) / np.where(fb != fa, fb - fa, 1.0), a, b)
+    return start + t[:, None] * step
 
 
-def clip_tets(X: np.ndarray, phi: np.ndarray) -> tuple[dict, np.ndarray, np.ndarray]:
-    """Marching tetrahedra. ``X (n, 4, 3)``, ``phi (n, 4)`` (a linear field per
-    tetrahedron): per side ``s`` (-1 where ``phi < 0``, +1 else) the pieces inside it,
-    ``{s: [(rows, nodes, vtk_type), ...]}`` (``rows`` the tetrahedra they come from,
+def clip_tets(X: np.ndarray, phi: np.ndarray, value=None) -> tuple[dict, np.ndarray, np.ndarray]:
+    """Marching tetrahedra. ``X (n, 4, 3)``, ``phi (n, 4)`` (a field at the vertices of
+    each tetrahedron): per side ``s`` (-1 where ``phi < 0``, +1 else) the pieces inside
+    it, ``{s: [(rows, nodes, vtk_type), ...]}`` (``rows`` the tetrahedra they come from,
     ``nodes`` ``(r, 4, 3)`` tetrahedra or ``(r, 6, 3)`` wedges), and the interface
-    triangles ``(rows, nodes (r, 3, 3))``."""
+    triangles ``(rows, nodes (r, 3, 3))``. Their nodes on edges are the zeros of the
+    linear interpolant of ``phi``, or with ``value(rows, points)`` (the field at points
+    ``(r, 3)`` of the tetrahedra ``rows``) those of the field on the edges."""
     inside = phi < 0.0
     count = inside.sum(axis=1)
     order = np.argsort(~inside, axis=1, kind="stable")  # side -1's vertices first
@@ -116,8 +140,10 @@ def clip_tets(X: np.ndarray, phi: np.ndarray) -> tuple[dict, np.ndarray, np.ndar
         Xr, pr, o = X[rows], phi[rows], order[rows]
         v = [Xr[np.arange(rows.size), o[:, m]] for m in range(4)]
 
-        def e(a, b, Xr=Xr, pr=pr, o=o):
-            return _edge_points(Xr, pr, o[:, a], o[:, b])
+        at = None if value is None else (lambda points, rows=rows: value(rows, points))
+
+        def e(a, b, Xr=Xr, pr=pr, o=o, at=at):
+            return _edge_points(Xr, pr, o[:, a], o[:, b], at)
 
         if k == 1:  # vertex 0 on side -1
             ends = [e(0, 1), e(0, 2), e(0, 3)]
@@ -153,7 +179,7 @@ def cut_pieces(cut: CutMesh, levels: int = 1) -> Pieces:
     cells = np.repeat(cut.cut_cells, m).astype(np.int32)
     X = np.tile(tets, (cut.cut_cells.size, 1, 1))
     phi = cut.maps.values(np.repeat(cells, 4), X.reshape(-1, 3)).reshape(-1, 4)
-    sides, rows, nodes = clip_tets(X, phi)
+    sides, rows, nodes = clip_tets(X, phi, lambda rows, x: cut.maps.values(cells[rows], x))
     pieces = {s: [(cells[r], n, t) for r, n, t in blocks] for s, blocks in sides.items()}
     order = np.argsort(cells[rows], kind="stable")
     parents = cells[rows][order]

@@ -32,10 +32,12 @@ def levelset(spec: InterfaceSpec, gdim: int = 2) -> Callable[[np.ndarray], np.nd
     -1 (``inside``). The curved 3D shapes are quadrics scaled to unit slope on the surface
     (a P2 level set holds them exactly): ``(|x - c|^2 - R^2) / (2 R)`` for a sphere."""
     p = spec.params
-    if spec.shape in ("sphere", "ellipsoid"):
-        axes = np.full(3, float(p["radius"])) if spec.shape == "sphere" else np.array(p["axes"])
-        c, scale = np.asarray(p["centre"], dtype=float), axes.min()
-        return lambda x: 0.5 * scale * (((x.T - c) / axes) ** 2).sum(axis=1) - 0.5 * scale
+    if spec.shape == "sphere":
+        c, R = np.asarray(p["centre"], dtype=float), float(p["radius"])
+        return lambda x: (((x.T - c) ** 2).sum(axis=1) - R**2) / (2 * R)
+    if spec.shape == "ellipsoid":
+        c, axes = np.asarray(p["centre"], dtype=float), np.asarray(p["axes"], dtype=float)
+        return lambda x: ((((x.T - c) / axes) ** 2).sum(axis=1) - 1.0) * axes.min() / 2
     if spec.shape == "cylinder":
         a, r = np.asarray(p["axis"], dtype=float), float(p["radius"])
         a, c = a / np.linalg.norm(a), np.asarray(p["point"], dtype=float)
