@@ -14,6 +14,7 @@ from test_scenes import one_line_error
 from xfem_contact.cases.solid import SPHERE_CENTRE, TRIAXIAL, sphere_errors, sphere_problem
 from xfem_contact.scenes.builder import build, levelset
 from xfem_contact.scenes.cli import main
+from xfem_contact.scenes.expressions import numpy_field
 from xfem_contact.scenes.records import InterfaceSpec
 from xfem_contact.scenes.run import run
 from xfem_contact.scenes.scene import bundled_scenes, load_scene
@@ -49,30 +50,33 @@ def test_sphere_scene_is_the_solid_case():
     assert e_n < 1.5e-3 and e_t < 1.5e-2, (e_n, e_t)
 
 
-def test_hexahedra_frictionless_plane_is_exact(tmp_path):
-    """Q1 hexahedra, a plane interface, frictionless: uniaxial compression normal to the
-    plane held by rollers on the left, bottom and back faces. The exact field is linear
-    (Q1 holds it): the contact pressure is the applied 1 Pa at every rule point."""
+def test_hexahedra_open_plane_is_exact():
+    """Q2 hexahedra cut by the plane x = 0.55 with a free interface (the forms of
+    tests/test_solid.py's inclined plane): E = 1, nu = 0 and the stress
+    ``(x - 0.55) diag(2, -1, 3)``, traction-free on the plane, balanced by the body force
+    ``(-2, 0, 0)``; its displacement, quadratic, held on the boundary by expressions of
+    x, y, z, is what Q2 finds on each side."""
+    exact = ["(x - 0.55) * 2 * x - 0.5 * (2 * x**2 - y**2 + 3 * z**2)", "-(x - 0.55) * y"]
+    exact.append("(x - 0.55) * 3 * z")
     data = {
         "mesh": {"kind": "box", "cells": [2, 2, 2], "cell": "hexahedron"},
-        "discretisation": {"degree": 1, "levelset_degree": 1},
-        "materials": {"steel": {"E": 100.0, "nu": 0.25}},
-        "interfaces": [
-            {"shape": "plane", "point": [0.55, 0, 0], "normal": [1, 0, 0], "law": "frictionless"}
-        ],
-        "loads": [
-            {"part": "left", "type": "displacement", "component": 0, "value": 0.0},
-            {"part": "bottom", "type": "displacement", "component": 1, "value": 0.0},
-            {"part": "back", "type": "displacement", "component": 2, "value": 0.0},
-            {"part": "right", "type": "pressure", "value": 1.0},
-        ],
-        "outputs": {"png": False},
+        "discretisation": {"degree": 2, "levelset_degree": 1, "quadrature_degree": 10},
+        "materials": {"a": {"E": 1.0, "nu": 0.0}},
+        "interfaces": [{"shape": "plane", "point": [0.55, 0, 0], "normal": [1, 0, 0]}],
+        "loads": [{"part": "boundary", "type": "displacement", "value": exact}]
+        + [{"type": "body_force", "value": [-2.0, 0.0, 0.0], "side": s} for s in (-1, 1)],
     }
-    summary = run(load_scene(data), out=tmp_path, progress_bar=False)
-    lam = np.array(summary["interface_samples"]["lambda_n"])
-    assert lam.size and np.abs(lam + 1.0).max() < 1e-10
-    counts = summary["steps"][-1]["interfaces"]["interface0"]
-    assert counts == {"open": 0, "stick": 0, "slip": lam.size}  # frictionless: all slip
+    data["interfaces"][0]["law"] = "free"
+    problem = solved(load_scene(data))
+    assert problem.cut.num_cut_cells_global == 4
+    V = problem.space.field_space(0)[0]
+    x = V.tabulate_dof_coordinates()
+    expected = np.stack([numpy_field(e, dim=3)(x.T) for e in exact], axis=1)
+    for field, side in ((0, -1), (1, 1)):  # on the cells where the side is
+        cells = np.flatnonzero(problem.cut.cell_sides != -side)
+        dofs = np.unique(V.dofmap.list[cells])
+        u = problem.space.field(problem.w, field).x.array.reshape(-1, 3)[dofs]
+        assert np.abs(u - expected[dofs]).max() < 1e-10
 
 
 def test_3d_outputs_and_show(tmp_path):

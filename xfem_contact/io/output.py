@@ -62,14 +62,21 @@ def write_lips(
     """Write a ``.vtu`` grid of uncut cells and sub-triangles with each side's displacement.
 
     The grid is :func:`xfem_contact.io.pictures.deformed_lips_grid` (quadratic cells,
-    point data ``u`` in m, cell data ``side``, ``cut``, ``cell``). Collective: in
+    point data ``u`` in m, cell data ``side``, ``cut``, ``cell``); on a 3D mesh
+    :func:`~xfem_contact.io.solid_grids.lips_arrays_3d`'s (linear cells, the cut cells
+    split into tetrahedra and wedges on each side). Collective: in
     parallel rank ``r`` writes its cells to ``path`` with suffix ``_r{r}`` and rank 0
     the ``.pvtu`` of the pieces. ``u_minus``, ``u_plus``: displacement Functions of sides
     -1 and +1; ``fields``: more point data, name to ``{-1: Function, 1: Function}``
     ((discontinuous) Lagrange, e.g. ``stress`` and ``von_mises`` of
     :class:`~xfem_contact.mechanics.stress.StressFields`). Returns this process's file.
     """
-    arrays = lips_arrays(cut, u_minus, u_plus, fields)
+    if cut.geometry is None:  # 3D
+        from xfem_contact.io.solid_grids import lips_arrays_3d
+
+        arrays = lips_arrays_3d(cut, u_minus, u_plus, fields)
+    else:
+        arrays = lips_arrays(cut, u_minus, u_plus, fields)
     return write_grid(path, arrays, cut.mesh.comm, VTU_COMPRESSION)
 
 
@@ -83,39 +90,50 @@ def write_plain(path: str | pathlib.Path, u, fields: dict | None = None) -> path
 
 
 def write_cut_geometry(
-    directory: str | pathlib.Path, cut: CutMesh, interface_data: dict | None = None
+    directory: str | pathlib.Path,
+    cut: CutMesh,
+    interface_data: dict | None = None,
+    u_minus=None,
 ) -> list[pathlib.Path]:
     """Write ``subcells.vtu`` (the curved sub-triangles of the cut cells, cell data
     ``side``, ``cut``, ``cell``) and ``interface.vtu`` (curved interface pieces, point
     data ``interface_data``: name to an array over its nodes, e.g.
     :func:`~xfem_contact.io.interface_data.interface_point_data`) into ``directory``:
-    the cut region only, the uncut cells are in ``result.vtu`` (:func:`write_lips`).
+    the cut region only, the uncut cells are in ``result.vtu`` (:func:`write_lips`). On a
+    3D mesh the pieces are :mod:`~xfem_contact.io.solid_grids`' (tetrahedra and wedges,
+    interface triangles), and ``u_minus`` (side -1's displacement, if given) is point data
+    ``u`` of the interface (to draw it deformed).
 
     Collective: in parallel rank ``r`` writes ``subcells_r{r}.vtu`` and
     ``interface_r{r}.vtu``, rank 0 ``subcells.pvtu`` and ``interface.pvtu``. Returns this
     process's files. See :mod:`xfem_contact.io.pictures`.
     """
+    from xfem_contact.io.solid_grids import subcell_arrays_3d
+
     directory, comm = pathlib.Path(directory), cut.mesh.comm
+    three_d = cut.geometry is None
+    subcells = subcell_arrays_3d(cut) if three_d else subcell_arrays(cut, uncut=False)
     paths = []
     for name, arrays in (
-        ("subcells", subcell_arrays(cut, uncut=False)),
-        ("interface", interface_grid_arrays(cut, interface_data)),
+        ("subcells", subcells),
+        ("interface", interface_grid_arrays(cut, interface_data, u_minus)),
     ):
         paths.append(write_grid(directory / f"{name}.vtu", arrays, comm, VTU_COMPRESSION))
     return paths
 
 
-def interface_grid_arrays(cut: CutMesh, interface_data: dict | None = None):
+def interface_grid_arrays(cut: CutMesh, interface_data: dict | None = None, u_minus=None):
     """:func:`~xfem_contact.io.vtu.interface_arrays` (in 3D
-    :func:`~xfem_contact.io.solid_grids.interface_arrays_3d`) with point data
-    ``interface_data`` (name to an array over its nodes)."""
+    :func:`~xfem_contact.io.solid_grids.interface_arrays_3d`, with point data ``u`` of
+    side -1's displacement ``u_minus`` if given) with point data ``interface_data`` (name
+    to an array over its nodes)."""
     if cut.geometry is None:
         from xfem_contact.io.solid_grids import interface_arrays_3d
 
-        arrays = interface_arrays_3d(cut)
+        arrays = interface_arrays_3d(cut, u_minus)
     else:
         arrays = interface_arrays(cut)
-    return arrays._replace(point_data=dict(interface_data or {}))
+    return arrays._replace(point_data=arrays.point_data | dict(interface_data or {}))
 
 
 def _jsonable(value):

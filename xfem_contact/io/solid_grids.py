@@ -251,8 +251,10 @@ def _blocks(cut: CutMesh, pieces: Pieces, uncut: bool) -> list[_Block]:
     return blocks
 
 
-def interface_arrays_3d(cut: CutMesh, levels: int = 1) -> GridArrays:
-    """The interface triangles (:func:`cut_pieces`), cell data ``cell``."""
+def interface_arrays_3d(cut: CutMesh, u_minus=None, levels: int = 1) -> GridArrays:
+    """The interface triangles (:func:`cut_pieces`), cell data ``cell``, with point data
+    ``u`` (m), the displacement ``u_minus`` of side -1, when given."""
     cells, X = cut_pieces(cut, levels).interface
-    arrays = grid_arrays(cut, [_Block(0, 1, cells, X, TRIANGLE)])
+    fields = {} if u_minus is None else {"u": {0: u_minus}}
+    arrays = grid_arrays(cut, [_Block(0, 1, cells, X, TRIANGLE)], fields)
     return arrays._replace(cell_data={"cell": arrays.cell_data["cell"]})

@@ -77,8 +77,8 @@ def plot_clipped(
 ) -> pathlib.Path:
     """PNG of the deformed body cut open by the plane through its centre normal to
     :data:`CLIP_NORMAL`, coloured by ``|u|`` (m) or by the scalar point field ``field``
-    (e.g. ``von_mises``, Pa), with the ``interface`` grid (deformed with side -1's
-    displacement where it has ``u``, else as it is) drawn in grey inside.
+    (e.g. ``von_mises``, Pa), with the section of the ``interface`` grid (point data
+    ``u``: side -1's displacement) deformed, in white.
 
     Args:
         grid: A 3D grid with point data ``u`` (m, ``(npoints, 3)``), e.g. ``result.vtu``.
@@ -107,10 +107,12 @@ def plot_clipped(
         show_edges=False,
         scalar_bar_args=_BAR,
     )
-    if interface is not None and interface.n_cells:
-        surface = interface.clip(normal=CLIP_NORMAL, origin=tuple(centre), invert=True)
-        if surface.n_cells:
-            plotter.add_mesh(surface.extract_feature_edges(boundary_edges=True), color="white")
+    if interface is not None and interface.n_cells and "u" in interface.point_data:
+        rim = interface.slice(normal=CLIP_NORMAL, origin=tuple(centre))
+        if rim.n_cells:  # the section of the interface, deformed with side -1
+            rim = rim.warp_by_vector("u", factor=scale)
+            rim.points -= 1e-3 * size * np.asarray(CLIP_NORMAL)  # over the cut face
+            plotter.add_mesh(rim, color="white", line_width=2.0)
     _colour_bar_label(plotter, label)
     _camera(plotter, grid)
     _title(plotter, f"{title} (displacement x {scale:.3g})")

@@ -329,7 +329,9 @@ class StepGrids:
         lips = lips_arrays if problem.mesh.geometry.dim == 2 else lips_arrays_3d
         return {
             "result": lips(problem.cut, fields[0], fields[1], named),
-            "interface": interface_grid_arrays(problem.cut, interface_point_data(problem)),
+            "interface": interface_grid_arrays(
+                problem.cut, interface_point_data(problem), fields[0]
+            ),
         }
 
     def write(self, t: float) -> None:
