@@ -140,6 +140,7 @@ def main():
     comm.barrier()  # every rank's pieces are on disk before rank 0 draws them
     if comm.rank == 0:
         summary = {
+            "scene": "sphere_contact",  # names the pictures
             "case": "sphere in a cube under triaxial compression, contact",
             "n": args.n,
             "degree": args.degree,

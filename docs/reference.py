@@ -25,12 +25,15 @@ import re
 import sys
 
 #: What each built-in boundary part of :data:`xfem_contact.scenes.schema.BUILTIN_PARTS`
-#: selects (``[mesh] corners = [[x0, y0], [x1, y1]]``, ``radii = [r0, r1]``)
+#: selects (``[mesh] corners = [[x0, y0], [x1, y1]]`` or ``[[x0, y0, z0], [x1, y1, z1]]``,
+#: ``radii = [r0, r1]``)
 PART_MEANINGS = {
     "left": "the facets on `x = x0`",
     "right": "the facets on `x = x1`",
     "bottom": "the facets on `y = y0`",
     "top": "the facets on `y = y1`",
+    "back": "the facets on `z = z0`",
+    "front": "the facets on `z = z1`",
     "inner": "the facets on the circle `r = r0` (centred at the origin)",
     "outer": "the facets on the circle `r = r1`",
     "boundary": "every boundary facet",
@@ -92,7 +95,7 @@ def _kind(check) -> tuple[str, str]:
     if name == "Text":
         return "string", check.rule or ""
     if name in ("Scalar", "Expression"):
-        return f"{check.target} or expression of x, y", ""
+        return f"{check.target} or expression of {', '.join('xyz'[: check.dim])}", ""
     return getattr(check, "__name__", name), ""
 
 
@@ -172,7 +175,44 @@ def scene_reference() -> str:
     ]
     for kind, (required, optional) in LOAD_KEYS.items():
         lines.append(f"| `{kind}` | {', '.join(required)} | {', '.join(optional)} |")
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines + three_d_keys()) + "\n"
+
+
+def three_d_keys() -> list[str]:
+    """Markdown lines: the keys whose form differs on a 3D mesh (a box, a 3D gmsh file)."""
+    from xfem_contact.scenes.schema import (
+        FIELDS,
+        FIELDS_BY_DIM,
+        MATERIAL_MODES,
+        PLANE_LOAD_TYPES,
+        SHAPES_BY_DIM,
+    )
+
+    lines = [
+        "",
+        "## On a 3D mesh",
+        "",
+        "A `box` mesh, or a gmsh file with volumes, makes a 3D scene. Its interface shapes are",
+        f"{', '.join(f'`{s}`' for s in SHAPES_BY_DIM[3])} (those of 2D,",
+        f"{', '.join(f'`{s}`' for s in SHAPES_BY_DIM[2][:-1])}, are refused naming their 3D",
+        f"analogues), its material mode {MATERIAL_MODES[3][0]!r} (the plane modes are refused),",
+        f"the load types {', '.join(f'`{t}`' for t in PLANE_LOAD_TYPES)} and the options",
+        '`lbb = "restriction"` and `kinematics = "large"` are 2D only. Vector values of',
+        "loads (`traction`, `body_force`, `displacement`) take three components, and these",
+        "keys their 3D form:",
+        "",
+        "| table | key | type | allowed | meaning |",
+        "|---|---|---|---|---|",
+    ]
+    for table, fields in FIELDS_BY_DIM[3].items():
+        for key, field in fields.items():
+            if field is FIELDS[table][key]:
+                continue
+            kind, allowed = _kind(field.check)
+            lines.append(
+                f"| `{table}` | `{key}` | {_cell(kind)} | {_cell(allowed)} | {_cell(field.doc)} |"
+            )
+    return lines
 
 
 def solver_options() -> str:
@@ -309,8 +349,9 @@ def builtin_parts() -> list[str]:
         "## Built-in boundary parts",
         "",
         "A load's `part` names a built-in part of the mesh kind, a part of `[parts.NAME]`",
-        "(a boolean expression of `x`, `y`), or, for a gmsh mesh, a named 1-D physical group",
-        "of the file. Any other name is an error listing the known ones.",
+        "(a boolean expression of the coordinates), or, for a gmsh mesh, a named physical",
+        "group of dimension d - 1 of the file (curves in 2D, surfaces in 3D). Any other name",
+        "is an error listing the known ones.",
         "",
         "| mesh kind | part | selects |",
         "|---|---|---|",
@@ -319,7 +360,8 @@ def builtin_parts() -> list[str]:
         for name in names:
             lines.append(f"| `{kind}` | `{name}` | {PART_MEANINGS[name]} |")
         if kind == "gmsh":
-            lines.append("| `gmsh` | any physical curve's name | the facets of that group |")
+            group = "any physical curve's (surface's in 3D) name"
+            lines.append(f"| `gmsh` | {group} | the facets of that group |")
     return [*lines, ""]
 
 
@@ -339,9 +381,10 @@ def expression_functions() -> list[str]:
         "## Expressions",
         "",
         'Level sets (`shape = "expression"`), part locators (`where`), prescribed',
-        "displacements and load values may be expressions of the coordinates `x`, `y` (m):",
-        "Python arithmetic (`+ - * / **`, the exponent of `**` a number of size at most",
-        f"{MAX_EXPONENT}) on numbers, `x`, `y`, the constant `pi` and the functions below.",
+        "displacements and load values may be expressions of the coordinates `x`, `y` (and",
+        "`z` on a 3D mesh; on a 2D one it is an error) (m): Python arithmetic",
+        f"(`+ - * / **`, the exponent of `**` a number of size at most {MAX_EXPONENT}) on",
+        "numbers, the coordinates, the constant `pi` and the functions below.",
         "Locators also take comparisons and `& | ~`. Loads (pressure, traction, body force",
         "values) are evaluated by UFL and take only the functions marked so. Anything else",
         "is an error naming the allowed names.",
@@ -349,7 +392,7 @@ def expression_functions() -> list[str]:
         "| function | arguments | in loads | meaning |",
         "|---|---|---|---|",
     ]
-    for name in sorted(ALLOWED_NAMES - {"x", "y", "pi"}):
+    for name in sorted(ALLOWED_NAMES - {"x", "y", "z", "pi"}):
         arity = next(k for k in (1, 2, 3) if accepts(f"{name}({', '.join(['x'] * k)})", False))
         in_loads = "yes" if accepts(f"{name}({', '.join(['x'] * arity)})", True) else ""
         lines.append(f"| `{name}` | {arity} | {in_loads} | {FUNCTION_MEANINGS[name]} |")

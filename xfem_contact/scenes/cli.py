@@ -85,8 +85,8 @@ def _scenes(args) -> int:
 
 
 def _show(args) -> int:
-    """Render a run folder: result.png, von_mises.png, cut.png, pressure.png and, for
-    friction laws, traction.png (those with data)."""
+    """Render a run folder: result.png, von_mises.png, cut.png (2D), pressure.png and, for
+    friction laws, traction.png (those with data); a 3D folder's are drawn in 3D."""
     from xfem_contact.io.pictures import render_folder
     from xfem_contact.solvers.log_lines import lines_to
 
