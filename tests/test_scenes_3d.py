@@ -105,7 +105,7 @@ def test_3d_outputs_and_show(tmp_path):
     assert surface.point_data["slip"].shape == (surface.n_points, 3)
     assert np.all(surface.point_data["status"] == 1)  # sticking
     assert main(["show", str(tmp_path)]) == 0
-    for name in ("result.png", "von_mises.png", "pressure.png", "traction.png"):
+    for name in ("result.png", "von_mises.png", "cut.png", "pressure.png", "traction.png"):
         assert (tmp_path / name).stat().st_size > 10_000, name
     assert json.loads((tmp_path / "summary.json").read_text())["scene"] == "sphere_triaxial"
 

@@ -23,10 +23,10 @@ from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.io.pictures import SIDE_COLOURS
 from xfem_contact.io.render import _legend, _plotter, _save, _title
 from xfem_contact.io.solid_grids import reference_subcells
+from xfem_contact.io.solid_pictures import INTERFACE_COLOUR
 
 __all__ = ["plot_cut_3d"]
 
-INTERFACE_COLOUR = "#e8c547"
 POINT_COLOUR = "#202020"
 EDGE_COLOUR = "#404040"
 #: At most this many interface rule points are drawn (a random choice, seeded)

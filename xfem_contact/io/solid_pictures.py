@@ -2,8 +2,9 @@
 
 From the grids a 3D scene run writes (:mod:`xfem_contact.io.solid_grids`): the deformed
 body cut open by a plane through its centre (both sides, each with its own displacement,
-magnified), coloured by ``|u|`` or by the von Mises stress, with the interface in it; and
-the whole interface surface coloured by a point field of its laws' state (the contact
+magnified), coloured by ``|u|`` or by the von Mises stress, with the interface in it; the
+cut (both sides cut open, the pieces of the cut cells, half the interface in front); and the
+whole interface surface coloured by a point field of its laws' state (the contact
 pressure ``lambda_n``, the tangential traction ``|lambda_t|``). Nothing here opens a
 window or needs a display.
 """
@@ -19,6 +20,8 @@ from xfem_contact.io.render import _plotter, _save, _title
 
 #: The plane the body is cut open by: its normal (the camera looks from that side)
 CLIP_NORMAL = (0.0, -1.0, 0.0)
+#: The colour of the interface surface
+INTERFACE_COLOUR = "#e8c547"
 #: VTK types of 3D cells (tetrahedron, voxel, hexahedron, wedge, pyramid and quadratic ones)
 SOLID_TYPES = (10, 11, 12, 13, 14, 24, 25, 29)
 
@@ -150,13 +153,62 @@ def plot_surface_field(
     return _save(plotter, path)
 
 
+def plot_cut_solid(
+    grid: pyvista.DataSet,
+    path: str | pathlib.Path,
+    interface: pyvista.DataSet | None = None,
+    title: str = "cut",
+    window_size: tuple[int, int] = (900, 700),
+) -> pathlib.Path:
+    """PNG of a 3D cut: both sides of ``grid`` (cell data ``side``, ``cut``; e.g.
+    ``result.vtu``, undeformed) cut open by the plane through its centre normal to
+    :data:`CLIP_NORMAL`, their uncut cells light and the pieces of the cut cells dark,
+    with the edges of the pieces, and the upper half of the ``interface`` surface in front
+    of the plane."""
+    from xfem_contact.io.pictures import SIDE_COLOURS
+    from xfem_contact.io.render import _legend
+
+    bounds = np.asarray(grid.bounds).reshape(3, 2)
+    centre = tuple(bounds.mean(axis=1))
+    plotter = _plotter(window_size)
+    side, cut = np.asarray(grid.cell_data["side"]), np.asarray(grid.cell_data["cut"])
+    for s in (-1, 1):
+        for c, shade in ((0, 0), (1, 1)):
+            cells = np.flatnonzero((side == s) & (cut == c))
+            if cells.size == 0:
+                continue
+            part = grid.extract_cells(cells).clip(normal=CLIP_NORMAL, origin=centre, invert=True)
+            if part.n_cells:
+                colour, edges = SIDE_COLOURS[s][shade], bool(c)
+                plotter.add_mesh(part, color=colour, show_edges=edges, ambient=0.45, diffuse=0.6)
+    if interface is not None and interface.n_cells:  # its upper half, in front of the plane
+        front = interface.clip(normal=CLIP_NORMAL, origin=centre, invert=False)
+        front = front.clip(normal=(0.0, 0.0, -1.0), origin=centre, invert=True)
+        if front.n_cells:
+            plotter.add_mesh(front, color=INTERFACE_COLOUR, smooth_shading=True)
+    _legend(
+        plotter,
+        [
+            ("side -1", SIDE_COLOURS[-1][0], "patch"),
+            ("side -1, cut cells", SIDE_COLOURS[-1][1], "patch"),
+            ("side +1", SIDE_COLOURS[1][0], "patch"),
+            ("side +1, cut cells", SIDE_COLOURS[1][1], "patch"),
+            ("interface", INTERFACE_COLOUR, "patch"),
+        ],
+    )
+    _camera(plotter, grid)
+    _title(plotter, title)
+    return _save(plotter, path)
+
+
 def render_solid(
     folder: pathlib.Path, grid: pyvista.DataSet, summary: dict, name: str
 ) -> list[pathlib.Path]:
     """The pictures of a 3D run folder (``grid``: its ``result*.vtu`` merged):
-    ``result.png`` and ``von_mises.png`` (:func:`plot_clipped`), and per interface
-    law state ``pressure.png`` (``lambda_n``) and, for friction laws, ``traction.png``
-    (``|lambda_t|``) on the interface surface (:func:`plot_surface_field`)."""
+    ``result.png`` and ``von_mises.png`` (:func:`plot_clipped`), ``cut.png``
+    (:func:`plot_cut_solid`), and of the interface laws' state ``pressure.png``
+    (``lambda_n``) and, for friction laws, ``traction.png`` (``|lambda_t|``) on the
+    interface surface (:func:`plot_surface_field`)."""
     from xfem_contact.io.vtk_grids import merge_grids
 
     pieces = [pyvista.read(p) for p in sorted(folder.glob("interface*.vtu"))]
@@ -176,6 +228,9 @@ def render_solid(
         )
     if interface is None:
         return written
+    written.append(
+        plot_cut_solid(grid, folder / "cut.png", interface, f"{name}: cut cells and interface")
+    )
     laws = (summary.get("interfaces") or {}).values()
     friction = any("friction" in law or law.get("law") == "sticking" for law in laws)
     plots = [("lambda_n", "pressure.png", "lambda_n (Pa)", "contact pressure lambda_n")]
