@@ -279,3 +279,38 @@ def test_box_scene_defaults_and_faces():
     assert (scene.gdim, scene.cell, scene.cells) == (3, "tetrahedron", (2, 2, 2))
     assert scene.corners == ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
     assert scene.materials["a"].plane == "3d"
+
+
+def test_gmsh_3d_scene_with_named_surfaces(tmp_path):
+    """A .geo with volumes and named physical surfaces: a 3D scene of tetrahedra whose
+    loads name the surfaces; each named part is its whole unit face (area 1 exactly); a
+    box's face name is refused (a gmsh file names its own parts)."""
+    import dolfinx.mesh
+
+    from xfem_contact.mechanics.loads import boundary_facets
+    from xfem_contact.scenes.builder import create_mesh, scene_parts
+
+    geo = tmp_path / "cube.geo"
+    geo.write_text(
+        'SetFactory("OpenCASCADE");\nBox(1) = {0, 0, 0, 1, 1, 1};\n'
+        'Physical Volume("cube") = {1};\nPhysical Surface("xmin") = {1};\n'
+        'Physical Surface("xmax") = {2};\n'
+    )
+    data = box(law="sticking")
+    data["mesh"] = {"kind": "gmsh", "file": "cube.geo", "size": 0.3}
+    data["loads"] = [
+        {"part": "xmin", "type": "displacement", "value": [0.0, 0.0, 0.0]},
+        {"part": "xmax", "type": "pressure", "value": 1.0},
+    ]
+    scene = load_scene(data, folder=tmp_path)
+    assert (scene.gdim, scene.cell) == (3, "tetrahedron")
+    meshed = create_mesh(scene)
+    mesh, parts = meshed.mesh, scene_parts(scene, meshed)
+    assert mesh.topology.cell_name() == "tetrahedron"
+    for name in ("xmin", "xmax"):
+        facets = boundary_facets(mesh, name, parts)
+        x = mesh.geometry.x[dolfinx.mesh.entities_to_geometry(mesh, 2, facets)]
+        area = 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
+        assert abs(area.sum() - 1.0) < 1e-12, (name, area.sum())
+    with pytest.raises(ValueError, match="no such boundary part"):
+        load_scene(with_load(data, part="left", type="pressure", value=1.0), folder=tmp_path)
