@@ -99,6 +99,10 @@ def test_3d_outputs_and_show(tmp_path):
     x = surface.points - np.asarray(SPHERE_CENTRE)
     radius = np.linalg.norm(x, axis=1)
     assert np.abs(radius - 0.2).max() < 1e-12  # on phi_h = 0, which P2 holds exactly
+    corners = surface.points[surface.cells.reshape(-1, 4)[:, 1:]]
+    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    outward = np.einsum("ij,ij->i", normal, corners.mean(axis=1) - SPHERE_CENTRE)
+    assert np.all(outward > 0)  # every triangle turned towards side +1
     n = x / radius[:, None]
     exact = np.einsum("ij,j,ij->i", n, TRIAXIAL, n)
     assert np.abs(surface.point_data["lambda_n"] - exact).max() < 0.1
@@ -314,3 +318,37 @@ def test_gmsh_3d_scene_with_named_surfaces(tmp_path):
         assert abs(area.sum() - 1.0) < 1e-12, (name, area.sum())
     with pytest.raises(ValueError, match="no such boundary part"):
         load_scene(with_load(data, part="left", type="pressure", value=1.0), folder=tmp_path)
+
+
+@pytest.mark.parametrize(
+    "interface, volume, area",
+    [
+        (  # a cylinder across the cube: its section times 1, its lateral area
+            {"shape": "cylinder", "point": [0.5, 0.5, 0], "axis": [0, 0, 2], "radius": 0.25},
+            np.pi * 0.25**2,
+            2 * np.pi * 0.25,
+        ),
+        (  # an ellipsoid inside: 4/3 pi a b c
+            {"shape": "ellipsoid", "centre": [0.5, 0.5, 0.5], "axes": [0.35, 0.25, 0.15]},
+            4 / 3 * np.pi * 0.35 * 0.25 * 0.15,
+            None,
+        ),
+    ],
+)
+def test_3d_shapes_cut_the_box(interface, volume, area):
+    """A scene's 3D shapes as the cut sees them (P2 tetrahedra, 4 per edge): the volume
+    inside and the interface's area against the exact ones."""
+    import dolfinx.fem
+
+    from xfem_contact.cases.paper import integrate
+    from xfem_contact.fem.cutmesh import CutMesh
+    from xfem_contact.scenes.builder import create_mesh, interface_levelsets
+
+    data = box() | {"interfaces": [interface], "mesh": {"kind": "box", "cells": [4, 4, 4]}}
+    scene = load_scene(data)
+    mesh = create_mesh(scene).mesh
+    cut = CutMesh(mesh, interface_levelsets(scene), degree=2)
+    one = dolfinx.fem.Constant(mesh, 1.0)
+    assert abs(integrate(one * cut.dx(-1)) / volume - 1) < 1e-4
+    if area is not None:
+        assert abs(integrate(one * cut.dGamma) / area - 1) < 1e-3
