@@ -224,8 +224,9 @@ def _mesh(mesh, folder: pathlib.Path) -> dict:
             kinds = [k for k, keys in MESH_KEYS.items() if key in keys]
             message = f"is for mesh.kind = {' or '.join(map(repr, kinds))}, not {kind!r}"
             raise SceneError(f"mesh.{key}", message)
-    unit = [[0.0] * gdim, [1.0] * gdim]
-    corners = tuple(tuple(map(float, c)) for c in mesh.get("corners", unit))
+    if gdim == 3:  # the defaults in 3D (each key's doc says it)
+        mesh = {"corners": [[0, 0, 0], [1, 1, 1]], "cells": [8, 8, 8], "cell": "tetrahedron"} | mesh
+    corners = tuple(tuple(map(float, c)) for c in mesh.get("corners", [[0, 0], [1, 1]]))
     if not all(high > low for low, high in zip(*corners, strict=True)):
         where = "right of and above" if gdim == 2 else "beyond (along x, y and z)"
         message = f"the second corner must lie {where} the first, got {mesh['corners']}"
@@ -241,8 +242,8 @@ def _mesh(mesh, folder: pathlib.Path) -> dict:
         "corners": corners,
         "radii": radii,
         "geometry_degree": mesh.get("geometry_degree", 1),
-        "cells": tuple(mesh.get("cells", [20, 20] if gdim == 2 else [8, 8, 8])),
-        "cell": mesh.get("cell", "quadrilateral" if gdim == 2 else "tetrahedron"),
+        "cells": tuple(mesh.get("cells", [20, 20])),
+        "cell": mesh.get("cell", "quadrilateral"),
         "gdim": gdim,
     }
 
@@ -250,7 +251,7 @@ def _mesh(mesh, folder: pathlib.Path) -> dict:
 def _material_mode(table: dict, where: str, gdim: int) -> str:
     """The mode of a checked material table on a mesh of dimension ``gdim`` (default:
     plane strain in 2D, 3d in 3D); a mode of the other dimension is refused."""
-    mode = table.get("plane", MATERIAL_MODES[gdim][0])
+    mode = table.get("plane", "strain") if gdim == 2 else table.get("plane", "3d")
     if mode not in MATERIAL_MODES[gdim]:
         message = (
             f"{mode!r} is not a mode of a {gdim}D mesh; valid there: "

@@ -352,9 +352,13 @@ FIELDS = {
 #: or expressions of the coordinates
 _FIELDS_3D = {
     "mesh": {
-        "corners": Field(Vector(2, _POINT_3D), "[[x0, y0, z0], [x1, y1, z1]] (m, box)"),
-        "cells": Field(Vector(3, Number(1, integer=True)), "cells along x, y and z (box)"),
-        "cell": Field(Choice(CELLS_3D), f"one of {CELLS_3D}"),
+        "corners": Field(
+            Vector(2, _POINT_3D), "[[x0, y0, z0], [x1, y1, z1]] (m, box; default the unit cube)"
+        ),
+        "cells": Field(
+            Vector(3, Number(1, integer=True)), "cells along x, y and z (box; default [8, 8, 8])"
+        ),
+        "cell": Field(Choice(CELLS_3D), f"one of {CELLS_3D} (default tetrahedron)"),
     },
     "interface": {
         "centre": Field(_POINT_3D, "[x, y, z] (m), centre of a sphere or an ellipsoid"),
