@@ -71,13 +71,29 @@ def write_lips(
     ((discontinuous) Lagrange, e.g. ``stress`` and ``von_mises`` of
     :class:`~xfem_contact.mechanics.stress.StressFields`). Returns this process's file.
     """
-    if cut.geometry is None:  # 3D
+    arrays = lips_grid_arrays(cut, u_minus, u_plus, fields)
+    return write_grid(path, arrays, cut.mesh.comm, VTU_COMPRESSION)
+
+
+def lips_grid_arrays(cut: CutMesh, u_minus, u_plus, fields: dict | None = None):
+    """The grid of :func:`write_lips`: :func:`~xfem_contact.io.vtu.lips_arrays`, or on a
+    3D cut :func:`~xfem_contact.io.solid_grids.lips_arrays_3d`."""
+    if cut.geometry is None:  # a 3D cut keeps no sub-cells
         from xfem_contact.io.solid_grids import lips_arrays_3d
 
-        arrays = lips_arrays_3d(cut, u_minus, u_plus, fields)
-    else:
-        arrays = lips_arrays(cut, u_minus, u_plus, fields)
-    return write_grid(path, arrays, cut.mesh.comm, VTU_COMPRESSION)
+        return lips_arrays_3d(cut, u_minus, u_plus, fields)
+    return lips_arrays(cut, u_minus, u_plus, fields)
+
+
+def subcell_grid_arrays(cut: CutMesh):
+    """The cut cells' pieces of :func:`write_cut_geometry`: the curved sub-triangles
+    (:func:`~xfem_contact.io.vtu.subcell_arrays`), or on a 3D cut
+    :func:`~xfem_contact.io.solid_grids.subcell_arrays_3d`."""
+    if cut.geometry is None:
+        from xfem_contact.io.solid_grids import subcell_arrays_3d
+
+        return subcell_arrays_3d(cut)
+    return subcell_arrays(cut, uncut=False)
 
 
 def write_plain(path: str | pathlib.Path, u, fields: dict | None = None) -> pathlib.Path:
@@ -108,14 +124,10 @@ def write_cut_geometry(
     ``interface_r{r}.vtu``, rank 0 ``subcells.pvtu`` and ``interface.pvtu``. Returns this
     process's files. See :mod:`xfem_contact.io.pictures`.
     """
-    from xfem_contact.io.solid_grids import subcell_arrays_3d
-
     directory, comm = pathlib.Path(directory), cut.mesh.comm
-    three_d = cut.geometry is None
-    subcells = subcell_arrays_3d(cut) if three_d else subcell_arrays(cut, uncut=False)
     paths = []
     for name, arrays in (
-        ("subcells", subcells),
+        ("subcells", subcell_grid_arrays(cut)),
         ("interface", interface_grid_arrays(cut, interface_data, u_minus)),
     ):
         paths.append(write_grid(directory / f"{name}.vtu", arrays, comm, VTU_COMPRESSION))

@@ -314,9 +314,8 @@ class StepGrids:
     def arrays(self) -> dict:
         """The grids of the current state (name to :class:`~xfem_contact.io.vtu.GridArrays`)."""
         from xfem_contact.io.interface_data import interface_point_data
-        from xfem_contact.io.output import interface_grid_arrays
-        from xfem_contact.io.solid_grids import lips_arrays_3d
-        from xfem_contact.io.vtu import lips_arrays, plain_arrays
+        from xfem_contact.io.output import interface_grid_arrays, lips_grid_arrays
+        from xfem_contact.io.vtu import plain_arrays
 
         problem, fields, stress = self.problem, self.result.fields, self.result.stress
         if problem.cut is None:  # a plain problem
@@ -326,9 +325,8 @@ class StepGrids:
             "stress": dict(zip((-1, 1), stress.stress, strict=True)),
             "von_mises": dict(zip((-1, 1), stress.von_mises, strict=True)),
         }
-        lips = lips_arrays if problem.mesh.geometry.dim == 2 else lips_arrays_3d
         return {
-            "result": lips(problem.cut, fields[0], fields[1], named),
+            "result": lips_grid_arrays(problem.cut, fields[0], fields[1], named),
             "interface": interface_grid_arrays(
                 problem.cut, interface_point_data(problem), fields[0]
             ),
@@ -342,16 +340,12 @@ class StepGrids:
 
     def write_last(self) -> None:
         """``result.vtu``, ``interface.vtu`` of the last step written, ``subcells.vtu``."""
-        from xfem_contact.io.output import VTU_COMPRESSION
+        from xfem_contact.io.output import VTU_COMPRESSION, subcell_grid_arrays
         from xfem_contact.io.series import write_grid
-        from xfem_contact.io.solid_grids import subcell_arrays_3d
-        from xfem_contact.io.vtu import subcell_arrays
 
         comm = self.problem.mesh.comm
         grids = dict(self.last)
-        if self.problem.cut is not None and self.problem.mesh.geometry.dim == 2:
-            grids["subcells"] = subcell_arrays(self.problem.cut, uncut=False)
-        elif self.problem.cut is not None:
-            grids["subcells"] = subcell_arrays_3d(self.problem.cut)
+        if self.problem.cut is not None:
+            grids["subcells"] = subcell_grid_arrays(self.problem.cut)
         for name, arrays in grids.items():
             write_grid(self.out / f"{name}.vtu", arrays, comm, VTU_COMPRESSION)
