@@ -41,6 +41,8 @@ def test_sphere_scene_is_the_solid_case():
     assert problem.mesh.geometry.dim == 3
     assert problem.bulk.materials[1].plane == "3d"
     case = sphere_problem(4, 2, "sticking", levelset="quadric")
+    # the same forms (their kernels compiled once for both)
+    assert problem.residual(problem.w).signature() == case.residual(case.w).signature()
     case.solve()
     assert problem.w.x.array.shape == case.w.x.array.shape
     difference = np.abs(problem.w.x.array - case.w.x.array).max()
@@ -283,17 +285,29 @@ def test_box_scene_defaults_and_faces():
     assert (scene.gdim, scene.cell, scene.cells) == (3, "tetrahedron", (2, 2, 2))
     assert scene.corners == ((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
     assert scene.materials["a"].plane == "3d"
+    assert_part_areas(scene, dict.fromkeys(faces, 1.0))
+
+
+def assert_part_areas(scene, areas: dict) -> None:
+    """Each named boundary part of the scene's mesh has the given area (m^2) to 1e-12."""
+    import dolfinx.mesh
+
+    from xfem_contact.mechanics.loads import boundary_facets
+    from xfem_contact.scenes.builder import create_mesh, scene_parts
+
+    meshed = create_mesh(scene)
+    mesh, parts = meshed.mesh, scene_parts(scene, meshed)
+    for name, area in areas.items():
+        facets = boundary_facets(mesh, name, parts)
+        x = mesh.geometry.x[dolfinx.mesh.entities_to_geometry(mesh, 2, facets)]
+        found = 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
+        assert abs(found.sum() - area) < 1e-12, (name, found.sum())
 
 
 def test_gmsh_3d_scene_with_named_surfaces(tmp_path):
     """A .geo with volumes and named physical surfaces: a 3D scene of tetrahedra whose
     loads name the surfaces; each named part is its whole unit face (area 1 exactly); a
     box's face name is refused (a gmsh file names its own parts)."""
-    import dolfinx.mesh
-
-    from xfem_contact.mechanics.loads import boundary_facets
-    from xfem_contact.scenes.builder import create_mesh, scene_parts
-
     geo = tmp_path / "cube.geo"
     geo.write_text(
         'SetFactory("OpenCASCADE");\nBox(1) = {0, 0, 0, 1, 1, 1};\n'
@@ -308,14 +322,7 @@ def test_gmsh_3d_scene_with_named_surfaces(tmp_path):
     ]
     scene = load_scene(data, folder=tmp_path)
     assert (scene.gdim, scene.cell) == (3, "tetrahedron")
-    meshed = create_mesh(scene)
-    mesh, parts = meshed.mesh, scene_parts(scene, meshed)
-    assert mesh.topology.cell_name() == "tetrahedron"
-    for name in ("xmin", "xmax"):
-        facets = boundary_facets(mesh, name, parts)
-        x = mesh.geometry.x[dolfinx.mesh.entities_to_geometry(mesh, 2, facets)]
-        area = 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
-        assert abs(area.sum() - 1.0) < 1e-12, (name, area.sum())
+    assert_part_areas(scene, {"xmin": 1.0, "xmax": 1.0})
     with pytest.raises(ValueError, match="no such boundary part"):
         load_scene(with_load(data, part="left", type="pressure", value=1.0), folder=tmp_path)
 
