@@ -18,6 +18,8 @@ follows a line of their reference coordinates, where it is needed with any treat
 
 from __future__ import annotations
 
+import numbers
+
 import ufl
 
 from xfem_contact.mechanics.defaults import DEFAULT
@@ -67,7 +69,12 @@ class MultiplierLaw(InterfaceLaw):
     ):
         if lbb not in LBB_OPTIONS:
             raise ValueError(f"Unknown LBB treatment {lbb!r}; valid: {LBB_OPTIONS}")
-        if isinstance(multiplier_degree, bool) or multiplier_degree not in MULTIPLIER_DEGREES:
+        integer = isinstance(multiplier_degree, numbers.Integral)
+        if (
+            not integer
+            or isinstance(multiplier_degree, bool)
+            or (multiplier_degree not in MULTIPLIER_DEGREES)
+        ):
             raise ValueError(
                 f"multiplier_degree must be one of {MULTIPLIER_DEGREES}, got {multiplier_degree!r}"
             )

@@ -75,11 +75,6 @@ class SlidingContact(ContactLaw):
             raise ValueError(
                 f"lbb {self.lbb!r} is not available in large sliding; valid: {SLIDING_LBB}"
             )
-        if self.multiplier_degree != 1:
-            raise ValueError(
-                f"multiplier_degree {self.multiplier_degree!r} is not available in large "
-                "sliding (the slave/master pairing carries P1 multipliers); valid: (1,)"
-            )
         if slave not in (-1, 1):
             raise ValueError(f"slave must be the side -1 or +1, got {slave!r}")
         if pairing not in PAIRING_UPDATES:
