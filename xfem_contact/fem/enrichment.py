@@ -72,7 +72,7 @@ class EnrichedSpace:
             cells' diameter takes the ramp 1 on the tip cells' vertices instead, with a
             logged warning.
 
-    A crack's multipliers live on the vertices of the cells it crosses (none on a tip
+    A crack's multipliers live on the nodes of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillates, ``docs/crack_enrichment.md``). A crack
     (see :mod:`xfem_contact.fem.crack_cut`) adds a last field, the branch
     dofs ``b`` (Lagrange ``degree``, ``4 gdim`` components), and ties the two sides'

@@ -53,20 +53,20 @@ def vital_vertex_prolongation(
 ) -> MultiplierProlongation:
     """Multiplier prolongation from the vital nodes of the cut edges. Collective.
 
-    Cut edges (end nodes on opposite sides of the interpolated level set) of
+    Cut edges (end vertices on opposite sides of the interpolated level set) of
     the cut cells (a crack's: those it crosses and its tip cells, so that the tip
     cells' own vertices carry the multiplier too; not the cells cut ahead of its tips,
-    where it would act on nothing) are gathered globally, vital nodes chosen
+    where it would act on nothing) are gathered globally, vital vertices chosen
     identically on every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`), and
-    each multiplier dof of a node on a cut edge expressed by
-    :func:`xfem_contact.mechanics.lbb.prolongation`; a node of a cut cell on no cut edge
-    takes the mean of the rows of its cut cells' nodes on one.
+    each multiplier dof of a vertex on a cut edge expressed by
+    :func:`xfem_contact.mechanics.lbb.prolongation`; a vertex of a cut cell on no cut
+    edge takes the mean of the rows of its cut cells' vertices on one.
 
     For a P1 multiplier the nodes are the vertices. A P2 multiplier (triangles and
     quadrilaterals: vertices, edge nodes, the quadrilateral's centre) has its vertices
     restricted so, and every other node of a cut cell tied to the mean of its edge's
     ends (the centre: of the cell's vertices): the P1 (Q1) restricted space, written in
-    the P2 (Q2) basis; richer relations lose the inf-sup bound (docs' stability page).
+    the P2 (Q2) basis (richer relations measured: docs' stability page).
 
     Args:
         cut: The cut mesh.
@@ -95,39 +95,30 @@ def vital_vertex_prolongation(
     cut_cells = cut.interface_cells(interface)
     if cut.crack is not None:  # not the cells cut ahead of a tip: the crack is not there
         cut_cells = cut_cells[np.isin(cut_cells, cut.cut_cells[cut.crack.kind != NONE])]
+    edges = np.unique(c2e.array.reshape(-1, ne_cell)[cut_cells].ravel())
+    ends = e2v.array.reshape(-1, 2)[edges]
+    crossing = vertex_side[ends[:, 0]] != vertex_side[ends[:, 1]]
+    edges, ends = edges[crossing], ends[crossing]
+    if cut.crack is not None:
+        ends = ends[~_sliver_extension_edges(cut, edges, ends, vertex_phi, cell_vertices, c2e)]
     degree = space.multiplier_degrees[field]
-    if degree == 1:
-        edges = np.unique(c2e.array.reshape(-1, ne_cell)[cut_cells].ravel())
-        ends = e2v.array.reshape(-1, 2)[edges]
-        crossing = vertex_side[ends[:, 0]] != vertex_side[ends[:, 1]]
-        edges, ends = edges[crossing], ends[crossing]
-        if cut.crack is not None:
-            drop = _sliver_extension_edges(cut, edges, ends, vertex_phi, cell_vertices, c2e)
-            ends = ends[~drop]
-        gdim = mesh.geometry.dim
+    if degree > 1:  # the vertices' nodes, and every other node tied to its vertices
+        nodes, node_of_vertex = _lagrange_nodes(mesh, degree, cell_vertices, vertex_side)
+        return _prolongation_of_nodes(mesh, space, field, nodes, node_of_vertex[ends], cut_cells)
+    gdim = mesh.geometry.dim
 
-        def positions(vertices: np.ndarray) -> np.ndarray:
-            nodes = dolfinx.mesh.entities_to_geometry(mesh, 0, vertices.astype(np.int32))
-            return mesh.geometry.x[nodes.ravel(), :gdim]
+    def positions(vertices: np.ndarray) -> np.ndarray:
+        nodes = dolfinx.mesh.entities_to_geometry(mesh, 0, vertices.astype(np.int32))
+        return mesh.geometry.x[nodes.ravel(), :gdim]
 
-        nodes = _Nodes(cell_vertices, vertex_side, vmap, positions)
-    else:
-        if cut.crack is not None:
-            raise ValueError(
-                "multiplier_degree 2 with lbb='restriction' is not available on a crack "
-                "(its tip cells' vital nodes are not derived); valid there: multiplier_degree 1"
-            )
-        nodes = _lagrange_nodes(cut, degree)
-        table = np.array(EDGE_NODES[mesh.topology.cell_type])
-        ends = nodes.cells[cut_cells][:, table[:, :2]].reshape(-1, 2)
-        ends = ends[nodes.side[ends[:, 0]] != nodes.side[ends[:, 1]]]
+    nodes = _Nodes(cell_vertices, vertex_side, vmap, positions)
     return _prolongation_of_nodes(mesh, space, field, nodes, ends, cut_cells)
 
 
-def _lagrange_nodes(cut: CutMesh, degree: int) -> _Nodes:
-    """The nodes of the scalar Lagrange space of ``degree`` on ``cut.mesh``, their sides
-    from the level set interpolated there. Collective."""
-    mesh = cut.mesh
+def _lagrange_nodes(mesh, degree: int, cell_vertices: np.ndarray, vertex_side: np.ndarray):
+    """The nodes of the scalar Lagrange space of ``degree`` on ``mesh`` (the sides of the
+    vertices' nodes ``vertex_side``, +1 elsewhere) and the node of each local vertex.
+    Collective."""
     cell_type = mesh.topology.cell_type
     if cell_type not in EDGE_NODES:
         valid = [c.name for c in EDGE_NODES]
@@ -136,12 +127,14 @@ def _lagrange_nodes(cut: CutMesh, degree: int) -> _Nodes:
             f"{cell_type.name} cells; valid: {valid}"
         )
     S = dolfinx.fem.functionspace(mesh, ("Lagrange", degree))
-    phi = dolfinx.fem.Function(S)
-    phi.interpolate(cut.levelset.function)
-    side = np.where(phi.x.array < 0.0, -1, 1).astype(np.int8)
+    cells = S.dofmap.list
+    node_of_vertex = np.full(vertex_side.size, -1, dtype=np.int64)
+    node_of_vertex[cell_vertices] = cells[:, : cell_vertices.shape[1]]
+    side = np.ones(S.dofmap.index_map.size_local + S.dofmap.index_map.num_ghosts, np.int8)
+    side[node_of_vertex] = vertex_side
     x = S.tabulate_dof_coordinates()[:, : mesh.geometry.dim]
-    links = _links(cell_type)
-    return _Nodes(S.dofmap.list, side, S.dofmap.index_map, lambda k: x[k], links)
+    nodes = _Nodes(cells, side, S.dofmap.index_map, lambda k: x[k], _links(cell_type))
+    return nodes, node_of_vertex
 
 
 def _prolongation_of_nodes(

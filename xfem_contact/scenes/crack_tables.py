@@ -73,9 +73,6 @@ def shared_crack_keys(cracks: list[CrackSpec], interfaces: list | None = None) -
         if spec.kinematics != "small":
             message = f"{spec.kinematics!r}: with cracks, interfaces slide small only for now"
             raise SceneError(f"{where}.kinematics", message)
-        if spec.multiplier_degree not in (None, 1):
-            message = f"{spec.multiplier_degree!r} is not available with cracks; valid: [1]"
-            raise SceneError(f"{where}.multiplier_degree", message)
     for k, spec in enumerate(cracks[1:], start=1):
         first = cracks[0]
         names = [c.name for c in cracks[:k]]
