@@ -69,8 +69,9 @@ def test_a_bad_degree_is_refused_in_one_line(bad):
 
 
 def test_p2_multipliers_on_tetrahedra_with_the_stabilisation():
-    """3D: the stabilised P2 multiplier builds and solves on tetrahedra (the restriction
-    is 2D only, for every degree)."""
+    """3D: the stabilised P2 multiplier is built on tetrahedra (solved by
+    ``bench/sphere_triaxial.py --multiplier-degree 2``); the restriction is 2D only, for
+    every degree."""
     mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, 3, 3, 3)
     cut = CutMesh(mesh, lambda x: np.sqrt(((x.T - 0.5) ** 2).sum(axis=1)) - 0.3, degree=2)
     problem = Problem(cut, 2, Material(100e6, 0.3), Bonded(multiplier_degree=2))
