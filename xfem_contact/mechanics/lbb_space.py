@@ -31,7 +31,7 @@ def _links(cell_type: dolfinx.mesh.CellType) -> np.ndarray:
     """``(k, 2)`` cell-local node pairs of a degree-2 Lagrange cell: each edge node with
     the ends of its edge, each interior node with the cell's vertices (the nodes whose
     mean is a node's value in a linear, or bilinear, field)."""
-    pairs = [(m, a) for a, b, m in EDGE_NODES[cell_type] for a in (a, b)]
+    pairs = [(m, end) for a, b, m in EDGE_NODES[cell_type] for end in (a, b)]
     pairs += [(m, v) for m, vertices in INTERIOR_NODES[cell_type] for v in vertices]
     return np.array(pairs, dtype=np.int64)
 
@@ -51,7 +51,7 @@ class _Nodes(typing.NamedTuple):
 def vital_vertex_prolongation(
     cut: CutMesh, space, field: int = 2, interface: str | None = None
 ) -> MultiplierProlongation:
-    """Multiplier prolongation from the vital nodes of the cut edges. Collective.
+    """Multiplier prolongation from the vital vertices of the cut edges. Collective.
 
     Cut edges (end vertices on opposite sides of the interpolated level set) of
     the cut cells (a crack's: those it crosses and its tip cells, so that the tip
