@@ -1,6 +1,6 @@
 """The numerical inf-sup test of every 2D element: the discrete inf-sup constant
-(:func:`xfem_contact.mechanics.inf_sup.inf_sup_constant`) of P1-P1 and P2-P1 on triangles
-and quadrilaterals, for each LBB treatment (none, restriction, stabilized; stabilized
+(:func:`xfem_contact.mechanics.inf_sup.inf_sup_constant`) of P1-P1, P2-P1 and P2-P2 on
+triangles and quadrilaterals, for each LBB treatment (none, restriction, stabilized; stabilized
 with the ghost penalty raised to the stabilisation's weight, 0.1, too), on n = 8, 16,
 32, 64 cells per side of the unit square, over circles at random centres and radii (a
 third of them passing within 1e-6 h of a mesh node: tiny cuts on purpose). Prints, per
@@ -9,7 +9,9 @@ element, treatment and n, the least and median beta and the count of indefinite 
 on tetrahedra cut by a sphere (``--tet-sizes``). Writes
 ``bench/results/inf_sup.{json,md,png}``.
 
-Run: ``python bench/inf_sup.py [--circles 50] [--sizes 8 16 32 64]`` (``make bench``).
+Run: ``python bench/inf_sup.py [--circles 50] [--sizes 8 16 32 64] [--elements P2-P2]``
+(``make bench``; default P1-P1 and P2-P1, with the tetrahedra; other ``--elements``
+write ``bench/results/inf_sup_<elements>.{json,md,png}``).
 """
 
 import xfem_contact  # noqa: F401  (before dolfinx)
@@ -33,7 +35,23 @@ from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.problem import Problem
 
 RESULTS = pathlib.Path(__file__).resolve().parent / "results"
-ELEMENTS = [("triangle", 1), ("triangle", 2), ("quadrilateral", 1), ("quadrilateral", 2)]
+#: (cell, displacement degree, multiplier degree)
+ELEMENTS = [
+    (cell, degree, multiplier)
+    for cell in ("triangle", "quadrilateral")
+    for degree, multiplier in ((1, 1), (2, 1), (2, 2))
+]
+
+
+#: The elements of ``bench/results/inf_sup.*``
+DEFAULT_ELEMENTS = ("P1-P1", "P2-P1")
+
+
+def label(degree: int, multiplier: int) -> str:
+    """``P2-P1``: the displacement and multiplier degrees."""
+    return f"P{degree}-P{multiplier}"
+
+
 #: label: (lbb, ghost penalty; None: the default)
 TREATMENTS = {
     "none": ("none", None),
@@ -56,26 +74,33 @@ def circles(count: int, n: int, rng) -> list[tuple[float, float, float]]:
     return out
 
 
-def plot(rows: list[dict], path: pathlib.Path) -> None:
+def plot(rows: list[dict], elements: list, path: pathlib.Path) -> None:
     """Least beta against n, one panel per element, one line per treatment."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(ELEMENTS), figsize=(4 * len(ELEMENTS), 3.6), sharey=True)
-    for ax, (cell, degree) in zip(axes, ELEMENTS, strict=True):
+    fig, axes = plt.subplots(
+        1, len(elements), figsize=(4 * len(elements), 3.6), sharey=True, squeeze=False
+    )
+    for ax, element in zip(axes[0], elements, strict=True):
+        cell, degree, multiplier = element
         for lbb in TREATMENTS:
-            sel = [r for r in rows if (r["cell"], r["degree"], r["lbb"]) == (cell, degree, lbb)]
+            sel = [r for r in rows if _key(r) == (*element, lbb)]
             ns = [r["n"] for r in sel]
             ax.loglog(ns, [max(r["beta_min"], 1e-8) for r in sel], "o-", label=f"{lbb} (least)")
-        ax.set_title(f"{cell}, P{degree}-P1")
+        ax.set_title(f"{cell}, {label(degree, multiplier)}")
         ax.set_xlabel("cells per side n")
-    axes[0].set_ylabel("discrete inf-sup constant beta")
-    axes[0].legend(fontsize=8)
+    axes[0][0].set_ylabel("discrete inf-sup constant beta")
+    axes[0][0].legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def _key(row: dict) -> tuple:
+    return row["cell"], row["degree"], row.get("multiplier_degree", 1), row["lbb"]
 
 
 def tetrahedra(sizes: list[int]) -> list[str]:
@@ -111,9 +136,18 @@ def main() -> None:
     parser.add_argument(
         "--tet-sizes", type=int, nargs="*", default=[4, 8, 12], help="n of the P1-P1 tetrahedra"
     )
+    parser.add_argument(
+        "--elements",
+        nargs="+",
+        choices=sorted({label(d, m) for _, d, m in ELEMENTS}),
+        default=list(DEFAULT_ELEMENTS),
+        help="these elements (default P1-P1 P2-P1; others: results in inf_sup_<elements>.*)",
+    )
     args = parser.parse_args()
+    elements = [e for e in ELEMENTS if label(*e[1:]) in args.elements]
+    default = sorted(args.elements) == sorted(DEFAULT_ELEMENTS)
     rows = []
-    for cell, degree in ELEMENTS:
+    for cell, degree, multiplier in elements:
         for lbb, (treatment, ghost_penalty) in TREATMENTS.items():
             for n in args.sizes:
                 mesh = dolfinx.mesh.create_unit_square(
@@ -123,7 +157,7 @@ def main() -> None:
                 for cx, cy, r in circles(args.circles, n, np.random.default_rng(n)):
                     circle = lambda x, c=(cx, cy), r=r: np.hypot(x[0] - c[0], x[1] - c[1]) - r  # noqa: E731
                     cut = CutMesh(mesh, circle, degree=2)
-                    law = Bonded(lbb=treatment)
+                    law = Bonded(lbb=treatment, multiplier_degree=multiplier)
                     material = Material(100e6, 0.3)
                     problem = Problem(cut, degree, material, law, ghost_penalty=ghost_penalty)
                     b2.append(inf_sup_constant(problem).beta_squared)
@@ -132,6 +166,7 @@ def main() -> None:
                     {
                         "cell": cell,
                         "degree": degree,
+                        "multiplier_degree": multiplier,
                         "lbb": lbb,
                         "n": n,
                         "beta_min": float(b.min()),
@@ -141,8 +176,8 @@ def main() -> None:
                     }
                 )
                 note(
-                    f"{cell:13s} P{degree}-P1 {lbb:21s} n={n:3d}: beta min {b.min():.3e} "
-                    f"median {np.median(b):.3e}, indefinite {rows[-1]['indefinite']}/"
+                    f"{cell:13s} {label(degree, multiplier)} {lbb:21s} n={n:3d}: beta min "
+                    f"{b.min():.3e} median {np.median(b):.3e}, indefinite {rows[-1]['indefinite']}/"
                     f"{len(b2)} ({time.perf_counter() - start:.1f} s)"
                 )
     lines = [
@@ -151,9 +186,9 @@ def main() -> None:
         + " | slope of min (last pair) | indefinite |",
         "|---|---|---|" + "---|" * len(args.sizes) + "---|---|",
     ]
-    for cell, degree in ELEMENTS:
+    for cell, degree, multiplier in elements:
         for lbb in TREATMENTS:
-            sel = [r for r in rows if (r["cell"], r["degree"], r["lbb"]) == (cell, degree, lbb)]
+            sel = [r for r in rows if _key(r) == (cell, degree, multiplier, lbb)]
             mins = [r["beta_min"] for r in sel]
             slope = (
                 math.log(mins[-1] / mins[-2]) / math.log(args.sizes[-1] / args.sizes[-2])
@@ -162,16 +197,18 @@ def main() -> None:
             )
             cells = " | ".join(f"{r['beta_min']:.2e} / {r['beta_median']:.2e}" for r in sel)
             lines.append(
-                f"| {cell} | P{degree}-P1 | {lbb} | {cells} | {slope:.2f} | "
+                f"| {cell} | {label(degree, multiplier)} | {lbb} | {cells} | {slope:.2f} | "
                 f"{sum(r['indefinite'] for r in sel)}/{args.circles * len(sel)} |"
             )
-    lines += tetrahedra(args.tet_sizes)
+    name = "inf_sup" if default else "_".join(["inf_sup", *args.elements])
+    if default:
+        lines += tetrahedra(args.tet_sizes)
     RESULTS.mkdir(exist_ok=True)
-    plot(rows, RESULTS / "inf_sup.png")
-    (RESULTS / "inf_sup.md").write_text("\n".join(lines) + "\n")
-    (RESULTS / "inf_sup.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))
+    plot(rows, elements, RESULTS / f"{name}.png")
+    (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
+    (RESULTS / f"{name}.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))
     print("\n".join(lines))
-    print(f"wrote {RESULTS / 'inf_sup.md'} and .json")
+    print(f"wrote {RESULTS / name}.md and .json")
 
 
 if __name__ == "__main__":

@@ -3,8 +3,8 @@ the contact pressure and tangential traction errors of the multiplier against th
 ``sigma n`` (uniform stress ``diag(-1, -2, -3)`` Pa, one material), with their rates.
 
 Run: ``python bench/sphere_triaxial.py [--sizes 4 8] [--degree 2] [--law sticking]
-[--cell tetrahedron] [--levelset distance|quadric]``; prints one row per size (dofs,
-Newton iterations, time).
+[--cell tetrahedron] [--levelset distance|quadric] [--multiplier-degree 2]``; prints one
+row per size (dofs, Newton iterations, time).
 """
 
 import argparse
@@ -34,8 +34,12 @@ def main() -> None:
         choices=["distance", "quadric"],
         help="the sphere's level set: signed distance, or the quadric P2 holds exactly",
     )
+    parser.add_argument(
+        "--multiplier-degree", type=int, default=1, choices=[1, 2], help="of the multiplier"
+    )
     args = parser.parse_args()
     options = {} if args.friction is None else {"friction": args.friction}
+    options["multiplier_degree"] = args.multiplier_degree
     comm = MPI.COMM_WORLD
     rows = []
     for n in args.sizes:
@@ -50,7 +54,8 @@ def main() -> None:
         rows.append((n, e_n, e_t))
         if comm.rank == 0:
             print(
-                f"{args.law} {args.cell} P{args.degree} n={n}: pressure error {e_n:.3e}, "
+                f"{args.law} {args.cell} P{args.degree}-P{args.multiplier_degree} n={n}: "
+                f"pressure error {e_n:.3e}, "
                 f"tangential {e_t:.3e}, {dofs} dofs (with inactive), "
                 f"{getattr(report, 'iterations', 1)} Newton iterations, {elapsed:.1f} s",
                 flush=True,

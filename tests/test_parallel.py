@@ -31,10 +31,27 @@ CASES = {
     "case2 P2 triangles, Coulomb, LBB restriction": lambda comm: inclusion_problem(
         10, 2, "coulomb", "triangle", loading="pull", friction=0.3, lbb="restriction", comm=comm
     ),
+    "case2 P2-P2 quadrilaterals, sticking": lambda comm: inclusion_problem(
+        10, 2, "sticking", multiplier_degree=2, comm=comm
+    ),
+    "case2 P2-P2 triangles, Coulomb, LBB restriction": lambda comm: inclusion_problem(
+        10,
+        2,
+        "coulomb",
+        "triangle",
+        loading="pull",
+        friction=0.3,
+        lbb="restriction",
+        multiplier_degree=2,
+        comm=comm,
+    ),
     "case3 annulus P2, curved cells": lambda comm: annulus_problem(6, 24, 2, comm=comm),
     "case3 annulus P1": lambda comm: annulus_problem(6, 24, 1, comm=comm),
     # large sliding: masters on the other rank, the inner ring turned by 0.3 rad
     "case3 turned, large sliding P2": lambda comm: rotating_annulus_problem(6, 2, 0.3, comm=comm),
+    "case3 turned, large sliding P2-P2": lambda comm: rotating_annulus_problem(
+        6, 2, 0.3, multiplier_degree=2, comm=comm
+    ),
     "case3 turned, large sliding P1": lambda comm: rotating_annulus_problem(6, 1, 0.3, comm=comm),
     "case3 turned, large sliding Coulomb": lambda comm: rotating_annulus_problem(
         6, 2, 0.3, law="coulomb", friction=0.3, outer="tangential_spring", comm=comm

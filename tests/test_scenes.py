@@ -92,6 +92,16 @@ def test_only_named_effects_are_built(law, multipliers, tangential, solver):
         assert problem.space.multiplier_components == multipliers
 
 
+@pytest.mark.parametrize("law", ["bonded", "sticking"])
+def test_multiplier_degree_makes_the_multiplier_p2(law):
+    data = base(law=law, multiplier_degree=2)
+    problem, effects = build(load_scene(data))
+    assert problem.law().multiplier_degree == 2
+    assert effects["laws"]["interface0"]["multiplier_degree"] == 2
+    element = problem.space.W.sub(2).ufl_element()
+    assert element.embedded_superdegree == 2
+
+
 def interface(**table) -> dict:
     """A scene change: the interfaces are one given by its table."""
     return lambda d: d.update(interfaces=[table])
@@ -255,6 +265,21 @@ BAD_SCENES = {
     "coulomb without friction": (circle(law="coulomb"), "interfaces[0].friction", "required"),
     "negative friction": (circle(friction=-0.1), "interfaces[0].friction", "must be >= 0.0"),
     "lbb choice": (circle(lbb="magic"), "interfaces[0].lbb", "choose one of ['stabilized'"),
+    "multiplier degree choice": (
+        circle(multiplier_degree=3),
+        "interfaces[0].multiplier_degree",
+        "integer 3 is not valid; choose one of [1, 2]",
+    ),
+    "multiplier degree a string": (
+        circle(multiplier_degree="2"),
+        "interfaces[0].multiplier_degree",
+        "choose one of [1, 2]",
+    ),
+    "multiplier degree of a free interface": (
+        circle(law="free", multiplier_degree=2),
+        "interfaces[0].multiplier_degree",
+        "is not an option of law 'free'",
+    ),
     "friction on a sticking law": (
         circle(law="sticking", friction=0.3),
         "interfaces[0].friction",

@@ -222,6 +222,7 @@ def frictional_crack_case(
     mesh: dolfinx.mesh.Mesh | None = None,
     cell: str = "triangle",
     along_row: float | None = None,
+    multiplier_degree: int = 1,
 ) -> CrackCase:
     """A closed crack of half length ``a = 1`` m inclined at ``beta`` to a remote
     compression of 1 Pa, Coulomb friction ``friction`` on its lips, in the square of half
@@ -233,7 +234,8 @@ def frictional_crack_case(
     crack's default). ``angle``, ``offset``, ``mesh``: as for :func:`griffith_case`;
     ``cell``: ``"triangle"`` or ``"quadrilateral"``; ``along_row``: None, or the crack
     along a row of cells, this fraction of a cell above a mesh line (``angle`` and the
-    second component of ``offset`` are then unused)."""
+    second component of ``offset`` are then unused); ``multiplier_degree``: the lips'
+    multiplier's (1 or 2)."""
     a, (d, normal) = 1.0, _frame(angle)
     centre = np.asarray(offset, dtype=float) * a
     if along_row is not None:
@@ -262,10 +264,11 @@ def frictional_crack_case(
         degree=degree,
         tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
     )
+    options = {"lbb": lbb, "multiplier_degree": multiplier_degree}
     law = (
-        crack_law("coulomb", friction=friction, lbb=lbb)
+        crack_law("coulomb", friction=friction, **options)
         if friction > 0
-        else crack_law("frictionless", lbb=lbb)
+        else crack_law("frictionless", **options)
     )
     problem = Problem(cut, degree, MATERIAL, law, ghost_penalty=0.0, tip_radius=tip_radius)
     problem.loads.add_displacement(_on_boundary(width), _boundary_values(width, exact))

@@ -39,6 +39,7 @@ def inclusion_problem(
     comm: MPI.Comm = MPI.COMM_WORLD,
     radius: float = INCLUSION_RADIUS,
     materials: dict[int, Material] | None = None,
+    levelset: str = "distance",
     **options,
 ) -> ElasticityProblem:
     """Paper case 2: unit square with a circular inclusion (R = 0.2 m), E = 100 MPa,
@@ -56,13 +57,23 @@ def inclusion_problem(
         radius: Inclusion radius (m), for degenerate cuts (through nodes, tiny cuts).
         materials: ``{-1: inside, 1: outside}`` instead of the paper's one material
             (the exact solution then no longer holds).
+        levelset: ``"distance"`` (the signed distance, whose P2 interpolant's zero set
+            is the circle to O(h^3)) or ``"quadric"`` (``(|x - c|^2 - R^2) / (2 R)``,
+            which P2 represents exactly: the exact circle and normal, on which the exact
+            contact pressure ``n.sigma.n`` is the trace of a quadratic polynomial).
         options: Passed to the problem (``friction``, ``lbb``, ``augmentation``, ...).
     """
     if loading not in LOADINGS:
         raise ValueError(f"Unknown loading {loading!r}; valid: {sorted(LOADINGS)}")
     mesh = dolfinx.mesh.create_unit_square(comm, n, n, dolfinx.mesh.CellType[cell])
     cx, cy = INCLUSION_CENTRE
-    cut = CutMesh(mesh, lambda x: np.hypot(x[0] - cx, x[1] - cy) - radius, degree=2)
+    shapes = {
+        "distance": lambda x: np.hypot(x[0] - cx, x[1] - cy) - radius,
+        "quadric": lambda x: ((x[0] - cx) ** 2 + (x[1] - cy) ** 2 - radius**2) / (2 * radius),
+    }
+    if levelset not in shapes:
+        raise ValueError(f"levelset must be one of {sorted(shapes)}, got {levelset!r}")
+    cut = CutMesh(mesh, shapes[levelset], degree=2)
     material = materials or Material(INCLUSION_E, 0.0)
     cls = ContactProblem if law in ContactProblem.LAWS else ElasticityProblem
     problem = cls(cut, degree, material, law, **options)

@@ -49,7 +49,7 @@ class DofCounts(typing.NamedTuple):
 
 class EnrichedSpace:
     """Displacement per side (Lagrange ``degree``, vector) and an optional
-    interface multiplier (P1 on the vertices of cut cells, scalar or vector).
+    interface multiplier (Lagrange on the nodes of cut cells, scalar or vector).
 
     Args:
         cut: The cut mesh.
@@ -61,7 +61,8 @@ class EnrichedSpace:
             fraction of the support's area on that side are dropped (set
             inactive) to keep the operator well conditioned; 0 keeps all.
         multipliers: Instead of ``multiplier``, one multiplier field per entry
-            ``(components, interface name)`` (fields 2, 3, ... of ``W``), each
+            ``(components, interface name)`` or ``(components, interface name, degree)``
+            (fields 2, 3, ... of ``W``; Lagrange of ``degree``, 1 or 2, default 1), each
             active on the cut cells of its interface only (``None``: all).
         tip_radius: For a cut by a crack (``cut.crack``): the tip enrichment's radius
             (m): the vertices within it of a tip carry the four branch functions
@@ -71,7 +72,7 @@ class EnrichedSpace:
             cells' diameter takes the ramp 1 on the tip cells' vertices instead, with a
             logged warning.
 
-    A crack's multipliers live on the vertices of the cells it crosses (none on a tip
+    A crack's multipliers live on the nodes of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillates, ``docs/crack_enrichment.md``). A crack
     (see :mod:`xfem_contact.fem.crack_cut`) adds a last field, the branch
     dofs ``b`` (Lagrange ``degree``, ``4 gdim`` components), and ties the two sides'
@@ -109,16 +110,20 @@ class EnrichedSpace:
         elements = [displacement, displacement]
         if multipliers is None:
             multipliers = [(multiplier, None)] if multiplier else []
-        multipliers = [(int(c), name) for c, name in multipliers]
-        for components, _ in multipliers:
+        multipliers = [(int(m[0]), m[1], int(m[2]) if len(m) > 2 else 1) for m in multipliers]
+        for components, _, multiplier_degree in multipliers:
             if components not in (1, gdim):
                 raise ValueError(f"A multiplier must have 1 or {gdim} components, got {components}")
+            if multiplier_degree not in (1, 2):
+                raise ValueError(f"A multiplier's degree must be 1 or 2, got {multiplier_degree}")
             shape = () if components == 1 else (gdim,)
-            elements.append(basix.ufl.element("Lagrange", cell, 1, shape=shape))
+            elements.append(basix.ufl.element("Lagrange", cell, multiplier_degree, shape=shape))
         if multiplier not in (0, 1, gdim):
             raise ValueError(f"multiplier must have 0, 1 or {gdim} components, got {multiplier}")
         #: ``(field, components, interface name)`` of each multiplier field
-        self.multiplier_fields = [(2 + k, c, name) for k, (c, name) in enumerate(multipliers)]
+        self.multiplier_fields = [(2 + k, c, name) for k, (c, name, _) in enumerate(multipliers)]
+        #: The Lagrange degree of each multiplier field, by field
+        self.multiplier_degrees = {2 + k: d for k, (_, _, d) in enumerate(multipliers)}
         self.multiplier_components = multipliers[0][0] if multipliers else 0
         self.has_multiplier = bool(multipliers)
         #: The field of the branch dofs (None without a crack)

@@ -32,6 +32,9 @@ DEFAULTS: dict[str, Default] = {
     "crack_lbb": Default(
         "restriction", "LBB treatment of a crack's law given by name ('stabilized' refused)"
     ),
+    "multiplier_degree": Default(
+        1, "multiplier degree: 1 (the cut cells' vertices) or 2 (their vertices and edge nodes)"
+    ),
     "multiplier_stabilization": Default(0.1, "weight of the Barbosa-Hughes term"),
     "multiplier_extension": Default(1e-12, "weight of the multiplier's normal-gradient term"),
     "slave": Default(-1, "slave side of large sliding (-1 or +1)"),

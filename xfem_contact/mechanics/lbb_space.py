@@ -3,6 +3,9 @@ multiplier field of an enriched space, in parallel: the prolongation ``R`` uses.
 
 from __future__ import annotations
 
+import typing
+
+import dolfinx.fem
 import dolfinx.mesh
 import numpy as np
 from mpi4py import MPI
@@ -11,6 +14,38 @@ from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.prolongation import MultiplierProlongation
 from xfem_contact.geometry.crack import NONE, TIP
 from xfem_contact.mechanics import lbb as lbb_module
+
+#: The edges of a degree-2 Lagrange cell as ``(end, end, edge node)`` (basix numbering)
+EDGE_NODES = {
+    dolfinx.mesh.CellType.triangle: ((1, 2, 3), (0, 2, 4), (0, 1, 5)),
+    dolfinx.mesh.CellType.quadrilateral: ((0, 1, 4), (0, 2, 5), (1, 3, 6), (2, 3, 7)),
+}
+#: Interior nodes of a degree-2 Lagrange cell as ``(node, its vertices)``
+INTERIOR_NODES = {
+    dolfinx.mesh.CellType.triangle: (),
+    dolfinx.mesh.CellType.quadrilateral: ((8, (0, 1, 2, 3)),),
+}
+
+
+def _links(cell_type: dolfinx.mesh.CellType) -> np.ndarray:
+    """``(k, 2)`` cell-local node pairs of a degree-2 Lagrange cell: each edge node with
+    the ends of its edge, each interior node with the cell's vertices (the nodes whose
+    mean is a node's value in a linear, or bilinear, field)."""
+    pairs = [(m, end) for a, b, m in EDGE_NODES[cell_type] for end in (a, b)]
+    pairs += [(m, v) for m, vertices in INTERIOR_NODES[cell_type] for v in vertices]
+    return np.array(pairs, dtype=np.int64)
+
+
+class _Nodes(typing.NamedTuple):
+    """The nodes of a multiplier field, process-local (owned first, then ghosts)."""
+
+    cells: np.ndarray  #: ``(num_cells, nodes per cell)`` local node of each cell's node
+    side: np.ndarray  #: ``(num_nodes,)`` int8 side (-1, +1) of each node
+    index_map: typing.Any  #: the nodes' index map (owned numbered contiguously)
+    positions: typing.Callable  #: local nodes ``(k,)`` -> coordinates ``(k, gdim)``
+    #: ``(k, 2)`` cell-local ``(node, vertex)``: each node off the vertices takes the mean
+    #: of its linked vertices (:func:`_links`); empty for P1
+    links: np.ndarray = np.zeros((0, 2), dtype=np.int64)
 
 
 def vital_vertex_prolongation(
@@ -24,8 +59,14 @@ def vital_vertex_prolongation(
     where it would act on nothing) are gathered globally, vital vertices chosen
     identically on every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`), and
     each multiplier dof of a vertex on a cut edge expressed by
-    :func:`xfem_contact.mechanics.lbb.prolongation`.
-    Multiplier dofs of vertices on no cut edge stay free unknowns.
+    :func:`xfem_contact.mechanics.lbb.prolongation`; a vertex of a cut cell on no cut
+    edge takes the mean of the rows of its cut cells' vertices on one.
+
+    For a P1 multiplier the nodes are the vertices. A P2 multiplier (triangles and
+    quadrilaterals: vertices, edge nodes, the quadrilateral's centre) has its vertices
+    restricted so, and every other node of a cut cell tied to the mean of its edge's
+    ends (the centre: of the cell's vertices): the P1 (Q1) restricted space, written in
+    the P2 (Q2) basis (richer relations measured: docs' stability page).
 
     Args:
         cut: The cut mesh.
@@ -35,7 +76,6 @@ def vital_vertex_prolongation(
     """
     mesh = cut.mesh
     tdim = mesh.topology.dim
-    comm = mesh.comm
     mesh.topology.create_connectivity(tdim, 1)
     mesh.topology.create_connectivity(1, 0)
     mesh.topology.create_connectivity(0, tdim)  # entities_to_geometry of the vertices
@@ -61,14 +101,66 @@ def vital_vertex_prolongation(
     edges, ends = edges[crossing], ends[crossing]
     if cut.crack is not None:
         ends = ends[~_sliver_extension_edges(cut, edges, ends, vertex_phi, cell_vertices, c2e)]
+    degree = space.multiplier_degrees[field]
+    if degree > 1:  # the vertices' nodes, and every other node tied to its vertices
+        nodes, node_of_vertex = _lagrange_nodes(mesh, degree, cell_vertices, vertex_side)
+        return _prolongation_of_nodes(mesh, space, field, nodes, node_of_vertex[ends], cut_cells)
+    gdim = mesh.geometry.dim
+
+    def positions(vertices: np.ndarray) -> np.ndarray:
+        nodes = dolfinx.mesh.entities_to_geometry(mesh, 0, vertices.astype(np.int32))
+        return mesh.geometry.x[nodes.ravel(), :gdim]
+
+    nodes = _Nodes(cell_vertices, vertex_side, vmap, positions)
+    return _prolongation_of_nodes(mesh, space, field, nodes, ends, cut_cells)
+
+
+def _lagrange_nodes(mesh, degree: int, cell_vertices: np.ndarray, vertex_side: np.ndarray):
+    """The nodes of the scalar Lagrange space of ``degree`` on ``mesh`` (the sides of the
+    vertices' nodes ``vertex_side``, +1 elsewhere) and the node of each local vertex.
+    Collective."""
+    cell_type = mesh.topology.cell_type
+    if cell_type not in EDGE_NODES:
+        valid = [c.name for c in EDGE_NODES]
+        raise ValueError(
+            f"lbb='restriction' with multiplier_degree {degree} is not available on "
+            f"{cell_type.name} cells; valid: {valid}"
+        )
+    S = dolfinx.fem.functionspace(mesh, ("Lagrange", degree))
+    cells = S.dofmap.list
+    node_of_vertex = np.full(vertex_side.size, -1, dtype=np.int64)
+    node_of_vertex[cell_vertices] = cells[:, : cell_vertices.shape[1]]
+    side = np.ones(S.dofmap.index_map.size_local + S.dofmap.index_map.num_ghosts, np.int8)
+    side[node_of_vertex] = vertex_side
+    x = S.tabulate_dof_coordinates()[:, : mesh.geometry.dim]
+    nodes = _Nodes(cells, side, S.dofmap.index_map, lambda k: x[k], _links(cell_type))
+    return nodes, node_of_vertex
+
+
+def _prolongation_of_nodes(
+    mesh,
+    space,
+    field: int,
+    nodes: _Nodes,
+    ends: np.ndarray,
+    cut_cells: np.ndarray,
+) -> MultiplierProlongation:
+    """The prolongation of ``field``'s dofs at ``nodes`` from the vital vertices of the
+    cut edges ``ends`` (local node pairs of vertices, ``(m, 2)``; duplicates allowed) of
+    ``cut_cells``; a vertex of a cut cell on no cut edge takes the mean of the rows of its
+    cut cells' vertices on one, a node off the vertices that of its linked vertices
+    (``nodes.links``). Collective."""
+    comm, vmap = mesh.comm, nodes.index_map
+    vertex_side = nodes.side
+    nv_cell = nodes.cells.shape[1] - len({int(n) for n, _ in nodes.links})
+    cell_vertices = nodes.cells[:, :nv_cell]
     global_ends = vmap.local_to_global(ends.ravel()).reshape(-1, 2)
     all_ends = np.concatenate(comm.allgather(global_ends))
     all_sides = np.concatenate(comm.allgather(vertex_side[ends]))
     # The greedy choice breaks ties by vertex label: label the vertices by position (the
     # global numbers depend on the partition: 2 ranks chose other vital vertices than 1)
     gdim = mesh.geometry.dim
-    nodes = dolfinx.mesh.entities_to_geometry(mesh, 0, ends.ravel().astype(np.int32))
-    all_x = np.concatenate(comm.allgather(mesh.geometry.x[nodes.ravel(), :gdim]))
+    all_x = np.concatenate(comm.allgather(nodes.positions(ends.ravel())))
     all_x = all_x.reshape(-1, gdim)
     ids, first = np.unique(all_ends.ravel(), return_index=True)
     order = np.lexsort([np.round(all_x[first, k], 12) for k in reversed(range(gdim))])
@@ -103,11 +195,13 @@ def vital_vertex_prolongation(
         rows = np.concatenate([rows, *extra_rows])
         cols = np.concatenate([cols, *extra_cols])
         vals = np.concatenate([vals, *extra_vals])
-    # Multiplier dofs per vertex (P1: cell-local dof i sits at cell vertex i)
+    rows, cols, vals = _linked_rows(comm, vmap, nodes, cut_cells, rows, cols, vals)
+    # Multiplier dofs per node (the cell-local dof i sits at the cell's node i)
+    cell_nodes = nodes.cells
     comps = {f: c for f, c, _ in space.multiplier_fields}[field]
-    mdofs = space.W.sub(field).dofmap.list.reshape(cell_vertices.shape[0], nv_cell, comps)
-    dof_of_vertex = np.full((vertex_phi.size, comps), -1, dtype=np.int64)
-    dof_of_vertex[cell_vertices] = mdofs
+    mdofs = space.W.sub(field).dofmap.list.reshape(cell_nodes.shape[0], cell_nodes.shape[1], comps)
+    dof_of_vertex = np.full((vertex_side.size, comps), -1, dtype=np.int64)
+    dof_of_vertex[cell_nodes] = mdofs
     # Reduced multiplier unknowns, numbered rank-major: each process owns the
     # unknowns of the vital vertices it owns, in increasing global id.
     owned_global = vmap.local_to_global(np.arange(vmap.size_local, dtype=np.int32))
@@ -125,6 +219,31 @@ def vital_vertex_prolongation(
     pcol = np.concatenate([position[cols[keep]] * comps + c for c in range(comps)])
     pval = np.tile(vals[keep], comps)
     return MultiplierProlongation(dofs, prow, pcol, pval, num_owned=vital_owned.size * comps)
+
+
+def _linked_rows(comm, vmap, nodes: _Nodes, cut_cells, rows, cols, vals):
+    """``(rows, cols, vals)`` with, for each node off the vertices of the cut cells, the
+    mean of the rows of its linked vertices (``nodes.links``; global node ids). Collective."""
+    if nodes.links.size == 0:
+        return rows, cols, vals
+    linked = vmap.local_to_global(nodes.cells[cut_cells][:, nodes.links].ravel())
+    linked = np.unique(np.concatenate(comm.allgather(linked)).reshape(-1, 2), axis=0)
+    node, count = np.unique(linked[:, 0], return_counts=True)
+    weight = 1.0 / count[np.searchsorted(node, linked[:, 0])]
+    order = np.argsort(rows, kind="stable")
+    start = np.searchsorted(rows[order], linked[:, 1], side="left")
+    stop = np.searchsorted(rows[order], linked[:, 1], side="right")
+    take = [order[i:j] for i, j in zip(start, stop, strict=True)]
+    extra_rows = np.concatenate(
+        [np.full(t.size, n) for t, n in zip(take, linked[:, 0], strict=True)]
+    )
+    extra_cols = np.concatenate([cols[t] for t in take])
+    extra_vals = np.concatenate([vals[t] * w for t, w in zip(take, weight, strict=True)])
+    return (
+        np.concatenate([rows, extra_rows]),
+        np.concatenate([cols, extra_cols]),
+        np.concatenate([vals, extra_vals]),
+    )
 
 
 def combine_prolongations(

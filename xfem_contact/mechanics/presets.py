@@ -46,8 +46,8 @@ class ElasticityProblem(_LawFamily):
         cut, degree, materials: See :class:`Problem`.
         law: ``"free"`` (default) or ``"bonded"``.
         options: Keyword-only: :class:`Problem`'s (``ghost_penalty``, ...) and the
-            law's (``lbb``, ``multiplier_stabilization``, ``multiplier_extension`` for
-            ``bonded``).
+            law's (``lbb``, ``multiplier_stabilization``, ``multiplier_extension``,
+            ``multiplier_degree`` for ``bonded``).
     """
 
     LAWS = INTERFACE_LAWS
@@ -67,7 +67,7 @@ class ContactProblem(_LawFamily):
         options: Keyword-only: :class:`Problem`'s (``ghost_penalty``, ``kinematics``,
             ``slave``, ``pairing``, ...) and the law's (``friction``, required by
             ``"coulomb"``; ``augmentation``, ``lbb``, ``multiplier_stabilization``,
-            ``multiplier_extension``).
+            ``multiplier_extension``, ``multiplier_degree``).
     """
 
     LAWS = CONTACT_LAWS

@@ -53,8 +53,9 @@ class Problem:
 
     Args:
         cut: The cut mesh.
-        degree: Displacement degree (1 or 2); multipliers are P1 on the vertices of
-            the cut cells (the paper's P2-P1 element for degree 2).
+        degree: Displacement degree (1 or 2); multipliers are Lagrange of each law's
+            ``multiplier_degree`` on the cut cells: P1 on their vertices (default; the
+            paper's P2-P1 element for degree 2) or P2 on their vertices and edge nodes.
         materials: One :class:`Material`, or ``{-1: inside, 1: outside}``; with several
             interfaces ``inside`` may be ``{interface name: Material}``.
         law: A law (object or name) for every interface, or ``{interface name: law}``
@@ -115,11 +116,14 @@ class Problem:
         if min_support_fraction is None:
             min_support_fraction = 0.0 if ghost_penalty > 0 else 1e-12
         gdim = self.mesh.geometry.dim
-        multipliers = [(law.multiplier_components(gdim), name) for name, law in self.laws.items()]
+        multipliers = [
+            (law.multiplier_components(gdim), name, law.multiplier_degree)
+            for name, law in self.laws.items()
+        ]
         self.space = EnrichedSpace(
             cut,
             degree,
-            multipliers=[(c, n) for c, n in multipliers if c > 0],
+            multipliers=[m for m in multipliers if m[0] > 0],
             min_support_fraction=min_support_fraction,
             tip_radius=tip_radius,
         )

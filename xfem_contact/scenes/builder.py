@@ -190,7 +190,11 @@ def build(scene: Scene, comm: MPI.Comm = MPI.COMM_WORLD, petsc_options_prefix: s
                 raise interface_error(scene, error) from None
             laws = {
                 spec.name: make_law(
-                    spec.law, friction=spec.friction, augmentation=spec.augmentation, lbb=spec.lbb
+                    spec.law,
+                    friction=spec.friction,
+                    augmentation=spec.augmentation,
+                    lbb=spec.lbb,
+                    multiplier_degree=spec.multiplier_degree,
                 )
                 for spec in scene.interfaces
             }

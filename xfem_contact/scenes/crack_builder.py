@@ -105,6 +105,7 @@ def crack_cut(scene: Scene, mesh: dolfinx.mesh.Mesh, interfaces: dict | None = N
     for spec in scene.interfaces:  # psi None: a closed interface among the cracks
         phis[spec.name], psis[spec.name] = (interfaces or {})[spec.name], None
         options = {"friction": spec.friction, "augmentation": spec.augmentation}
+        options["multiplier_degree"] = spec.multiplier_degree
         laws[spec.name] = make_law(spec.law, lbb=spec.lbb, **options)
         inside[spec.name] = scene.materials[spec.inside]
     several = len(phis) > 1

@@ -22,6 +22,7 @@ class InterfaceSpec:
     #: None: the law's default (:data:`~xfem_contact.mechanics.defaults.DEFAULTS`)
     augmentation: float | None = None
     lbb: str | None = None
+    multiplier_degree: int | None = None
     kinematics: str = "small"
     slave: int = -1
     pairing: str = "iterate"
@@ -43,6 +44,7 @@ class CrackSpec:
     friction: float | None = None
     augmentation: float | None = None
     lbb: str | None = None
+    multiplier_degree: int | None = None
     tip_radius: float | None = None
     rings: tuple | None = None
     reference_K: tuple | None = None

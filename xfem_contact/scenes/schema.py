@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import warnings
 
-from xfem_contact.mechanics.laws import CONTACT_LAWS, LBB_OPTIONS, LINEAR_LAWS
+from xfem_contact.mechanics.laws import CONTACT_LAWS, LBB_OPTIONS, LINEAR_LAWS, MULTIPLIER_DEGREES
 from xfem_contact.mechanics.loads import BOX_FACES
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
 from xfem_contact.scenes.checks import (  # noqa: F401  (re-exported)
@@ -235,6 +235,11 @@ FIELDS = {
         "friction": Field(Number(0.0), "Coulomb coefficient >= 0"),
         "augmentation": Field(_POSITIVE, "> 0"),
         "lbb": Field(Choice(LBB_OPTIONS), " | ".join(LBB_OPTIONS)),
+        "multiplier_degree": Field(
+            Choice(MULTIPLIER_DEGREES),
+            "1 (P1 multiplier on the cut cells' vertices; default) | 2 (P2: their vertices "
+            "and edge nodes; small kinematics)",
+        ),
         "kinematics": Field(Choice(KINEMATICS), f"one of {KINEMATICS}"),
         "slave": Field(Choice((-1, 1)), "slave side -1 or +1 (large kinematics; default -1)"),
         "master": Field(Choice((-1, 1)), "master side, the other one (large kinematics)"),

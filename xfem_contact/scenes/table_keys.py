@@ -24,15 +24,19 @@ def shape_parameters(table: dict, where: str, shape_keys: dict) -> dict:
     return {k: table[k] for k in required + optional if k in table}
 
 
+#: The law options a table may give
+LAW_KEYS = ("friction", "augmentation", "lbb", "multiplier_degree")
+
+
 def law_options(table: dict, where: str, law: str) -> dict:
-    """``friction``, ``augmentation`` and ``lbb`` of ``law`` in ``table`` (None where not
-    given): Coulomb needs its friction; an option the law does not take is an error."""
+    """The :data:`LAW_KEYS` of ``law`` in ``table`` (None where not given): Coulomb needs
+    its friction; an option the law does not take is an error."""
     if law == "coulomb" and "friction" not in table:
         raise SceneError(f"{where}.friction", "required for law 'coulomb' (coefficient >= 0)")
-    for key in ("friction", "augmentation", "lbb"):
+    for key in LAW_KEYS:
         if key in table and key not in LAW_OPTIONS[law]:
             options = ", ".join(LAW_OPTIONS[law]) or "none"
             raise SceneError(
                 f"{where}.{key}", f"is not an option of law {law!r} (its options: {options})"
             )
-    return {key: table.get(key) for key in ("friction", "augmentation", "lbb")}
+    return {key: table.get(key) for key in LAW_KEYS}

@@ -14,7 +14,7 @@ in :data:`LAWS`.
 from xfem_contact.mechanics.laws.base import Fields, InterfaceContext, InterfaceLaw, law_options
 from xfem_contact.mechanics.laws.bonding import Bonded, Free
 from xfem_contact.mechanics.laws.contact import ContactLaw, Coulomb, Frictionless, Sticking
-from xfem_contact.mechanics.laws.multiplier import LBB_OPTIONS, MultiplierLaw
+from xfem_contact.mechanics.laws.multiplier import LBB_OPTIONS, MULTIPLIER_DEGREES, MultiplierLaw
 from xfem_contact.mechanics.laws.sliding import (
     SLIDING_LAWS,
     SlidingContact,
@@ -60,6 +60,7 @@ __all__ = [
     "LAW_OPTIONS",
     "LBB_OPTIONS",
     "LINEAR_LAWS",
+    "MULTIPLIER_DEGREES",
     "Bonded",
     "ContactLaw",
     "Coulomb",

@@ -304,6 +304,8 @@ class InterfaceLaw(abc.ABC):
     tangential: typing.ClassVar[bool] = False
     #: The LBB treatment of the law's multiplier (``"none"`` without a multiplier)
     lbb: str = "none"
+    #: The Lagrange degree of the law's multiplier field (1 without a multiplier)
+    multiplier_degree: int = 1
 
     @property
     def transmits(self) -> str:

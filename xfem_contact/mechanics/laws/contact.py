@@ -57,7 +57,7 @@ class ContactLaw(MultiplierLaw):
 
     Args:
         augmentation: Dimensionless factor of ``r = augmentation * E / h`` (> 0).
-        lbb, multiplier_stabilization, multiplier_extension: See
+        lbb, multiplier_stabilization, multiplier_extension, multiplier_degree: See
             :class:`~xfem_contact.mechanics.laws.multiplier.MultiplierLaw`.
     """
 

@@ -1,8 +1,9 @@
 """Laws with an interface multiplier, and their LBB treatments.
 
-The multiplier is P1 on the vertices of the interface's cut cells. A space that
-rich violates the inf-sup (LBB) condition and oscillates, so every multiplier law
-takes an ``lbb`` option:
+The multiplier is Lagrange on the nodes of the interface's cut cells: P1 on their
+vertices (``multiplier_degree=1``) or P2 on their vertices and edge nodes
+(``multiplier_degree=2``). A space that rich violates the inf-sup (LBB) condition and
+oscillates, so every multiplier law takes an ``lbb`` option:
 
 - ``"stabilized"`` (default): the consistent Barbosa-Hughes term
   ``- s int (lambda - t(u)).(mu - t(v))`` (:meth:`MultiplierLaw.stabilization_form`);
@@ -17,6 +18,8 @@ follows a line of their reference coordinates, where it is needed with any treat
 
 from __future__ import annotations
 
+import numbers
+
 import ufl
 
 from xfem_contact.mechanics.defaults import DEFAULT
@@ -30,6 +33,8 @@ from xfem_contact.mechanics.lbb_space import vital_vertex_prolongation
 from xfem_contact.mechanics.parameters import Parameter, constant
 
 LBB_OPTIONS = ("stabilized", "restriction", "none")
+#: Lagrange degrees of a multiplier field
+MULTIPLIER_DEGREES = (1, 2)
 #: Weight of the normal-gradient term on cells where the interface follows a reference
 #: coordinate line (the multiplier modes there have no trace; see ``extension_form``)
 ALIGNED_EXTENSION = 0.1
@@ -44,21 +49,37 @@ class MultiplierLaw(InterfaceLaw):
             (used with ``lbb="stabilized"``); a Constant of the forms.
         multiplier_extension: Weight of the normal-gradient term (see
             :meth:`extension_form`; not with ``lbb="none"``); a Constant of the forms.
+        multiplier_degree: Lagrange degree of the multiplier on the cut cells (one of
+            :data:`MULTIPLIER_DEGREES`): 1 on their vertices, 2 on their vertices and
+            edge nodes (with ``lbb="restriction"`` the vital nodes of
+            :func:`~xfem_contact.mechanics.lbb_space.vital_vertex_prolongation`).
     """
 
     multiplier_stabilization = Parameter(minimum=0.0)
     multiplier_extension = Parameter(minimum=0.0)
     lbb = FixedAtConstruction()
+    multiplier_degree = FixedAtConstruction()
 
     def __init__(
         self,
         lbb: str = DEFAULT.lbb,
         multiplier_stabilization: float = DEFAULT.multiplier_stabilization,
         multiplier_extension: float = DEFAULT.multiplier_extension,
+        multiplier_degree: int = DEFAULT.multiplier_degree,
     ):
         if lbb not in LBB_OPTIONS:
             raise ValueError(f"Unknown LBB treatment {lbb!r}; valid: {LBB_OPTIONS}")
+        integer = isinstance(multiplier_degree, numbers.Integral)
+        if (
+            not integer
+            or isinstance(multiplier_degree, bool)
+            or (multiplier_degree not in MULTIPLIER_DEGREES)
+        ):
+            raise ValueError(
+                f"multiplier_degree must be one of {MULTIPLIER_DEGREES}, got {multiplier_degree!r}"
+            )
         self.lbb = lbb
+        self.multiplier_degree = int(multiplier_degree)
         self.multiplier_stabilization = multiplier_stabilization
         self.multiplier_extension = multiplier_extension
 
@@ -73,7 +94,7 @@ class MultiplierLaw(InterfaceLaw):
         return self.lbb != "none"
 
     def describe(self) -> dict:
-        return super().describe() | {"lbb": self.lbb}
+        return super().describe() | {"lbb": self.lbb, "multiplier_degree": self.multiplier_degree}
 
     def prolongation(self, ctx: InterfaceContext, space):
         if self.lbb != "restriction":

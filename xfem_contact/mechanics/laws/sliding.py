@@ -51,8 +51,8 @@ class SlidingContact(ContactLaw):
             feet of its points cross master-piece ends, a Gauss rule per sub-segment
             (:mod:`~xfem_contact.mechanics.sliding.segments`); False: the interface
             rule's points. An attribute, settable between solves.
-        augmentation, lbb, multiplier_stabilization, multiplier_extension: As for
-            :class:`~xfem_contact.mechanics.laws.contact.Frictionless` (``lbb``:
+        augmentation, lbb, multiplier_stabilization, multiplier_extension, multiplier_degree:
+            As for :class:`~xfem_contact.mechanics.laws.contact.Frictionless` (``lbb``:
             ``"stabilized"`` or ``"none"``).
     """
 
