@@ -6,9 +6,10 @@ values of a basis of ``P_q`` at the points, ``m = dim P_q``) has a subset of at 
 points carrying the same moments with positive weights (Caratheodory's theorem on the cone of
 the columns). The reduction here removes points by null vectors of ``M``: for ``v`` with
 ``M v = 0``, ``w - alpha v`` keeps the moments, and the largest ``alpha`` that keeps every
-weight ``>= 0`` zeroes one of them. Points enter one at a time next to the ``m`` kept, and
-the null vector of those ``m + 1`` (from a batched SVD) removes one. Vectorised over rules;
-the loop runs over the points to remove, so the cost grows as ``n m^3`` per rule.
+weight ``>= 0`` zeroes one of them. Points enter one at a time next to the ``m`` kept,
+and the null vector of those ``m + 1`` (the last column of a batched complete QR) removes
+one. Vectorised over rules; the loop runs over the points to remove, so the cost grows as
+``n m^3`` per rule.
 
 The basis is the tensor Legendre polynomials of ``2 X - 1`` (well conditioned on the unit
 box holding the reference tetrahedron and hexahedron), total degree ``<= q``. It spans the
@@ -122,7 +123,7 @@ def _reduce(basis, index, w, m):
         idx = np.concatenate([idx, index[:, j : j + 1]], axis=1)
         A = np.concatenate([A, basis[:, j : j + 1]], axis=1)
         cur = np.concatenate([cur, w[:, j : j + 1]], axis=1)
-        v = np.linalg.svd(np.swapaxes(A, 1, 2), full_matrices=True)[2][:, -1, :]
+        v = np.linalg.qr(A, mode="complete")[0][:, :, -1]  # orthogonal to A's columns
         v = np.where((v.max(axis=1) > -v.min(axis=1))[:, None], v, -v)  # a positive entry
         ratio = np.where(v > 0, cur / np.where(v > 0, v, 1.0), np.inf)
         i = np.argmin(ratio, axis=1)
