@@ -14,6 +14,7 @@ import numpy.typing as npt
 import ufl
 
 from xfem_contact._deprecation import renamed_attribute
+from xfem_contact._timers import phase, seconds
 from xfem_contact.fem import cut_boundary
 from xfem_contact.fem.crack_cut import Crack
 from xfem_contact.fem.cut3d_state import cut_state_3d
@@ -24,11 +25,13 @@ from xfem_contact.geometry.crack_union import CrackUnion
 from xfem_contact.geometry.levelset import CellMaps, LevelSet, LevelSetCallable
 from xfem_contact.quadrature import rules as quadrature
 from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart, marker_space
+from xfem_contact.quadrature.compression import compress_rules, num_moments
 
 _SIDE_PARTS = {SIDE_MINUS: (4, 6), SIDE_PLUS: (5, 7)}  # side measure: uncut, cut cells parts
 _INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + index
 _BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
 _CUT_CELLS0 = 50  # measure ids of cut.dx_cut(name): _CUT_CELLS0 + index, _CUT_CELLS0 - 1 all
+_MAX_MOMENTS = 20  # the largest dim P_d that rules are compressed to
 _counter = itertools.count()
 CELLS = ("triangle", "quadrilateral", "tetrahedron", "hexahedron")
 """The cell kinds of the meshes :class:`CutMesh` cuts."""
@@ -75,6 +78,16 @@ class CutMesh:
             (:mod:`xfem_contact.geometry.crack_union`, ``crack.union``), each with its
             own measure. 2D only.
         tip_points: Gauss points per direction of a tip cell's Duffy rules.
+        compression: Integrate the cut cells with compressed rules
+            (:func:`~xfem_contact.quadrature.compression.compress_rules`): for an integrand
+            of polynomial degree ``p`` (as FFCx takes it for the standard rule: the
+            measure's ``quadrature_degree`` metadata or UFL's estimate), each side and
+            interface rule of more than ``2 dim P_d`` points is replaced by at most
+            ``dim P_d`` of its points with positive weights and the same moments of degree
+            ``d = min(p, quadrature_degree)``, for ``dim P_d <= 20`` (``d <= 3`` in 3D,
+            ``d <= 5`` in 2D: the cost grows as ``(dim P_d)^3`` per rule; higher degrees
+            keep the full rules). Triangles and tetrahedra without a crack; default on
+            for P2 tetrahedra, off otherwise. :attr:`rules` stay the full rules.
 
     Example:
         >>> cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 0.5)
@@ -89,6 +102,7 @@ class CutMesh:
         quadrature_degree: int | None = None,
         tangent: LevelSetCallable | dolfinx.fem.Function | None = None,
         tip_points: int = 24,
+        compression: bool | None = None,
     ):
         tdim = mesh.topology.dim
         kinds = [t.name for t in mesh.topology.entity_types[tdim]]
@@ -107,6 +121,17 @@ class CutMesh:
             quadrature_degree = 6 if tangent is None else 16
         if quadrature_degree < 1:
             raise ValueError(f"quadrature_degree must be >= 1, got {quadrature_degree}")
+        simplex = kinds[0] in ("triangle", "tetrahedron")
+        if compression is None:
+            compression = kinds[0] == "tetrahedron" and degree == 2
+        if compression and (not simplex or tangent is not None):
+            raise ValueError(
+                f"compression: rules are compressed on triangles and tetrahedra without a "
+                f"crack, not on {kinds[0]}s{' with a crack' if tangent is not None else ''}; "
+                "valid: compression=False"
+            )
+        #: Whether the cut cells are integrated with compressed rules (see the constructor)
+        self.compression = bool(compression)
         self.mesh = mesh
         self.degree = degree
         self.quadrature_degree = quadrature_degree
@@ -155,6 +180,7 @@ class CutMesh:
             SIDE_PLUS: owned[state.cell_sides == 1],
         }
         self._cell_rules = {sid: self._rules(state.cut_cells, r) for sid, r in state.rules.items()}
+        self._compressed: dict[tuple[int, int], CellRules] = {}
         self._interface_rules: dict[int, quadrature.RuleSet] = {}
         self._boundary_parts: dict[int, list[IntegrationPart]] = {}
 
@@ -407,8 +433,12 @@ class CutMesh:
             self._boundary_parts[slot] = cut_boundary.boundary_parts(self, side, facets)
         return self._boundary_parts[slot]
 
-    def integration_parts(self, subdomain_id: int) -> list[IntegrationPart]:
-        """Standard and runtime parts of a measure id (for :func:`xfem_contact.form`)."""
+    def integration_parts(
+        self, subdomain_id: int, degree: int | None = None
+    ) -> list[IntegrationPart]:
+        """Standard and runtime parts of a measure id (for :func:`xfem_contact.form`), the
+        runtime rules for an integrand of polynomial ``degree`` (``None``: the full
+        rules; see ``compression``)."""
         if subdomain_id >= _BOUNDARY0:
             return self._boundary(subdomain_id - _BOUNDARY0)
         if subdomain_id >= _CUT_CELLS0 - 1:
@@ -420,16 +450,36 @@ class CutMesh:
             if subdomain_id not in self._cell_rules:
                 r = self.interface_rules_of(self.interface_names[k])
                 self._cell_rules[k + _INTERFACE0] = self._rules(self.cut_cells, r)
-            return [IntegrationPart("cell", rules=self._cell_rules[subdomain_id])]
+            return [IntegrationPart("cell", rules=self._runtime_rules(subdomain_id, degree))]
         for side, (uncut, cut_part) in _SIDE_PARTS.items():  # a part of a side measure
             if subdomain_id == uncut:
                 return [IntegrationPart("cell", entities=self._standard[side])]
             if subdomain_id == cut_part:
-                return [IntegrationPart("cell", rules=self._cell_rules[side])]
+                return [IntegrationPart("cell", rules=self._runtime_rules(side, degree))]
         if subdomain_id not in self._cell_rules:
             raise ValueError(f"Unknown CutMesh measure id {subdomain_id}")
         parts = []
         if subdomain_id in self._standard:
             parts.append(IntegrationPart("cell", entities=self._standard[subdomain_id]))
-        parts.append(IntegrationPart("cell", rules=self._cell_rules[subdomain_id]))
+        parts.append(IntegrationPart("cell", rules=self._runtime_rules(subdomain_id, degree)))
         return parts
+
+    def _runtime_rules(self, sid: int, degree: int | None) -> CellRules:
+        """The runtime rules of measure id ``sid`` (a side, the interface or a named
+        interface) for an integrand of polynomial ``degree``: compressed to degree
+        ``min(degree, quadrature_degree)`` with :attr:`compression`, once per state."""
+        if not self.compression or degree is None:
+            return self._cell_rules[sid]
+        d = min(degree, self.quadrature_degree)
+        if num_moments(self.mesh.topology.dim, d) > _MAX_MOMENTS:
+            return self._cell_rules[sid]
+        if (sid, d) not in self._compressed:
+            timer = phase("rule compression")
+            if sid >= _INTERFACE0:
+                full = self.interface_rules_of(self.interface_names[sid - _INTERFACE0])
+            else:
+                full = self.rules[sid]
+            rules = compress_rules(full, d, keep=2 * num_moments(self.mesh.topology.dim, d))
+            seconds(timer)
+            self._compressed[sid, d] = self._rules(self.cut_cells, rules)
+        return self._compressed[sid, d]
