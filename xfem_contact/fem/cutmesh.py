@@ -87,7 +87,9 @@ class CutMesh:
             ``d = min(p, quadrature_degree)``, for ``dim P_d <= 20`` (``d <= 3`` in 3D,
             ``d <= 5`` in 2D: the cost grows as ``(dim P_d)^3`` per rule; higher degrees
             keep the full rules). Triangles and tetrahedra without a crack; default on
-            for P2 tetrahedra, off otherwise. :attr:`rules` stay the full rules.
+            for P2 tetrahedra, off otherwise. :attr:`rules` stay the full rules. A
+            (measure, degree) is compressed once per cut, when a form first needs it,
+            timed as DOLFINx's ``"xfem_contact: rule compression"``.
 
     Example:
         >>> cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 0.5)
