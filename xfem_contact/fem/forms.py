@@ -4,9 +4,10 @@ Measures whose ``subdomain_data`` provides ``integration_parts(subdomain_id, deg
 (:class:`~xfem_contact.quadrature.cell_rules.CellRules`, :class:`~xfem_contact.fem.cutmesh.CutMesh`)
 are rewritten into a standard cell integral over the cells their part covers
 with the standard rule, and a runtime integral (integrand times the marker) over
-the cells with per-cell rules. ``degree`` is the integrand's polynomial degree as FFCx
-takes it for a standard rule (the integral's ``quadrature_degree`` metadata, else UFL's
-estimate), so that a source may give rules of that degree. Forms are compiled once per
+the cells with per-cell rules. For a source whose ``compression`` is true, ``degree`` is
+the integrand's polynomial degree as FFCx takes it for a standard rule (the integral's
+``quadrature_degree`` metadata, else UFL's estimate), so that it may give rules of that
+degree; ``None`` for the others. Forms are compiled once per
 signature with the :mod:`xfem_contact.codegen` back end and re-created cheaply for new
 rules.
 """
@@ -66,8 +67,10 @@ def _is_cut_source(data) -> bool:
 
 def _source_key(data, integral) -> tuple[str, int, int, int]:
     """Deterministic order of the cut-cell measures of a form (so of its signature), one
-    per integrand degree."""
-    return (type(data).__name__, data.id, integral.subdomain_id(), integrand_degree(integral))
+    per integrand degree for a source whose rules depend on it (its ``compression``;
+    -1 for the others)."""
+    degree = integrand_degree(integral) if data.compression else -1
+    return (type(data).__name__, data.id, integral.subdomain_id(), degree)
 
 
 def integrand_degree(integral: ufl.Integral) -> int:
@@ -117,7 +120,8 @@ def _rewrite(ufl_form: ufl.Form) -> _Rewrite:
     parts = {}
     for key in keys:
         itg = next(i for i in ours if key_of[id(i)] == key)
-        parts[key] = list(itg.subdomain_data().integration_parts(itg.subdomain_id(), key[3]))
+        degree = None if key[3] < 0 else key[3]
+        parts[key] = list(itg.subdomain_data().integration_parts(itg.subdomain_id(), degree))
     # One id per part; the degrees of a measure whose parts are the same share them.
     ids, shared, next_standard, next_runtime = {}, {}, _STANDARD_ID0, _RUNTIME_ID0
     for key in keys:

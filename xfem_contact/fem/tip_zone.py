@@ -57,6 +57,11 @@ class TipZone:
         """The cut's id (orders the measures of a form)."""
         return self.cut.id
 
+    @property
+    def compression(self) -> bool:
+        """Whether the cut's rules depend on the integrand's degree (its ``compression``)."""
+        return self.cut.compression
+
     def dx(self, side: int, metadata: dict | None = None) -> ufl.Measure:
         """As :meth:`CutMesh.dx <xfem_contact.fem.cutmesh.CutMesh.dx>`: ``metadata``
         applies to the uncut cells outside the zone."""

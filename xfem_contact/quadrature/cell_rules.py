@@ -72,6 +72,9 @@ class CellRules:
             to share one among the rules of a mesh; made here if not given.
     """
 
+    #: The rules do not depend on the integrand's degree (see :func:`xfem_contact.form`)
+    compression = False
+
     def __init__(
         self,
         mesh: dolfinx.mesh.Mesh,
