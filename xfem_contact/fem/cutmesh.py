@@ -363,7 +363,8 @@ class CutMesh:
     def dx(self, side: int, metadata: dict | None = None) -> ufl.Measure:
         """Measure of side ``-1`` (phi < 0) or ``+1`` (phi >= 0): ``expr * cut.dx(-1)``.
 
-        ``metadata`` (e.g. ``{"quadrature_degree": 4}``) applies to uncut cells.
+        ``metadata`` (e.g. ``{"quadrature_degree": 4}``) applies to uncut cells, and with
+        ``compression`` sets the degree of the cut cells' compressed rules.
         """
         if side not in (-1, 1):
             raise ValueError(f"side must be -1 or +1, got {side!r}")

@@ -7,9 +7,8 @@ with the standard rule, and a runtime integral (integrand times the marker) over
 the cells with per-cell rules. For a source whose ``compression`` is true, ``degree`` is
 the integrand's polynomial degree as FFCx takes it for a standard rule (the integral's
 ``quadrature_degree`` metadata, else UFL's estimate), so that it may give rules of that
-degree; ``None`` for the others. Forms are compiled once per
-signature with the :mod:`xfem_contact.codegen` back end and re-created cheaply for new
-rules.
+degree; ``None`` for the others. Forms are compiled once per signature with the
+:mod:`xfem_contact.codegen` back end and re-created cheaply for new rules.
 """
 
 from __future__ import annotations
