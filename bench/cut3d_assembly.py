@@ -8,9 +8,10 @@ term, assembled through the runtime rules (``cut.dx(-1) + cut.dx(+1)`` and
 assemblies into an existing matrix. Also printed: the cut (level set, classification and
 rules), the number of cut cells, the points per cut cell of the rules the cut form
 integrates with, the time of the form's rule compression (``CutMesh``'s ``compression``,
-on by default for P2 tetrahedra: sides and interface compressed to the integrands'
-degrees 2 and 4; 4 keeps the full rules), and the relative errors of the sphere's
-volume and area (how much the rules' degree buys)::
+on by default for P2 and affine P1 tetrahedra: the sides' rules of the stiffness's degree
+2; the interface mass's degree 4 keeps the full rules on P2 tetrahedra and gets the
+planar cut's degree-4 rules on P1 ones), and the relative errors of the sphere's volume
+and area (how much the rules' degree buys)::
 
     python bench/cut3d_assembly.py --sizes 16 --degrees 1 2 --quadrature-degrees 2 6
 

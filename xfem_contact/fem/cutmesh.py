@@ -14,24 +14,22 @@ import numpy.typing as npt
 import ufl
 
 from xfem_contact._deprecation import renamed_attribute
-from xfem_contact._timers import phase, seconds
 from xfem_contact.fem import cut_boundary
 from xfem_contact.fem.crack_cut import Crack
 from xfem_contact.fem.cut3d_state import cut_state_3d
 from xfem_contact.fem.cut_state import INTERFACE, SIDE_MINUS, SIDE_PLUS, CutState, cut_state
+from xfem_contact.fem.degree_rules import DegreeRules
 from xfem_contact.fem.interface_cells import trace_nullity
 from xfem_contact.geometry import cut
 from xfem_contact.geometry.crack_union import CrackUnion
 from xfem_contact.geometry.levelset import CellMaps, LevelSet, LevelSetCallable
 from xfem_contact.quadrature import rules as quadrature
 from xfem_contact.quadrature.cell_rules import CellRules, IntegrationPart, marker_space
-from xfem_contact.quadrature.compression import compress_rules, num_moments
 
 _SIDE_PARTS = {SIDE_MINUS: (4, 6), SIDE_PLUS: (5, 7)}  # side measure: uncut, cut cells parts
 _INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + index
 _BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
 _CUT_CELLS0 = 50  # measure ids of cut.dx_cut(name): _CUT_CELLS0 + index, _CUT_CELLS0 - 1 all
-_MAX_MOMENTS = 20  # the largest dim P_d that rules are compressed to
 _counter = itertools.count()
 CELLS = ("triangle", "quadrilateral", "tetrahedron", "hexahedron")
 """The cell kinds of the meshes :class:`CutMesh` cuts."""
@@ -86,8 +84,11 @@ class CutMesh:
             ``dim P_d`` of its points with positive weights and the same moments of degree
             ``d = min(p, quadrature_degree)``, for ``dim P_d <= 20`` (``d <= 3`` in 3D,
             ``d <= 5`` in 2D: the cost grows as ``(dim P_d)^3`` per rule; higher degrees
-            keep the full rules). Triangles and tetrahedra without a crack; default on
-            for P2 tetrahedra, off otherwise. :attr:`rules` stay the full rules. A
+            keep the full rules). On affine P1 tetrahedra the exact planar cut gives the
+            rules of degree ``d`` directly (Basix rules on its sub-tetrahedra and
+            triangles, the same moments, at any ``d``). Triangles and tetrahedra
+            without a crack; default on for P2 and affine P1 tetrahedra, off otherwise.
+            :attr:`rules` stay the full rules. A
             (measure, degree) is compressed once per cut, when a form first needs it,
             timed as DOLFINx's ``"xfem_contact: rule compression"``.
 
@@ -124,8 +125,11 @@ class CutMesh:
         if quadrature_degree < 1:
             raise ValueError(f"quadrature_degree must be >= 1, got {quadrature_degree}")
         simplex = kinds[0] in ("triangle", "tetrahedron")
+        # Affine P1 tetrahedra: the exact cut gives the rules of a lower degree directly
+        affine = mesh.geometry.cmaps[0].degree == 1
+        self._planar = kinds[0] == "tetrahedron" and degree == 1 and affine
         if compression is None:
-            compression = kinds[0] == "tetrahedron" and degree == 2
+            compression = kinds[0] == "tetrahedron" and (degree == 2 or self._planar)
         if compression and (not simplex or tangent is not None):
             raise ValueError(
                 f"compression: rules are compressed on triangles and tetrahedra without a "
@@ -182,6 +186,7 @@ class CutMesh:
             SIDE_PLUS: owned[state.cell_sides == 1],
         }
         self._cell_rules = {sid: self._rules(state.cut_cells, r) for sid, r in state.rules.items()}
+        self._degree_rules = DegreeRules(state, self.quadrature_degree, self._planar, _INTERFACE0)
         self._compressed: dict[tuple[int, int], CellRules] = {}
         self._interface_rules: dict[int, quadrature.RuleSet] = {}
         self._boundary_parts: dict[int, list[IntegrationPart]] = {}
@@ -469,20 +474,14 @@ class CutMesh:
 
     def _runtime_rules(self, sid: int, degree: int | None) -> CellRules:
         """The runtime rules of measure id ``sid`` (a side, the interface or a named
-        interface) for an integrand of polynomial ``degree``: compressed to degree
-        ``min(degree, quadrature_degree)`` with :attr:`compression`, once per state."""
+        interface) for an integrand of polynomial ``degree``: with :attr:`compression`,
+        those of :mod:`~xfem_contact.fem.degree_rules`, once per state."""
         if not self.compression or degree is None:
             return self._cell_rules[sid]
-        d = min(degree, self.quadrature_degree)
-        if num_moments(self.mesh.topology.dim, d) > _MAX_MOMENTS:
+        rules = self._degree_rules.rules(sid, degree)
+        if rules is None:
             return self._cell_rules[sid]
-        if (sid, d) not in self._compressed:
-            timer = phase("rule compression")
-            if sid >= _INTERFACE0:
-                full = self.interface_rules_of(self.interface_names[sid - _INTERFACE0])
-            else:
-                full = self.rules[sid]
-            rules = compress_rules(full, d, keep=2 * num_moments(self.mesh.topology.dim, d))
-            seconds(timer)
-            self._compressed[sid, d] = self._rules(self.cut_cells, rules)
-        return self._compressed[sid, d]
+        key = (sid, min(degree, self.quadrature_degree))
+        if key not in self._compressed:
+            self._compressed[key] = self._rules(self.cut_cells, rules)
+        return self._compressed[key]
