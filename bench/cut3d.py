@@ -18,7 +18,9 @@ nodal values):
 
     python bench/cut3d.py --sizes 4 8 16 32
 
-``--min-depth 1`` splits every sub-box of the P2 tetrahedra's hexahedra that the interface
+``--order k`` sets the Gauss points per interval of Saye's rules (P2 tetrahedra and
+hexahedra; default 4, as ``quadrature_degree = 6`` in ``CutMesh``). ``--min-depth 1``
+splits every sub-box of the P2 tetrahedra's hexahedra that the interface
 may cross before Saye's rules (:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`).
 
 The fuzz (``--fuzz N``) cuts ``N`` reference cells per kind by random spheres, ellipsoids,
@@ -133,6 +135,10 @@ MIN_DEPTH = 0
 """Forced box splits of the P2 tetrahedra's rules (``--min-depth``)."""
 
 
+ORDER = 4
+"""Gauss points per interval of Saye's rules (``--order``)."""
+
+
 def sphere_tets(n: int, degree: int = 4, shape: str = "sphere") -> tuple[float, float, int, float]:
     """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P1 level set)."""
     vertices = kuhn_mesh(n, PERTURB)
@@ -152,7 +158,7 @@ def sphere_tets(n: int, degree: int = 4, shape: str = "sphere") -> tuple[float, 
 
 
 def sphere_p2_tets(
-    n: int, order: int = 4, shape: str = "sphere"
+    n: int, order: int | None = None, shape: str = "sphere"
 ) -> tuple[float, float, int, float]:
     """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P2 level set,
     Saye's rules on its four hexahedra)."""
@@ -168,7 +174,7 @@ def sphere_p2_tets(
     side = classify_p2_tets(phi)
     cut = np.flatnonzero(side == 0)
     rules = p2_tet_cut_rules(
-        phi[cut], order, min_depth=MIN_DEPTH, jacobian=lambda rows, X: J[cut[rows]]
+        phi[cut], order or ORDER, min_depth=MIN_DEPTH, jacobian=lambda rows, X: J[cut[rows]]
     )
     elapsed = time.process_time() - start
     volume = detJ[side == -1].sum() / 6.0
@@ -178,7 +184,7 @@ def sphere_p2_tets(
 
 
 def sphere_hexes(
-    n: int, degree: int, order: int = 4, shape: str = "sphere"
+    n: int, degree: int, order: int | None = None, shape: str = "sphere"
 ) -> tuple[float, float, int, float]:
     """Volume, area, cut-cell count and CPU seconds on ``n^3`` hexahedra (Q``degree``)."""
     h = 1.0 / n
@@ -190,7 +196,7 @@ def sphere_hexes(
     side = classify_hexes(phi, degree)
     cut = np.flatnonzero(side == 0)
     J = np.broadcast_to(h * np.eye(3), (cut.size, 3, 3))
-    rules = hex_cut_rules(phi[cut], degree, order, jacobian=lambda rows, X: J[rows])
+    rules = hex_cut_rules(phi[cut], degree, order or ORDER, jacobian=lambda rows, X: J[rows])
     elapsed = time.process_time() - start
     volume = ((side == -1).sum() + rules.minus.weights.sum()) * h**3
     area = rules.interface.weights.sum() * h**3
@@ -324,9 +330,15 @@ def main() -> None:
         default=0,
         help="forced box splits of the P2 tetrahedra's rules (p2_tet_cut_rules min_depth)",
     )
+    parser.add_argument(
+        "--order",
+        type=int,
+        default=4,
+        help="Gauss points per interval of Saye's rules (P2 tetrahedra, hexahedra)",
+    )
     args = parser.parse_args()
-    global PERTURB, MIN_DEPTH
-    PERTURB, MIN_DEPTH = args.perturb, args.min_depth
+    global PERTURB, MIN_DEPTH, ORDER
+    PERTURB, MIN_DEPTH, ORDER = args.perturb, args.min_depth, args.order
     for kind in args.kinds if args.fuzz else []:
         start = time.perf_counter()
         counts = fuzz_cells(kind, args.fuzz)

@@ -27,8 +27,9 @@ from xfem_contact.fem.cut_state import (
 from xfem_contact.fem.interface_cells import cell_interfaces, without_slivers
 from xfem_contact.geometry.levelset import CellMaps, named_interfaces
 from xfem_contact.quadrature.cut3d_rules import classify_3d, cut_rules_3d
+from xfem_contact.quadrature.rules import RuleSet
 
-__all__ = ["cut_state_3d"]
+__all__ = ["cut_state_3d", "planar_cut_rules"]
 
 
 def cut_state_3d(
@@ -85,6 +86,27 @@ def cut_state_3d(
     return frozen_state(
         mesh.comm, previous, fields, side, cut_cells, rules, cell_interface, timings
     )
+
+
+def planar_cut_rules(state: CutState, quadrature_degree: int) -> dict[int, RuleSet]:
+    """The rules of a P1 tetrahedron cut ``state`` at another ``quadrature_degree``: the
+    exact planar cut again, with Basix rules of that degree on the sub-tetrahedra and
+    interface triangles, by measure id; the interface on the rows ``state`` keeps (no
+    slivers). Not collective.
+
+    On affine tetrahedra these have the moments of degree ``<= quadrature_degree`` of any
+    rules of the cut of a higher degree (both are exact), with fewer points.
+    """
+    maps, cells = state.maps, state.cut_cells
+    cut = cut_rules_3d(
+        "tetrahedron",
+        1,
+        maps.nodal_values(cells),
+        quadrature_degree,
+        lambda rows, X: maps.jacobian(cells[rows], X),
+    )
+    kept = np.diff(state.rules[INTERFACE].offsets) > 0
+    return {SIDE_MINUS: cut.minus, SIDE_PLUS: cut.plus, INTERFACE: cut.interface.select(kept)}
 
 
 def _collective(mesh: dolfinx.mesh.Mesh, step):

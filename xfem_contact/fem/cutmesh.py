@@ -18,6 +18,7 @@ from xfem_contact.fem import cut_boundary
 from xfem_contact.fem.crack_cut import Crack
 from xfem_contact.fem.cut3d_state import cut_state_3d
 from xfem_contact.fem.cut_state import INTERFACE, SIDE_MINUS, SIDE_PLUS, CutState, cut_state
+from xfem_contact.fem.degree_rules import DegreeRules
 from xfem_contact.fem.interface_cells import trace_nullity
 from xfem_contact.geometry import cut
 from xfem_contact.geometry.crack_union import CrackUnion
@@ -75,6 +76,21 @@ class CutMesh:
             (:mod:`xfem_contact.geometry.crack_union`, ``crack.union``), each with its
             own measure. 2D only.
         tip_points: Gauss points per direction of a tip cell's Duffy rules.
+        compression: Integrate the cut cells with compressed rules
+            (:func:`~xfem_contact.quadrature.compression.compress_rules`): for an integrand
+            of polynomial degree ``p`` (as FFCx takes it for the standard rule: the
+            measure's ``quadrature_degree`` metadata or UFL's estimate), each side and
+            interface rule of more than ``2 dim P_d`` points is replaced by at most
+            ``dim P_d`` of its points with positive weights and the same moments of degree
+            ``d = min(p, quadrature_degree)``, for ``dim P_d <= 20`` (``d <= 3`` in 3D,
+            ``d <= 5`` in 2D: the cost grows as ``(dim P_d)^3`` per rule; higher degrees
+            keep the full rules). On affine P1 tetrahedra the exact planar cut gives the
+            rules of degree ``d`` directly (Basix rules on its sub-tetrahedra and
+            triangles, the same moments, at any ``d``). Triangles and tetrahedra
+            without a crack; default on for P2 and affine P1 tetrahedra, off otherwise.
+            :attr:`rules` stay the full rules. A
+            (measure, degree) is compressed once per cut, when a form first needs it,
+            timed as DOLFINx's ``"xfem_contact: rule compression"``.
 
     Example:
         >>> cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 0.5)
@@ -89,6 +105,7 @@ class CutMesh:
         quadrature_degree: int | None = None,
         tangent: LevelSetCallable | dolfinx.fem.Function | None = None,
         tip_points: int = 24,
+        compression: bool | None = None,
     ):
         tdim = mesh.topology.dim
         kinds = [t.name for t in mesh.topology.entity_types[tdim]]
@@ -107,6 +124,20 @@ class CutMesh:
             quadrature_degree = 6 if tangent is None else 16
         if quadrature_degree < 1:
             raise ValueError(f"quadrature_degree must be >= 1, got {quadrature_degree}")
+        simplex = kinds[0] in ("triangle", "tetrahedron")
+        # Affine P1 tetrahedra: the exact cut gives the rules of a lower degree directly
+        affine = mesh.geometry.cmaps[0].degree == 1
+        self._planar = kinds[0] == "tetrahedron" and degree == 1 and affine
+        if compression is None:
+            compression = kinds[0] == "tetrahedron" and (degree == 2 or self._planar)
+        if compression and (not simplex or tangent is not None):
+            raise ValueError(
+                f"compression: rules are compressed on triangles and tetrahedra without a "
+                f"crack, not on {kinds[0]}s{' with a crack' if tangent is not None else ''}; "
+                "valid: compression=False"
+            )
+        #: Whether the cut cells are integrated with compressed rules (see the constructor)
+        self.compression = bool(compression)
         self.mesh = mesh
         self.degree = degree
         self.quadrature_degree = quadrature_degree
@@ -155,6 +186,8 @@ class CutMesh:
             SIDE_PLUS: owned[state.cell_sides == 1],
         }
         self._cell_rules = {sid: self._rules(state.cut_cells, r) for sid, r in state.rules.items()}
+        self._degree_rules = DegreeRules(state, self.quadrature_degree, self._planar, _INTERFACE0)
+        self._compressed: dict[tuple[int, int], CellRules] = {}
         self._interface_rules: dict[int, quadrature.RuleSet] = {}
         self._boundary_parts: dict[int, list[IntegrationPart]] = {}
 
@@ -335,7 +368,8 @@ class CutMesh:
     def dx(self, side: int, metadata: dict | None = None) -> ufl.Measure:
         """Measure of side ``-1`` (phi < 0) or ``+1`` (phi >= 0): ``expr * cut.dx(-1)``.
 
-        ``metadata`` (e.g. ``{"quadrature_degree": 4}``) applies to uncut cells.
+        ``metadata`` (e.g. ``{"quadrature_degree": 4}``) applies to uncut cells, and with
+        ``compression`` sets the degree of the cut cells' compressed rules.
         """
         if side not in (-1, 1):
             raise ValueError(f"side must be -1 or +1, got {side!r}")
@@ -407,8 +441,12 @@ class CutMesh:
             self._boundary_parts[slot] = cut_boundary.boundary_parts(self, side, facets)
         return self._boundary_parts[slot]
 
-    def integration_parts(self, subdomain_id: int) -> list[IntegrationPart]:
-        """Standard and runtime parts of a measure id (for :func:`xfem_contact.form`)."""
+    def integration_parts(
+        self, subdomain_id: int, degree: int | None = None
+    ) -> list[IntegrationPart]:
+        """Standard and runtime parts of a measure id (for :func:`xfem_contact.form`), the
+        runtime rules for an integrand of polynomial ``degree`` (``None``: the full
+        rules; see ``compression``)."""
         if subdomain_id >= _BOUNDARY0:
             return self._boundary(subdomain_id - _BOUNDARY0)
         if subdomain_id >= _CUT_CELLS0 - 1:
@@ -420,16 +458,30 @@ class CutMesh:
             if subdomain_id not in self._cell_rules:
                 r = self.interface_rules_of(self.interface_names[k])
                 self._cell_rules[k + _INTERFACE0] = self._rules(self.cut_cells, r)
-            return [IntegrationPart("cell", rules=self._cell_rules[subdomain_id])]
+            return [IntegrationPart("cell", rules=self._runtime_rules(subdomain_id, degree))]
         for side, (uncut, cut_part) in _SIDE_PARTS.items():  # a part of a side measure
             if subdomain_id == uncut:
                 return [IntegrationPart("cell", entities=self._standard[side])]
             if subdomain_id == cut_part:
-                return [IntegrationPart("cell", rules=self._cell_rules[side])]
+                return [IntegrationPart("cell", rules=self._runtime_rules(side, degree))]
         if subdomain_id not in self._cell_rules:
             raise ValueError(f"Unknown CutMesh measure id {subdomain_id}")
         parts = []
         if subdomain_id in self._standard:
             parts.append(IntegrationPart("cell", entities=self._standard[subdomain_id]))
-        parts.append(IntegrationPart("cell", rules=self._cell_rules[subdomain_id]))
+        parts.append(IntegrationPart("cell", rules=self._runtime_rules(subdomain_id, degree)))
         return parts
+
+    def _runtime_rules(self, sid: int, degree: int | None) -> CellRules:
+        """The runtime rules of measure id ``sid`` (a side, the interface or a named
+        interface) for an integrand of polynomial ``degree``: with :attr:`compression`,
+        those of :mod:`~xfem_contact.fem.degree_rules`, once per state."""
+        if not self.compression or degree is None:
+            return self._cell_rules[sid]
+        rules = self._degree_rules.rules(sid, degree)
+        if rules is None:
+            return self._cell_rules[sid]
+        key = (sid, min(degree, self.quadrature_degree))
+        if key not in self._compressed:
+            self._compressed[key] = self._rules(self.cut_cells, rules)
+        return self._compressed[key]

@@ -1,10 +1,13 @@
 """Turn UFL forms with cut-cell measures into DOLFINx forms.
 
-Measures whose ``subdomain_data`` provides ``integration_parts(subdomain_id)``
+Measures whose ``subdomain_data`` provides ``integration_parts(subdomain_id, degree)``
 (:class:`~xfem_contact.quadrature.cell_rules.CellRules`, :class:`~xfem_contact.fem.cutmesh.CutMesh`)
 are rewritten into a standard cell integral over the cells their part covers
 with the standard rule, and a runtime integral (integrand times the marker) over
-the cells with per-cell rules. Forms are compiled once per signature with the
+the cells with per-cell rules. For a source whose ``compression`` is true, ``degree`` is
+the integrand's polynomial degree as FFCx takes it for a standard rule (the integral's
+``quadrature_degree`` metadata, else UFL's estimate), so that it may give rules of that
+degree; ``None`` for the others. Forms are compiled once per signature with the
 :mod:`xfem_contact.codegen` back end and re-created cheaply for new rules.
 """
 
@@ -19,6 +22,9 @@ import numpy as np
 import ufl
 from dolfinx.fem import IntegralType
 from dolfinx.fem.forms import CompiledForm, compile_form, create_form, get_integration_domains
+from ufl.algorithms import estimate_total_polynomial_degree
+from ufl.algorithms.apply_algebra_lowering import apply_algebra_lowering
+from ufl.algorithms.apply_derivatives import apply_derivatives
 
 from xfem_contact.codegen import LANGUAGE, kernel_store, runtime_abi
 from xfem_contact.codegen.compat import analyze_ufl_objects, compute_ir, get_options
@@ -58,9 +64,23 @@ def _is_cut_source(data) -> bool:
     return hasattr(data, "integration_parts")
 
 
-def _source_key(data, integral) -> tuple[str, int, int]:
-    """Deterministic order of the cut-cell measures of a form (so of its signature)."""
-    return (type(data).__name__, data.id, integral.subdomain_id())
+def _source_key(data, integral) -> tuple[str, int, int, int]:
+    """Deterministic order of the cut-cell measures of a form (so of its signature), one
+    per integrand degree for a source whose rules depend on it (its ``compression``;
+    -1 for the others)."""
+    degree = integrand_degree(integral) if data.compression else -1
+    return (type(data).__name__, data.id, integral.subdomain_id(), degree)
+
+
+def integrand_degree(integral: ufl.Integral) -> int:
+    """The polynomial degree FFCx takes for ``integral``'s standard rule: its
+    ``quadrature_degree`` metadata, else UFL's estimate of the integrand's degree (after
+    algebra lowering and derivatives, as FFCx estimates it)."""
+    degree = integral.metadata().get("quadrature_degree", "auto")
+    if degree not in ("auto", None, -1):
+        return int(degree)
+    integrand = apply_derivatives(apply_algebra_lowering(integral.integrand()))
+    return int(estimate_total_polynomial_degree(integrand))
 
 
 def _integral(
@@ -94,18 +114,24 @@ def _rewrite(ufl_form: ufl.Form) -> _Rewrite:
                     f"carrying other subdomain data ({type(data).__name__}); use the plain "
                     "measure (no subdomain data) or the cut measures"
                 )
-    keys = sorted({_source_key(i.subdomain_data(), i) for i in ours})
+    key_of = {id(i): _source_key(i.subdomain_data(), i) for i in ours}
+    keys = sorted(set(key_of.values()))
     parts = {}
     for key in keys:
-        itg = next(i for i in ours if _source_key(i.subdomain_data(), i) == key)
-        parts[key] = list(itg.subdomain_data().integration_parts(itg.subdomain_id()))
-    ids, next_standard, next_runtime = {}, _STANDARD_ID0, _RUNTIME_ID0
+        itg = next(i for i in ours if key_of[id(i)] == key)
+        degree = None if key[3] < 0 else key[3]
+        parts[key] = list(itg.subdomain_data().integration_parts(itg.subdomain_id(), degree))
+    # One id per part; the degrees of a measure whose parts are the same share them.
+    ids, shared, next_standard, next_runtime = {}, {}, _STANDARD_ID0, _RUNTIME_ID0
     for key in keys:
         for j, part in enumerate(parts[key]):
-            if part.rules is None:
-                ids[key, j], next_standard = next_standard, next_standard + 1
-            else:
-                ids[key, j], next_runtime = next_runtime, next_runtime + 1
+            same = (key[:3], j, None if part.rules is None else part.rules.id)
+            if same not in shared:
+                if part.rules is None:
+                    shared[same], next_standard = next_standard, next_standard + 1
+                else:
+                    shared[same], next_runtime = next_runtime, next_runtime + 1
+            ids[key, j] = shared[same]
 
     integrals, domains, rules = [], {}, {}
     for itg in ufl_form.integrals():
@@ -113,7 +139,7 @@ def _rewrite(ufl_form: ufl.Form) -> _Rewrite:
         if not _is_cut_source(data):
             integrals.append(itg)
             continue
-        key = _source_key(data, itg)
+        key = key_of[id(itg)]
         for j, part in enumerate(parts[key]):
             sid = ids[key, j]
             if part.rules is None:

@@ -57,6 +57,11 @@ class TipZone:
         """The cut's id (orders the measures of a form)."""
         return self.cut.id
 
+    @property
+    def compression(self) -> bool:
+        """Whether the cut's rules depend on the integrand's degree (its ``compression``)."""
+        return self.cut.compression
+
     def dx(self, side: int, metadata: dict | None = None) -> ufl.Measure:
         """As :meth:`CutMesh.dx <xfem_contact.fem.cutmesh.CutMesh.dx>`: ``metadata``
         applies to the uncut cells outside the zone."""
@@ -67,11 +72,13 @@ class TipZone:
         <xfem_contact.fem.cutmesh.CutMesh.side_measure_ids>`."""
         return self.cut.side_measure_ids(subdomain_id)
 
-    def integration_parts(self, subdomain_id: int) -> list[IntegrationPart]:
+    def integration_parts(
+        self, subdomain_id: int, degree: int | None = None
+    ) -> list[IntegrationPart]:
         """The cut's parts, each standard cell part divided into the zone's cells (with
         :attr:`metadata`) and the others. Every process returns the same parts."""
         parts = []
-        for part in self.cut.integration_parts(subdomain_id):
+        for part in self.cut.integration_parts(subdomain_id, degree):
             if part.rules is not None or part.integral_type != "cell":
                 parts.append(part)
                 continue

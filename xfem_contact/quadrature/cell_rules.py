@@ -72,6 +72,9 @@ class CellRules:
             to share one among the rules of a mesh; made here if not given.
     """
 
+    #: The rules do not depend on the integrand's degree (see :func:`xfem_contact.form`)
+    compression = False
+
     def __init__(
         self,
         mesh: dolfinx.mesh.Mesh,
@@ -154,6 +157,7 @@ class CellRules:
         """A UFL cell measure that integrates with these rules (``expr * rules.measure()``)."""
         return ufl.Measure("dx", domain=self.mesh, subdomain_data=self, subdomain_id=0, **kwargs)
 
-    def integration_parts(self, subdomain_id: int) -> list:
-        """The one part of :meth:`measure`: these runtime rules (for :func:`xfem_contact.form`)."""
+    def integration_parts(self, subdomain_id: int, degree: int | None = None) -> list:
+        """The one part of :meth:`measure`: these runtime rules, whatever the integrand's
+        polynomial ``degree`` (for :func:`xfem_contact.form`)."""
         return [IntegrationPart("cell", rules=self)]
