@@ -11,7 +11,7 @@ positive definite; ``--mumps icntl_7=4`` sets a MUMPS control, so that
 ``bench/scaling.py`` gives it the factorisation and controls xfem-contact's solver uses) and
 the displacement written as VTX, as the demo does (``--out ''``: not written).
 ``--mesh cube``: the unit cube, ``--n`` cells per edge (``--cell tetrahedron`` or
-``hexahedron``), the triaxial pressures of the sphere case
+``hexahedron``), the material (E = 100 Pa, nu = 0.3) and triaxial pressures of the sphere case
 (``xfem_contact.cases.solid.sphere_problem`` without its sphere: 1, 2, 3 Pa on the
 faces normal to x, y, z) and its seven point constraints. ``--factor gamg``: CG +
 algebraic multigrid with the rigid modes (3 in 2D, 6 in 3D). Prints one JSON line
@@ -45,8 +45,10 @@ E, NU = 100e6, 0.0
 OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 
 
-#: The sphere case's principal stresses (Pa) along x, y, z (``TRIAXIAL`` of
-#: ``xfem_contact.cases.solid``, not imported: the package stays out of this process)
+#: The sphere case's material (Pa, -) and principal stresses (Pa) along x, y, z
+#: (``SOLID`` and ``TRIAXIAL`` of ``xfem_contact.cases.solid``, not imported: the
+#: package stays out of this process)
+SOLID_E, SOLID_NU = 100.0, 0.3
 TRIAXIAL = (-1.0, -2.0, -3.0)
 #: Its point constraints: ``u_i = 0`` at the point (``sphere_problem``'s)
 HELD_3D = (
@@ -78,13 +80,13 @@ def rigid_modes(V: dolfinx.fem.FunctionSpace) -> PETSc.NullSpace:
     return PETSc.NullSpace().create(vectors=[v.petsc_vec for v in vectors], comm=V.mesh.comm)
 
 
-def _elasticity(mesh, degree: int):
-    """The space and the bilinear form of linear elasticity (E, NU) on ``mesh``."""
+def _elasticity(mesh, degree: int, young: float = E, nu: float = NU):
+    """The space and the bilinear form of linear elasticity (Pa, -) on ``mesh``."""
     gdim = mesh.geometry.dim
     V = dolfinx.fem.functionspace(
         mesh, basix.ufl.element("Lagrange", mesh.basix_cell(), degree, shape=(gdim,))
     )
-    mu, lmbda = E / (2 * (1 + NU)), E * NU / ((1 + NU) * (1 - 2 * NU))
+    mu, lmbda = young / (2 * (1 + nu)), young * nu / ((1 + nu) * (1 - 2 * nu))
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
 
     def sigma(w):
@@ -117,7 +119,14 @@ def square(comm, n: int, degree: int, cell: str):
 def cube(comm, n: int, degree: int, cell: str):
     """The sphere case's cube without its sphere: ``(V, a, L, bcs)``. Collective."""
     mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
-    V, a, v = _elasticity(mesh, degree)
+    return triaxial(mesh, degree)
+
+
+def triaxial(mesh, degree: int):
+    """The sphere case's loads on a mesh of the unit cube (one material, SOLID_E and
+    SOLID_NU), whose nodes include the points of :data:`HELD_3D`: ``(V, a, L, bcs)``.
+    Collective."""
+    V, a, v = _elasticity(mesh, degree, SOLID_E, SOLID_NU)
     fdim = mesh.topology.dim - 1
     facets = [
         dolfinx.mesh.locate_entities_boundary(
@@ -166,8 +175,9 @@ def annulus(comm, n: int, degree: int):
 
 
 def solve(setup, out: pathlib.Path | None, mumps: dict[str, int], factor: str = "lu") -> dict:
-    """Solve the problem ``setup()`` gives and write; returns the dofs and the wall
-    time of each phase (s); ``out`` None: nothing written. Collective."""
+    """Solve the problem ``setup()`` gives and write; returns the dofs, the wall time of
+    each phase (s) and the Krylov iterations, and the displacement; ``out`` None:
+    nothing written. Collective."""
     comm = MPI.COMM_WORLD
     times = {}
     start = time.perf_counter()
@@ -213,7 +223,7 @@ def solve(setup, out: pathlib.Path | None, mumps: dict[str, int], factor: str = 
     for obj in (ksp, A, b):
         obj.destroy()
     dofs = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
-    return {"dofs": dofs, "timings": times, "krylov": iterations}
+    return {"dofs": dofs, "timings": times, "krylov": iterations}, uh
 
 
 def main():
@@ -252,7 +262,7 @@ def main():
     else:
         setup = functools.partial(annulus, comm, args.n, args.degree)
     out = pathlib.Path(args.out) if args.out else None
-    result = solve(setup, out, mumps, args.factor)
+    result, _ = solve(setup, out, mumps, args.factor)
     if MPI.COMM_WORLD.rank == 0:
         print(json.dumps(result))
 
