@@ -18,8 +18,9 @@ ranks: the speed-up of each preset against plain DOLFINx's.
 Writes ``bench/results/scale3d.{json,md}`` (``--name``: another stem).
 
 Run: ``python bench/scale3d.py [--sizes 4 8] [--ranks 1] [--direct-max 8]`` (``make
-bench``); the measured study: ``--sizes 8 16 24 36 --direct-max 12``, and
-``--sizes 16 --ranks 1 2 --direct-max 16 --name scale3d_ranks``.
+bench``); the measured studies: ``--sizes 8 16 24 --direct-max 12 --name
+scale3d_large``, ``--sizes 34 --solvers plain iterative --name scale3d_1m`` (over a
+million dofs) and ``--sizes 12 --ranks 1 2 --direct-max 12 --name scale3d_ranks``.
 """
 
 import argparse
