@@ -412,7 +412,8 @@ def _bench_script(result: pathlib.Path) -> pathlib.Path:
 
 def bench_page(result: pathlib.Path) -> str:
     """The page of one benchmark result ``bench/results/NAME.md``: the bench script's
-    docstring (its first paragraph), the command, the table and the pictures. The
+    docstring (its first paragraph), the command, the table and the pictures
+    (``NAME.png``, ``NAME_*.png``). The
     script is ``bench/NAME.py`` or, for a second result of one script (``--name``),
     the one whose name ``NAME`` starts with (``iterative_large``: ``iterative.py``)."""
     script = _bench_script(result)
@@ -433,7 +434,11 @@ def bench_page(result: pathlib.Path) -> str:
         "```",
         "",
     ]
-    for picture in sorted(result.parent.glob(f"{result.stem}*.png")):
+    pictures = [
+        *result.parent.glob(f"{result.stem}.png"),
+        *result.parent.glob(f"{result.stem}_*.png"),
+    ]
+    for picture in sorted(pictures):
         lines += [f"![{picture.stem}](../../bench/results/{picture.name})", ""]
     return "\n".join(lines)
 

@@ -1,8 +1,8 @@
 """The fast paths of the solvers give what the slow ones gave.
 
 - :func:`xfem_contact.fem.subspaces.collapse` equals DOLFINx's ``collapse``;
-- a form assembled straight into the reduced numbering (on 2 x 2 blocks where the
-  unknowns pair up) equals ``R^T A R`` by PtAP,
+- a form assembled straight into the reduced numbering (on node blocks where the
+  unknowns group by node) equals ``R^T A R`` by PtAP,
   bit for bit, and a prolongation in ``R`` takes the PtAP path;
 - the uncut cells assembled field by field on the fields' own spaces
   (:func:`xfem_contact.fem.field_blocks.uncut_field_blocks`) give the same matrix, a term
@@ -27,6 +27,7 @@ from petsc4py import PETSc
 from ufl.algorithms import expand_derivatives
 
 from xfem_contact.cases.paper import inclusion_problem
+from xfem_contact.cases.solid import sphere_problem
 from xfem_contact.codegen import kernel_store
 from xfem_contact.fem import forms
 from xfem_contact.fem.field_blocks import _coupled, uncut_field_blocks
@@ -110,12 +111,18 @@ def test_direct_assembly_equals_ptap(problem):
     reduced.destroy()
 
 
-@pytest.mark.parametrize("law, block_size", [("coulomb", 2), ("frictionless", 1)])
-def test_pattern_on_pairs_only_where_the_unknowns_pair_up(law, block_size):
-    """Vector fields give 2 x 2 blocks, a scalar multiplier does not; either way, and
-    with the blocks switched off, the matrix is PtAP's."""
+@pytest.mark.parametrize(
+    "law, gdim, block_size",
+    [("coulomb", 2, 2), ("frictionless", 2, 1), ("sticking", 3, 3), ("frictionless", 3, 1)],
+)
+def test_pattern_on_node_blocks_only_where_the_unknowns_group(law, gdim, block_size):
+    """Vector fields give node blocks (2 x 2, 3 x 3 in 3D), a scalar multiplier does
+    not; either way, and with the blocks switched off, the matrix is PtAP's."""
     options = {"friction": 0.3} if law == "coulomb" else {}
-    problem = inclusion_problem(8, 2, law, **options)
+    if gdim == 2:
+        problem = inclusion_problem(8, 2, law, **options)
+    else:
+        problem = sphere_problem(4, 2, law)
     J, R = _jacobian(problem), problem.prolongation()
     full = dolfinx.fem.petsc.assemble_matrix(J, bcs=problem.loads.bcs)
     full.assemble()

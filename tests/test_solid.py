@@ -359,7 +359,9 @@ def test_restriction_is_refused_in_3d():
 
 def test_iterative_preset_in_3d_gives_the_direct_answer():
     """The iterative preset (GMRES, band multigrid with GAMG on six rigid modes per
-    side) on the sticking sphere: the direct solver's fields."""
+    side) on the sticking sphere: the direct solver's fields. The Jacobian and the
+    coarse level are stored in 3 x 3 node blocks (GAMG aggregates nodes), the band
+    factored LDL^T (the Jacobian is symmetric)."""
     direct = sphere_problem(4, 2, "sticking")
     direct.solve()
     iterative = sphere_problem(4, 2, "sticking")
@@ -367,3 +369,20 @@ def test_iterative_preset_in_3d_gives_the_direct_answer():
     iterative.solve()
     scale = np.abs(direct.w.x.array).max()
     assert np.abs(iterative.w.x.array - direct.w.x.array).max() < 1e-8 * scale
+    context = iterative.newton.snes.getKSP().getPC().getPythonContext()
+    assert iterative.newton.J_r.getBlockSize() == context.A_c.getBlockSize() == 3
+    assert context.ksp_band.getPC().getType() == "cholesky"
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("degree", [1, 2])
+def test_sphere_iterative_parallel_equals_serial(degree):
+    """The iterative preset on 1 and 2 ranks: the same fields (gathered by position)."""
+    fields = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        problem = sphere_problem(6, degree, "sticking", comm=comm)
+        problem.petsc_options = preset("iterative")
+        problem.solve()
+        fields.append(gathered_fields(problem))
+    differences = max_relative_difference(*fields)
+    assert all(v <= 1e-10 for v in differences.values()), differences

@@ -109,6 +109,8 @@ def test_every_preset_is_a_row_with_what_selects_it():
         (Facts({"pc_type": "python"}, crack_tip=True), {"crack"}),
         (Facts({}, crack_tip=True, couplings=True), {"crack", "reused_lu"}),
         (Facts({"ksp_type": "preonly"}, couplings=True), set()),
+        (Facts(preset("iterative"), symmetric=True), {"symmetric_band"}),
+        (Facts(preset("iterative"), symmetric=False), set()),
     ],
 )
 def test_problem_options_add_the_rows_that_apply(facts, added):

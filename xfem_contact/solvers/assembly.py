@@ -103,30 +103,38 @@ def _coupled_cells(a: dolfinx.fem.Form) -> tuple[npt.NDArray, npt.NDArray]:
     return np.unique(np.concatenate(cells)), np.unique(np.concatenate(pairs), axis=0)
 
 
-def _pairs(chosen: Selection, fields: list, comm) -> dolfinx.cpp.common.IndexMap | None:
-    """The index map of the reduced unknowns taken two by two (the two components of a
-    node), if every field (``fields``: the cell dofmaps of the fields of the mixed
-    space ``W``) has two components and the unknowns pair up on
-    every process (owned and ghost ones alike: even counts, ghost pairs ``2m, 2m + 1``),
-    else ``None`` (e.g. a scalar multiplier: frictionless contact). Collective.
+def _node_blocks(
+    chosen: Selection, fields: list, bs: int, comm
+) -> dolfinx.cpp.common.IndexMap | None:
+    """The index map of the reduced unknowns taken ``bs`` by ``bs`` (the components of a
+    node: ``bs`` the mesh's dimension), if every field (``fields``: the cell dofmaps of
+    the fields of the mixed space ``W``) has ``bs`` components and the unknowns group up
+    on every process (owned and ghost ones alike: counts divisible by ``bs``, ghost
+    groups ``bs m, ..., bs m + bs - 1``), else ``None`` (e.g. a scalar multiplier:
+    frictionless contact). Collective.
 
-    A node's two components are consecutive in ``W`` and active together, so they are
+    A node's components are consecutive in ``W`` and active together, so they are
     consecutive in the reduced numbering too."""
     imap = chosen.index_map
     ghosts, owners = imap.ghosts, imap.owners
     first = imap.local_range[0]
-    paired = (
-        all(d.shape[1] % 2 == 0 and np.all(d[:, 1::2] == d[:, 0::2] + 1) for d in fields)
-        and imap.size_local % 2 == 0
-        and first % 2 == 0
-        and ghosts.size % 2 == 0
-        and np.all(ghosts[0::2] % 2 == 0)
-        and np.all(ghosts[1::2] == ghosts[0::2] + 1)
+    components = range(1, bs)
+    grouped = (
+        bs > 1
+        and all(
+            d.shape[1] % bs == 0 and all(np.all(d[:, k::bs] == d[:, 0::bs] + k) for k in components)
+            for d in fields
+        )
+        and imap.size_local % bs == 0
+        and first % bs == 0
+        and ghosts.size % bs == 0
+        and np.all(ghosts[0::bs] % bs == 0)
+        and all(np.all(ghosts[k::bs] == ghosts[0::bs] + k) for k in components)
     )
-    if not comm.allreduce(bool(paired), op=MPI.LAND):
+    if not comm.allreduce(bool(grouped), op=MPI.LAND):
         return None
     return dolfinx.cpp.common.IndexMap(
-        comm, imap.size_local // 2, ghosts[0::2] // 2, owners[0::2], _TAG + 1
+        comm, imap.size_local // bs, ghosts[0::bs] // bs, owners[0::bs], _TAG + 1
     )
 
 
@@ -143,17 +151,18 @@ def reduced_matrix(
     ``W``'s local dof numbers (the numbering :func:`dolfinx.fem.petsc.assemble_matrix`
     inserts with). Collective.
 
-    With ``blocks`` and unknowns that pair up (:func:`_pairs`) the pattern is built on
-    the pairs, as DOLFINx builds a vector space's (a quarter of the entries to sort),
-    and the matrix has block size 2. With ``fill`` the whole pattern is stored
-    (:func:`_fill_pattern`)."""
+    With ``blocks`` and unknowns that group by node (:func:`_node_blocks`) the pattern is
+    built on the nodes, as DOLFINx builds a vector space's (a quarter of the entries to
+    sort in 2D, a ninth in 3D), and the matrix has the mesh's dimension as block size.
+    With ``fill`` the whole pattern is stored (:func:`_fill_pattern`)."""
     comm = a.mesh.comm  # lives as long as the mesh (the index map's own does not)
     W = a.function_spaces[0]
     dofmap = W.dofmap.map()  # (num_cells, dofs per cell)
     fields = [W.sub([i]).dofmap.map() for i in range(W.element.num_sub_elements)] or [dofmap]
-    pairs_map = _pairs(chosen, fields, comm) if blocks else None
-    bs = 1 if pairs_map is None else 2
-    index_map = chosen.index_map if pairs_map is None else pairs_map
+    gdim = a.mesh.geometry.dim
+    nodes_map = _node_blocks(chosen, fields, gdim, comm) if blocks else None
+    bs = 1 if nodes_map is None else gdim
+    index_map = chosen.index_map if nodes_map is None else nodes_map
     pattern = dolfinx.cpp.la.SparsityPattern(comm, [index_map] * 2, [bs, bs])
     cells, pairs = _coupled_cells(a)
     block = chosen.local // bs if bs > 1 else chosen.local  # -1 stays negative
@@ -213,15 +222,21 @@ def _block_lgmap(
 ) -> tuple[PETSc.LGMap, bool]:
     """The local-to-global map of a field's own space into the reduced matrix (block
     size ``bs``): its dofs' reduced columns (``columns`` of their ``parent`` dofs), -1
-    for inactive dofs. Made of 2 x 2 blocks when the field and the matrix pair up at
-    every node (then ``True``), else dof by dof. Local."""
+    for inactive dofs. Made of ``bs`` x ``bs`` blocks when the field and the matrix
+    group up at every node (then ``True``), else dof by dof. Local."""
     cols = columns[parent]
-    if bs == 2 and cols.size % 2 == 0:
-        first, second = cols[0::2], cols[1::2]
-        idle = (first < 0) & (second < 0)
-        if np.all(idle | ((first >= 0) & (first % 2 == 0) & (second == first + 1))):
-            blocks = np.where(idle, -1, first // 2).astype(PETSc.IntType)
-            return PETSc.LGMap().create(blocks, bsize=2, comm=comm), True
+    if bs > 1 and cols.size % bs == 0:
+        nodes = cols.reshape(-1, bs)
+        first = nodes[:, 0]
+        idle = np.all(nodes < 0, axis=1)
+        whole = (
+            (first >= 0)
+            & (first % bs == 0)
+            & np.all(nodes == first[:, None] + np.arange(bs), axis=1)
+        )
+        if np.all(idle | whole):
+            blocks = np.where(idle, -1, first // bs).astype(PETSc.IntType)
+            return PETSc.LGMap().create(blocks, bsize=bs, comm=comm), True
     return PETSc.LGMap().create(cols.astype(PETSc.IntType), comm=comm), False
 
 
@@ -254,7 +269,7 @@ def _rows(cell_rows: np.ndarray):
 def _assemble_unrolled(A: PETSc.Mat, a: dolfinx.fem.Form, bcs: list) -> None:
     """:func:`dolfinx.fem.petsc.assemble_matrix` of a form on one space (unit diagonal
     at the Dirichlet dofs) inserting dof by dof (``MatSetValuesLocal``), also into a
-    matrix of block size 2: DOLFINx inserts with ``MatSetValuesBlockedLocal``, which
+    matrix of block size > 1: DOLFINx inserts with ``MatSetValuesBlockedLocal``, which
     reads the mixed space's dof numbers as block numbers there. Collective."""
     constants = dolfinx.fem.pack_constants(a)
     coefficients = dolfinx.fem.pack_coefficients(a)
@@ -288,7 +303,7 @@ class ReducedMatrix:
             as :func:`dolfinx.fem.petsc.assemble_matrix` applies them).
         R: Prolongation, global shape ``(dim W, n_reduced)``. Not modified;
             kept for the ``PtAP`` path.
-        blocks: Allow a pattern (and matrix) of 2 x 2 blocks (:func:`reduced_matrix`);
+        blocks: Allow a pattern (and matrix) of node blocks (:func:`reduced_matrix`);
             off for matrices that others add to with a scalar pattern (``MatAXPY``).
         field_blocks: Forms on a field's own space to add, each with the parent dof
             in ``W`` of every local dof of that space and whether it is constant (no

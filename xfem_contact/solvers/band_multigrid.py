@@ -28,7 +28,8 @@ are the band's rows, the multipliers' rows ``B`` and the coarse level.
 Sub-solver options live under the PC's prefix plus ``bmg_u_`` (the PCMG, or GAMG for
 degree 1) and ``bmg_band_`` (the band's LU); the rows ``band_u``, ``band_u_degree1`` and
 ``band`` of :data:`~xfem_contact.solvers.options.PRESETS` are the defaults, which options
-in the database override.
+in the database override; a symmetric problem's band is factored LDL^T (the row
+``symmetric_band``), its matrix checked symmetric first.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ from petsc4py import PETSc
 
 from xfem_contact.solvers.options import PRESETS
 from xfem_contact.solvers.scaling import gather
+from xfem_contact.solvers.symmetry import mark_symmetric
 
 
 class BandMultigrid:
@@ -90,6 +92,8 @@ class BandMultigrid:
         for ksp, row in ((self.ksp_band, PRESETS["band"]), (self.ksp_u, self.u_preset)):
             with _defaults(ksp.getOptionsPrefix(), row.options):
                 ksp.setFromOptions()
+                if ksp.getPC().getType() == PETSc.PC.Type.CHOLESKY:
+                    mark_symmetric(ksp.getOperators()[0])  # checked, then flagged
                 ksp.setUp()
 
     def apply(self, pc: PETSc.PC, r: PETSc.Vec, x: PETSc.Vec) -> None:
@@ -154,7 +158,7 @@ class BandMultigrid:
             self.u_preset = PRESETS["band_u_degree1"]
             self.A = J.createSubMatrix(self.u, self.u)
             self.A.axpy(1.0, _gram(self.B), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            self.A.setBlockSize(2)
+            self.A.setBlockSize(self.u.getBlockSize())
             self.A.setNearNullSpace(space)
             self.ksp_u.setOperators(self.A)
             self._objects.append(self.A)
@@ -170,7 +174,7 @@ class BandMultigrid:
             self.A_c = J.PtAP(self.P_full)
             BP = self.B.matMult(self.P_full)
             self.A_c.axpy(1.0, _gram(BP), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            self.A_c.setBlockSize(2)
+            self.A_c.setBlockSize(self.u.getBlockSize())
             coarse_modes = _orthonormal([_restricted(m, coarse) for m in self._modes])
             coarse_space = PETSc.NullSpace().create(vectors=coarse_modes, comm=comm)
             self.A_c.setNearNullSpace(coarse_space)

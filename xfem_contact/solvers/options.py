@@ -118,6 +118,14 @@ def uses_fieldsplit(options: dict) -> bool:
     return options.get("pc_type") in FIELDSPLIT_PRECONDITIONERS
 
 
+def uses_band_multigrid(options: dict) -> bool:
+    """Whether ``options`` choose the band multigrid
+    (:class:`xfem_contact.solvers.band_multigrid.BandMultigrid`). Not collective."""
+    return options.get("pc_type") == "python" and str(options.get("pc_python_type", "")).endswith(
+        "band_multigrid.BandMultigrid"
+    )
+
+
 class Facts(typing.NamedTuple):
     """What a problem knows of itself when its options are chosen (:func:`problem_options`).
 
@@ -190,6 +198,13 @@ PRESETS: dict[str, Preset] = {
         "MUMPS LDL^T: about half the factor entries and flops of the LU "
         "(xfem_contact.solvers.symmetry checks every matrix first)",
         lambda facts: facts.symmetric and "pc_type" not in facts.options,
+    ),
+    "symmetric_band": Preset(
+        {"bmg_band_pc_type": "cholesky"},
+        "a symmetric Jacobian (as for 'symmetric') preconditioned by the band multigrid",
+        "MUMPS LDL^T of the band: about half the memory of its LU "
+        "(xfem_contact.solvers.symmetry checks the band's matrix first)",
+        lambda facts: facts.symmetric and uses_band_multigrid(facts.options),
     ),
     "crack": Preset(
         {"mat_mumps_icntl_14": 100},
