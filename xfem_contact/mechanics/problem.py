@@ -63,6 +63,9 @@ class Problem:
             the default's, 0 for a crack (it spoils the tip's field: energy error x3).
         min_support_fraction: See :class:`EnrichedSpace`. Default: every dof with the
             ghost penalty (it extends the field), else those with support on their side.
+        aggregation: Cell aggregation (see :class:`EnrichedSpace`): the side volume
+            fraction below which a cut cell's dofs are extended from a root cell; None:
+            off. The Dirichlet dofs stay unknowns.
         kinematics: ``"small"`` (linear elasticity, small sliding) or ``"large"`` (Saint
             Venant-Kirchhoff bulk, contact laws in large sliding: the slave/master hybrid
             element of :mod:`xfem_contact.mechanics.sliding`).
@@ -90,6 +93,7 @@ class Problem:
         *,
         ghost_penalty: float | None = None,
         min_support_fraction: float | None = DEFAULT.min_support_fraction,
+        aggregation: float | None = DEFAULT.aggregation,
         kinematics: str = DEFAULT.kinematics,
         slave: int = DEFAULT.slave,
         pairing: str = DEFAULT.pairing,
@@ -122,6 +126,7 @@ class Problem:
             multipliers=[(c, n) for c, n in multipliers if c > 0],
             min_support_fraction=min_support_fraction,
             tip_radius=tip_radius,
+            aggregation=aggregation,
         )
         check_ghosts(self.mesh)
         #: Loads, supports and Dirichlet data (``loads.bcs``), and the pseudo-time
@@ -305,7 +310,15 @@ class Problem:
             for name, law in self.laws.items()
             if (p := law.prolongation(self.contexts[name], self.space)) is not None
         ]
-        return prolongation_matrix(self.space, combine_prolongations(prolongations, self.mesh.comm))
+        fixed = None
+        if self.space.aggregation is not None:
+            fixed = np.concatenate(
+                [np.zeros(0, np.int64)]
+                + [bc.dof_indices()[0].astype(np.int64) for bc in self.loads.bcs]
+            )
+        return prolongation_matrix(
+            self.space, combine_prolongations(prolongations, self.mesh.comm), fixed
+        )
 
     def restriction(self):
         """Deprecated name of :meth:`prolongation` (it returns ``R`` with ``x = R y``)."""
