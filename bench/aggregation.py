@@ -14,8 +14,15 @@ Condition numbers: the extreme eigenvalues of the symmetric scaled matrix (dense
 1500 unknowns, else SLEPc: Krylov-Schur, shift-and-invert at 0 with an LU for the least
 in modulus).
 
-Run: ``python bench/aggregation.py [--circles 30] [--sizes 8 16 32]``; writes
-``bench/results/aggregation.{json,md}``.
+Part ``accuracy``: the contact pressure's relative L2 error of paper case 2 (sticking,
+P2 on quadrilaterals and triangles, n = 10, 20, 40) and case 3 (the annulus, alpha = 0,
+P2 on curved Q2 cells, 4 x 16, 8 x 32, 16 x 64) with the default treatment (ghost
+penalty 0.01), none (no ghost penalty, the dofs of empty support dropped), aggregation on
+top of the ghost penalty, and aggregation alone.
+
+Run: ``python bench/aggregation.py [--parts conditioning accuracy] [--circles 30]
+[--sizes 8 16 32]``; writes ``bench/results/aggregation.{json,md}`` (conditioning) and
+``bench/results/aggregation_accuracy.md``.
 """
 
 import xfem_contact  # noqa: F401  (before dolfinx)
@@ -33,6 +40,12 @@ from mpi4py import MPI
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
+from xfem_contact.cases.paper import (
+    annulus_pressure_error,
+    annulus_problem,
+    inclusion_errors,
+    inclusion_problem,
+)
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.forms import form
 from xfem_contact.io.progress import note
@@ -139,12 +152,73 @@ def _extreme(A: PETSc.Mat, largest: bool) -> float:
     return float(value)
 
 
+#: label: problem options of the accuracy part
+ACCURACY_TREATMENTS = {
+    "ghost penalty 0.01 (default)": {},
+    "none (ghost penalty 0)": {"ghost_penalty": 0.0},
+    "ghost penalty 0.01 + aggregation 0.25": {"aggregation": 0.25},
+    "aggregation 0.25 alone": {"aggregation": 0.25, "ghost_penalty": 0.0},
+}
+
+
+def accuracy() -> None:
+    """The accuracy part (module docstring): prints and writes a Markdown table."""
+    cases = [
+        (f"case 2, {cell}, n = {n}", lambda o, n=n, c=cell: _case2(n, c, o))
+        for cell in ("quadrilateral", "triangle")
+        for n in (10, 20, 40)
+    ]
+    cases += [
+        (f"case 3, {nr} x {na}", lambda o, nr=nr, na=na: _case3(nr, na, o))
+        for nr, na in ((4, 16), (8, 32), (16, 64))
+    ]
+    lines = [
+        "| case | " + " | ".join(ACCURACY_TREATMENTS) + " |",
+        "|---|" + "---|" * len(ACCURACY_TREATMENTS),
+    ]
+    for name, run in cases:
+        errors = []
+        for options in ACCURACY_TREATMENTS.values():
+            try:
+                errors.append(f"{run(options):.3e}")
+            except Exception as error:  # reported, not hidden
+                errors.append(f"failed: {type(error).__name__}")
+        lines.append(f"| {name} | " + " | ".join(errors) + " |")
+        note(lines[-1])
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "aggregation_accuracy.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def _case2(n, cell, options) -> float:
+    problem = inclusion_problem(n, 2, "sticking", cell, **options)
+    problem.solve()
+    return inclusion_errors(problem, problem.w).pressure
+
+
+def _case3(n_radial, n_angular, options) -> float:
+    problem = annulus_problem(n_radial, n_angular, 2, **options)
+    problem.solve()
+    return annulus_pressure_error(problem)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument(
+        "--parts", nargs="+", default=["conditioning", "accuracy"], help="parts to run"
+    )
     parser.add_argument("--circles", type=int, default=30, help="circles per mesh")
     parser.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32], help="n")
     parser.add_argument("--elements", nargs="+", default=[f"{c}:{d}" for c, d in ELEMENTS])
     args = parser.parse_args()
+    if "accuracy" in args.parts:
+        accuracy()
+    if "conditioning" in args.parts:
+        conditioning(args)
+
+
+def conditioning(args) -> None:
+    """The conditioning part (module docstring): prints and writes a Markdown table."""
     elements = [(e.split(":")[0], int(e.split(":")[1])) for e in args.elements]
     rows = []
     for cell, degree in elements:

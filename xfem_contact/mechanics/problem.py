@@ -310,12 +310,7 @@ class Problem:
             for name, law in self.laws.items()
             if (p := law.prolongation(self.contexts[name], self.space)) is not None
         ]
-        fixed = None
-        if self.space.aggregation is not None:
-            fixed = np.concatenate(
-                [np.zeros(0, np.int64)]
-                + [bc.dof_indices()[0].astype(np.int64) for bc in self.loads.bcs]
-            )
+        fixed = None if self.space.aggregation is None else self.loads.dirichlet_dofs()
         return prolongation_matrix(
             self.space, combine_prolongations(prolongations, self.mesh.comm), fixed
         )
