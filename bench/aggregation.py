@@ -1,14 +1,16 @@
-"""Cell aggregation bounds the conditioning whatever the cut: the 2-norm condition number
-of the Jacobi-scaled reduced matrix (:mod:`xfem_contact.solvers.scaling`) of a bonded
-circle (paper case 2's setting: unit square, E = 100 MPa, nu = 0.3, rigid modes removed
-at three points) on n = 8, 16, 32 cells per side, over circles at random centres and
-radii, two thirds of them passing within ``eps h`` of a mesh node (``eps`` log-uniform in
-1e-10 .. 1e-2; the node inside, or outside: tiny cuts of either side on purpose), for
-P1 and P2 on triangles and quadrilaterals, three treatments of small cuts: none
-(``ghost_penalty=0``), cell aggregation (``aggregation=0.25``, ``ghost_penalty=0``) and
-the default ghost penalty alone. Prints, per element, treatment and n, the largest
-``C = cond h^2`` (h = 1/n) and its median, and the count of outliers (``C`` above ten
-times the median of the aggregated samples of that element and n).
+"""Cell aggregation against small cuts: conditioning, accuracy, the Williams crack.
+
+Part ``conditioning``: the 2-norm condition number of the Jacobi-scaled reduced matrix
+(:mod:`xfem_contact.solvers.scaling`) of a bonded circle (paper case 2's setting: unit
+square, E = 100 MPa, nu = 0.3, rigid modes removed at three points) on n = 8, 16, 32
+cells per side, over circles at random centres and radii, two thirds of them passing
+within ``eps h`` of a mesh node (``eps`` log-uniform in 1e-10 .. 1e-2; the node inside,
+or outside: tiny cuts of either side on purpose), for P1 and P2 on triangles and
+quadrilaterals, three treatments of small cuts: none (``ghost_penalty=0``), cell
+aggregation (``aggregation=0.25``, ``ghost_penalty=0``) and the default ghost penalty
+alone. Prints, per element, treatment and n, the largest ``C = cond h^2`` (h = 1/n) and
+its median, and the count of outliers (``C`` above ten times the median of the
+aggregated samples of that element and n).
 
 Condition numbers: the extreme eigenvalues of the symmetric scaled matrix (dense below
 1500 unknowns, else SLEPc: Krylov-Schur, shift-and-invert at 0 with an LU for the least
@@ -20,9 +22,14 @@ P2 on curved Q2 cells, 4 x 16, 8 x 32, 16 x 64) with the default treatment (ghos
 penalty 0.01), none (no ghost penalty, the dofs of empty support dropped), aggregation on
 top of the ghost penalty, and aggregation alone.
 
-Run: ``python bench/aggregation.py [--parts conditioning accuracy] [--circles 30]
-[--sizes 8 16 32]``; writes ``bench/results/aggregation.{json,md}`` (conditioning) and
-``bench/results/aggregation_accuracy.md``.
+Part ``crack``: the Williams crack on Q2 quadrilaterals (geometric tip enrichment,
+r_e = 0.3), n = 32, 64, 128, without and with ``aggregation=0.25``: the energy error,
+its rate and the condition number of the matrix the solver factors (tip-transformed;
+``bench/crack_convergence.py``'s estimate, n <= 64).
+
+Run: ``python bench/aggregation.py [--parts conditioning accuracy crack] [--circles 30]
+[--sizes 8 16 32]``; writes ``bench/results/aggregation.{json,md}`` (conditioning),
+``bench/results/aggregation_accuracy.md`` and ``bench/results/aggregation_crack.md``.
 """
 
 import xfem_contact  # noqa: F401  (before dolfinx)
@@ -40,6 +47,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
+from xfem_contact.cases.cracks import williams_case, williams_energy_error
 from xfem_contact.cases.paper import (
     annulus_pressure_error,
     annulus_problem,
@@ -202,10 +210,33 @@ def _case3(n_radial, n_angular, options) -> float:
     return annulus_pressure_error(problem)
 
 
+def crack() -> None:
+    """The crack part (module docstring): prints and writes a Markdown table."""
+    import crack_convergence  # the bench next to this one
+
+    lines = [
+        "| aggregation | n | energy error | rate | condition number |",
+        "|---|---|---|---|---|",
+    ]
+    for threshold in (None, 0.25):
+        errors = []
+        for n in (32, 64, 128):
+            case = williams_case(n, 2, tip_radius=0.3, cell="quadrilateral", aggregation=threshold)
+            case.problem.solve()
+            errors.append(williams_energy_error(case))
+            rate = "" if len(errors) < 2 else f"{math.log2(errors[-2] / errors[-1]):.2f}"
+            kappa = crack_convergence.condition_number(case.problem) if n <= 64 else math.nan
+            lines.append(f"| {threshold} | {n} | {errors[-1]:.3e} | {rate} | {kappa:.2e} |")
+            note(lines[-1])
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "aggregation_crack.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
-        "--parts", nargs="+", default=["conditioning", "accuracy"], help="parts to run"
+        "--parts", nargs="+", default=["conditioning", "accuracy", "crack"], help="parts"
     )
     parser.add_argument("--circles", type=int, default=30, help="circles per mesh")
     parser.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32], help="n")
@@ -215,6 +246,8 @@ def main() -> None:
         accuracy()
     if "conditioning" in args.parts:
         conditioning(args)
+    if "crack" in args.parts:
+        crack()
 
 
 def conditioning(args) -> None:

@@ -110,3 +110,28 @@ def test_extension_reproduces_polynomials(cell, degree):
         aggregation.rows, weights=aggregation.vals * at_sources, minlength=aggregation.dofs.size
     )
     assert np.allclose(extended, values[aggregation.dofs], rtol=0.0, atol=1e-12)
+
+
+@pytest.mark.mpi
+def test_aggregation_is_the_same_on_one_and_two_ranks():
+    """The constrained dofs (their count) and the solution's pressure error of case 2
+    (Q2, tiny cut, no ghost penalty) agree between one process and all of them."""
+
+    def run(comm):
+        problem = inclusion_problem(
+            N,
+            2,
+            "sticking",
+            radius=0.25 + 1e-6 / N,
+            comm=comm,
+            ghost_penalty=0.0,
+            aggregation=THRESHOLD,
+        )
+        problem.solve()
+        count = comm.allreduce(problem.space.aggregation.dofs.size, op=MPI.SUM)
+        return count, inclusion_errors(problem, problem.w).pressure
+
+    count, error = run(MPI.COMM_WORLD)
+    count_self, error_self = run(MPI.COMM_SELF)
+    assert count == count_self
+    assert abs(error - error_self) <= 1e-8 * error_self

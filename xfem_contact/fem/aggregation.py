@@ -15,9 +15,11 @@ basis on the reference cell, ``F_root`` the root's geometry map, pulled back by 
 method). Every remaining unknown has a well cut cell in its support, so the scaled
 operator's conditioning does not depend on where the interface cuts.
 
-A crack's cells are aggregated only where the crack crosses them away from its tips:
-cells whose nodes carry branch unknowns or tied dofs (a node whose support the crack
-does not cut completely) are never badly cut, and such dofs are never constrained.
+A crack's cells are aggregated only where the crack crosses them: its tip cells, the
+cells cut by its extension ahead of a tip and the cells holding a tied dof (a node whose
+support the crack does not cut completely) are never badly cut, and tied dofs are never
+constrained. The branch unknowns and the ramp are unchanged: in the tip zone only the
+side fields of badly cut cells are extended.
 
 All arrays here are process-local unless stated; the functions that gather are
 collective. The cells and roots are gathered on every process (interface-sized data).
@@ -125,7 +127,7 @@ def aggregate(
     """
     cut = space.cut
     areas = cell_areas(cut)
-    eligible = _eligible_cells(space, active)
+    eligible = _eligible_cells(space)
     parts = [
         _side_aggregation(space, field, side, threshold, areas, eligible, active)
         for field, side in ((0, -1), (1, 1))
@@ -139,9 +141,9 @@ def aggregate(
     )
 
 
-def _eligible_cells(space: EnrichedSpace, active: npt.NDArray[np.bool_]) -> np.ndarray:
+def _eligible_cells(space: EnrichedSpace) -> np.ndarray:
     """Per owned cell: whether it may be badly cut (a cut cell; with a crack, one it
-    crosses whose dofs hold no active branch unknown and no tie). Collective."""
+    crosses none of whose dofs is tied). Collective."""
     cut = space.cut
     n = cut.cell_sides.size
     eligible = np.zeros(n, dtype=bool)
@@ -154,9 +156,6 @@ def _eligible_cells(space: EnrichedSpace, active: npt.NDArray[np.bool_]) -> np.n
     tied.array[space.ties.ravel()] = 1.0
     tied.scatter_forward()
     near_tip = tied.array > 0
-    if space.branch_field is not None:
-        dofs = space.W.sub(space.branch_field).dofmap.list[:n]
-        eligible &= ~active[dofs].any(axis=1)
     for field in (0, 1):
         eligible &= ~near_tip[space.W.sub(field).dofmap.list[:n]].any(axis=1)
     return eligible
