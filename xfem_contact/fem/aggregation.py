@@ -6,14 +6,17 @@ side ``s``. Each badly cut cell is attached to a *root*: a cell of side ``s`` th
 badly cut, reached from it in the fewest facet steps through cells side ``s`` touches
 (nearest root centroid among those at that distance). A dof of side ``s``'s displacement
 whose support on that side holds badly cut cells only is not an unknown: it takes the
-root's polynomial extended to its node,
+polynomial of one root extended to its node,
 
     u_c = sum_j N_j^root(X_c) u_j,      X_c = F_root^-1(x_c),
 
 over the root cell's dofs ``j`` of the same field and component (``N_j`` the Lagrange
 basis on the reference cell, ``F_root`` the root's geometry map, pulled back by Newton's
-method). Every remaining unknown has a well cut cell in its support, so the scaled
-operator's conditioning does not depend on where the interface cuts.
+method). Its root is chosen among the roots of its badly cut cells and their well cut
+facet neighbours: the one whose reference cell ``X_c`` lies least outside of (the
+shortest extrapolation; ties by position). Every remaining unknown has a well cut cell
+in its support, so the scaled operator's conditioning does not depend on where the
+interface cuts.
 
 A crack's cells are aggregated only where the crack crosses them: its tip cells, the
 cells cut by its extension ahead of a tip and the cells holding a tied dof (a node whose
@@ -195,8 +198,13 @@ def _side_aggregation(space, field, side, threshold, areas, eligible, active) ->
     centroids = _centroids(mesh)
     table = _gather_bad_cells(mesh, bad, codes, centroids)
     roots = _roots(table)
-    # The root cells' geometry and dofs, from their owners
-    root_ids = np.unique(np.array(list(roots.values()), dtype=np.int64))
+    # candidate roots of a badly cut cell: its root and its well cut facet neighbours
+    candidates = {cell: {root} for cell, root in roots.items()}
+    for cell, other in table.neighbours.tolist():
+        if table.codes[other] == _WELL and cell in candidates:
+            candidates[cell].add(other)
+    # The candidates' geometry and dofs, from their owners
+    root_ids = np.unique(np.array([r for c in candidates.values() for r in c], dtype=np.int64))
     root_table = _gather_roots(space, field, root_ids)
     # Each constrained owned dof: the root nearest its node among its badly cut cells'
     dofmap = W.sub(field).dofmap.list
@@ -207,7 +215,13 @@ def _side_aggregation(space, field, side, threshold, areas, eligible, active) ->
     owner_cell = cell_map.local_to_global(np.repeat(bad, dofmap.shape[1]))[mine]
     node = np.repeat(nodes, gdim, axis=1).reshape(-1, gdim)[mine]
     # a dof's cells are all badly cut, owned by some process: gather its (dof, root) pairs
-    choice = _nearest_roots(comm, W, local_dof, owner_cell, node, roots, root_table, constrained)
+    pairs = [(k, r) for k, c in enumerate(owner_cell) for r in sorted(candidates.get(int(c), ()))]
+    pick = np.array([k for k, _ in pairs], dtype=np.int64)
+    root = np.array([r for _, r in pairs], dtype=np.int64)
+    element = cut.maps.coordinate_element
+    choice = _nearest_roots(
+        comm, W, local_dof[pick], root, node[pick], element, root_table, constrained
+    )
     dofs, cell_root, x = choice
     if dofs.size:
         rows, sources, vals = _extension_rows(space, dofs, cell_root, x, root_table, field)
@@ -346,18 +360,20 @@ def _gather_roots(space, field, root_ids) -> _Roots:
     )
 
 
-def _nearest_roots(comm, W, local_dof, owner_cell, node, roots, root_table, constrained):
-    """For each owned constrained dof: the root (nearest centroid to its node) among
-    the roots of its badly cut cells, and its node. Collective: the (dof, root) pairs of
-    every process are gathered, since a dof's cells may be owned elsewhere."""
+def _nearest_roots(comm, W, local_dof, root, node, element, root_table, constrained):
+    """For each owned constrained dof: among its candidate roots (``root``, one per
+    entry, the dof ``local_dof`` at ``node`` repeated per candidate), the one its node
+    lies nearest to in reference coordinates (the distance outside the reference cell:
+    the least extrapolation; ties by position), and its node. Collective: the candidates
+    of every process are gathered, since a dof's cells may be owned elsewhere."""
     imap = W.dofmap.index_map
     global_dof = imap.local_to_global(local_dof.astype(np.int32))
-    root = np.array([roots.get(int(c), -1) for c in owner_cell], dtype=np.int64)
-    reached = root >= 0
-    root_nodes = root_table.nodes[[root_table.index[int(r)] for r in root[reached]]]
-    distance = np.full(root.size, np.inf)
-    distance[reached] = np.linalg.norm(root_nodes.mean(axis=1) - node[reached], axis=1)
-    parts = comm.allgather((global_dof[reached], root[reached], distance[reached], node[reached]))
+    rows = np.array([root_table.index[int(r)] for r in root], dtype=np.int64)
+    distance = np.zeros(root.size)
+    if root.size:
+        X = _pull_back(element, root_table.nodes[rows], node)
+        distance = _outside(element.cell_type, X)
+    parts = comm.allgather((global_dof, root, distance, node))
     g = np.concatenate([p[0] for p in parts])
     r = np.concatenate([p[1] for p in parts])
     d = np.concatenate([p[2] for p in parts])
@@ -395,6 +411,16 @@ def _extension_rows(space, dofs, roots, x, root_table, field):
     sources = sources[np.arange(dofs.size), :, comp]  # (m, nodes)
     rows = np.repeat(np.arange(dofs.size, dtype=np.int64), N.shape[1])
     return rows, sources.ravel().astype(np.int64), N.ravel()
+
+
+def _outside(cell_type, X) -> np.ndarray:
+    """How far each reference point of ``X`` ``(m, tdim)`` lies outside the reference
+    cell (max norm; 0 inside), shape ``(m,)``."""
+    if cell_type in (basix.CellType.triangle, basix.CellType.tetrahedron):
+        beyond = np.concatenate([-X, X.sum(axis=1, keepdims=True) - 1.0], axis=1)
+    else:
+        beyond = np.concatenate([-X, X - 1.0], axis=1)
+    return np.maximum(beyond.max(axis=1), 0.0)
 
 
 def _pull_back(element, nodes, x) -> np.ndarray:
