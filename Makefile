@@ -61,6 +61,7 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/inf_sup.py
 	$(PY) bench/inf_sup.py --elements P2-P2 --sizes 8 16 32
 	$(PY) bench/multiplier_degree.py
+	$(PY) bench/aggregation.py
 	$(PY) bench/cut3d.py --sizes 4 8 16 32
 	$(PY) bench/cut3d.py --fuzz 10000 --sizes
 	$(PY) bench/cut3d_assembly.py --sizes 16 --quadrature-degrees 2 4 6

@@ -1,12 +1,14 @@
 """Each stability test fails with the guard it checks switched off.
 
-Guards: the ghost penalty (cut fractions), the harmonic-mean augmentation (stiffness
+Guards: the ghost penalty (cut fractions), cell aggregation (cut fractions without the
+ghost penalty), the harmonic-mean augmentation (stiffness
 contrast), the Coulomb clamp (friction cone), the objective bulk (a large rotation in
 one step or ten). The LBB check carries its own counter-test (``lbb="none"``).
 Marked ``guards``: ``pytest -m guards`` runs these alone.
 """
 
 import pytest
+import test_aggregation
 import test_cuts
 import test_friction
 import test_materials
@@ -24,6 +26,12 @@ def without_ghost_penalty(monkeypatch):
         test_cuts, "solve_at", lambda f, d, comm=None, **o: solve_at(f, d, ghost_penalty=0.0)
     )
     return lambda: test_cuts.test_condition_and_error_stay_bounded_as_the_cut_vanishes(2)
+
+
+def without_aggregation(monkeypatch):
+    make = test_aggregation.aggregated_problem
+    monkeypatch.setattr(test_aggregation, "aggregated_problem", lambda: make(aggregation=None))
+    return test_aggregation.test_aggregation_bounds_the_condition_without_ghost_penalty
 
 
 def with_arithmetic_mean_augmentation(monkeypatch):
@@ -51,6 +59,7 @@ def with_small_strain_bulk(monkeypatch):
 
 GUARDS = {
     "ghost penalty": without_ghost_penalty,
+    "cell aggregation": without_aggregation,
     "harmonic-mean augmentation": with_arithmetic_mean_augmentation,
     "Coulomb clamp": without_coulomb_clamp,
     "objective bulk": with_small_strain_bulk,

@@ -103,11 +103,13 @@ def williams_case(
     tip_radius: float | None = 0.3,
     cell: str = "triangle",
     comm: MPI.Comm = MPI.COMM_WORLD,
+    aggregation: float | None = None,
 ) -> CrackCase:
     """The exact Williams field of ``K = (K_I, K_II)`` on the square ``[-1, 1]^2`` (``n``
     cells a side) with a crack from its left side to a tip near the centre, imposed on the
     whole boundary (each lip's value where the crack meets it). Geometric tip enrichment
-    of radius ``tip_radius`` (m; None: topological)."""
+    of radius ``tip_radius`` (m; None: topological); ``aggregation``: see
+    :class:`~xfem_contact.mechanics.problem.Problem`."""
     d, normal = _frame()
     tip = OFFSET
     cut = CutMesh(
@@ -117,7 +119,15 @@ def williams_case(
         tangent=lambda x: (x[0] - tip[0]) * d[0] + (x[1] - tip[1]) * d[1],
     )
     field = WilliamsField(tip_frame(tip, d), K[0], K[1], MATERIAL.E, MATERIAL.nu)
-    problem = Problem(cut, degree, MATERIAL, "free", ghost_penalty=0.0, tip_radius=tip_radius)
+    problem = Problem(
+        cut,
+        degree,
+        MATERIAL,
+        "free",
+        ghost_penalty=0.0,
+        tip_radius=tip_radius,
+        aggregation=aggregation,
+    )
     displacement = _williams_sides(field)
     problem.loads.add_displacement(_on_boundary(1.0), {-1: displacement(-1), 1: displacement(1)})
     return CrackCase(problem, [K], displacement, 1.0)

@@ -23,6 +23,14 @@ import numpy.typing as npt
 import ufl
 from mpi4py import MPI
 
+from xfem_contact.fem.aggregation import (
+    Aggregation,
+    abs_det_at,
+    aggregate,
+    cell_areas,
+    check_threshold,
+    side_areas,
+)
 from xfem_contact.fem.branch import UFL, branch_values, null_pins
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.subspaces import collapse
@@ -71,6 +79,10 @@ class EnrichedSpace:
             None without a crack); ``None``: the tip cells' nodes. A radius below the tip
             cells' diameter takes the ramp 1 on the tip cells' vertices instead, with a
             logged warning.
+        aggregation: Cell aggregation (:mod:`~xfem_contact.fem.aggregation`): a cut cell
+            whose part on a side is below this fraction of its area is badly cut, and the
+            dofs of that side's displacement in badly cut cells alone are extended from a
+            root cell's (:attr:`aggregation`); None: off.
 
     A crack's multipliers live on the nodes of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillates, ``docs/crack_enrichment.md``). A crack
@@ -97,6 +109,7 @@ class EnrichedSpace:
         min_support_fraction: float = 0.0,
         multipliers: Sequence[tuple[int, str | None]] | None = None,
         tip_radius: float | str | None = None,
+        aggregation: float | None = None,
     ):
         if degree not in (1, 2):
             raise ValueError(f"Displacement degree must be 1 or 2, got {degree}")
@@ -150,6 +163,9 @@ class EnrichedSpace:
             self.ramp = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 1)))
         self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
         self.min_support_fraction = min_support_fraction
+        check_threshold(aggregation)
+        self.aggregation_threshold = aggregation
+        self._aggregation: Aggregation | None = None
         self._collapsed: dict[int, tuple[dolfinx.fem.FunctionSpace, npt.NDArray]] = {}
         self._active = self._active_dofs()
         self._scalar: tuple | None = None  # one displacement component, its nodes
@@ -253,7 +269,7 @@ class EnrichedSpace:
             active |= support
         for field, _, name in self.multiplier_fields:
             rules = cut.interface_rules_of(name)
-            length = rules.sums(rules.weights * _abs_det_at(cut, rules))
+            length = rules.sums(rules.weights * abs_det_at(cut, rules))
             if cut.crack is not None:  # a crack's: the crossed cells' vertices only
                 length = np.where(cut.crack.kind == CROSSED, length, 0.0)
             carrying = cut.cut_cells[length > 0.0]
@@ -261,6 +277,8 @@ class EnrichedSpace:
         if self.branch_field is not None:
             active |= self._branch_support()
         self._ties = self._tied(active)
+        if self.aggregation_threshold is not None:
+            self._aggregation = aggregate(self, self.aggregation_threshold, active)
         return active
 
     def _branch_support(self) -> npt.NDArray[np.bool_]:
@@ -319,6 +337,12 @@ class EnrichedSpace:
         return pairs[owned]
 
     @property
+    def aggregation(self) -> Aggregation | None:
+        """The dofs of badly cut cells extended from their roots (owned rows, see
+        :class:`~xfem_contact.fem.aggregation.Aggregation`); None without aggregation."""
+        return self._aggregation
+
+    @property
     def ties(self) -> npt.NDArray[np.int64]:
         """Owned dofs ``(kept, follower)``, shape ``(m, 2)``: the follower (side +1) is
         the kept dof (side -1) in the reduced system (nodes a crack does not cut
@@ -327,11 +351,8 @@ class EnrichedSpace:
 
     def _side_fraction(self, field: int, side: int) -> np.ndarray:
         """Per dof: (area of its support on ``side``) / (area of its support)."""
-        cut = self.cut
-        areas = _cell_areas(cut)
-        side_area = np.where(cut.cell_sides == side, areas, 0.0)
-        rules = cut.side_rules(side)
-        side_area[cut.cut_cells] = rules.sums(rules.weights * _abs_det_at(cut, rules))
+        areas = cell_areas(self.cut)
+        side_area = side_areas(self.cut, side, areas)
         on_side = self._mark(field, np.arange(areas.size, dtype=np.int32), side_area)
         total = self._mark(field, np.arange(areas.size, dtype=np.int32), areas)
         return np.divide(on_side, total, out=np.zeros_like(total), where=total > 0)
@@ -404,17 +425,3 @@ class EnrichedSpace:
         branch = 0 if self.branch_field is None else counts[self.branch_field]
         return DofCounts(standard, counts[0] + counts[1] - standard - ties + branch, multiplier)
 
-
-def _cell_areas(cut: CutMesh) -> np.ndarray:
-    """Areas of the owned cells, shape ``(num_owned,)`` (assembled once)."""
-    mesh = cut.mesh
-    V0 = dolfinx.fem.functionspace(mesh, ("DG", 0))
-    v = ufl.TestFunction(V0)
-    vec = dolfinx.fem.assemble_vector(dolfinx.fem.form(v * ufl.dx))
-    return vec.array[V0.dofmap.list[: cut.cell_sides.size, 0]]
-
-
-def _abs_det_at(cut: CutMesh, rules) -> np.ndarray:
-    """|det J| at every point of ``rules`` (points of cut cells)."""
-    J = cut.maps.jacobian(cut.cut_cells[rules.point_rows], rules.points)
-    return np.abs(np.linalg.det(J))

@@ -44,7 +44,9 @@ class MultiplierProlongation:
 
 
 def prolongation_matrix(
-    space: EnrichedSpace, prolongation: MultiplierProlongation | None = None
+    space: EnrichedSpace,
+    prolongation: MultiplierProlongation | None = None,
+    fixed: np.ndarray | None = None,
 ) -> PETSc.Mat:
     """Build the prolongation ``R`` with ``x = R y``. Collective.
 
@@ -53,9 +55,13 @@ def prolongation_matrix(
     its ``prolongation.num_owned`` multiplier unknowns.
 
     Args:
-        space: The enriched space; its active owned dofs are kept.
+        space: The enriched space; its active owned dofs are kept, but those of its
+            :attr:`~xfem_contact.fem.enrichment.EnrichedSpace.aggregation` (with cell
+            aggregation), whose rows are their roots' dofs' columns.
         prolongation: Optional multiplier prolongation; its dofs are removed
             from the identity part and replaced by its entries.
+        fixed: Local dofs of ``W`` that stay unknowns whatever the aggregation (the
+            Dirichlet ones: their values are imposed), or None.
 
     Returns:
         ``R`` as a PETSc AIJ matrix of global shape ``(dim W, n_reduced)``;
@@ -71,6 +77,11 @@ def prolongation_matrix(
     active[ties[:, 1]] = False  # a follower is its kept dof's column
     if prolongation is not None:
         active[prolongation.dofs] = False
+    aggregation = space.aggregation
+    if aggregation is not None and fixed is not None:
+        aggregation = aggregation.without(np.asarray(fixed))
+    if aggregation is not None:
+        active[aggregation.dofs] = False
     selected = np.flatnonzero(active)
     n_sel = selected.size
     n_mult = 0 if prolongation is None else prolongation.num_owned
@@ -94,6 +105,15 @@ def prolongation_matrix(
         entries_rows.append(prolongation.dofs[prolongation.rows])
         entries_cols.append(global_mult[owner] + prolongation.cols - starts[owner])
         entries_vals.append(prolongation.vals)
+    if aggregation is not None:
+        column = np.full(n_owned, -1, dtype=np.int64)
+        column[selected] = np.arange(n_sel) + sel_offset
+        column[ties[:, 1]] = column[ties[:, 0]]
+        source = _global_lookup(column, imap.local_range[0] * bs, aggregation.sources, comm)
+        known = source >= 0  # an inactive source dof is 0
+        entries_rows.append(aggregation.dofs[aggregation.rows[known]])
+        entries_cols.append(source[known])
+        entries_vals.append(aggregation.vals[known])
     rows = np.concatenate(entries_rows)
     cols = np.concatenate(entries_cols)
     vals = np.concatenate(entries_vals)
@@ -107,3 +127,16 @@ def prolongation_matrix(
     R.setPreallocationCSR((indptr, cols.astype(PETSc.IntType), vals))
     R.assemble()
     return R
+
+
+def _global_lookup(values, start, wanted, comm: MPI.Comm) -> np.ndarray:
+    """``values`` (per owned dof, the first at global index ``start``) at the global
+    indices ``wanted`` owned by any process (-1 where no process has a value >= 0).
+    Collective: every process's requests are gathered."""
+    requests = np.unique(np.concatenate(comm.allgather(np.asarray(wanted, dtype=np.int64))))
+    local = requests - start
+    here = (local >= 0) & (local < values.size)
+    answers = np.full(requests.size, -1, dtype=np.int64)
+    answers[here] = values[local[here]]
+    comm.Allreduce(MPI.IN_PLACE, answers, op=MPI.MAX)
+    return answers[np.searchsorted(requests, wanted)]

@@ -27,6 +27,9 @@ DEFAULTS: dict[str, Default] = {
     "min_support_fraction": Default(
         None, "enriched dofs kept down to this cut fraction (None: all with the ghost penalty)"
     ),
+    "aggregation": Default(
+        None, "cell aggregation: side volume fraction of a badly cut cell (None: off)"
+    ),
     "augmentation": Default(1.0, "dimensionless factor of r = augmentation E / h (contact laws)"),
     "lbb": Default("stabilized", "LBB treatment: 'stabilized', 'restriction' or 'none'"),
     "crack_lbb": Default(

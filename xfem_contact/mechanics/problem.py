@@ -64,6 +64,9 @@ class Problem:
             the default's, 0 for a crack (it spoils the tip's field: energy error x3).
         min_support_fraction: See :class:`EnrichedSpace`. Default: every dof with the
             ghost penalty (it extends the field), else those with support on their side.
+        aggregation: Cell aggregation (see :class:`EnrichedSpace`): the side volume
+            fraction below which a cut cell's dofs are extended from a root cell; None:
+            off. The Dirichlet dofs stay unknowns.
         kinematics: ``"small"`` (linear elasticity, small sliding) or ``"large"`` (Saint
             Venant-Kirchhoff bulk, contact laws in large sliding: the slave/master hybrid
             element of :mod:`xfem_contact.mechanics.sliding`).
@@ -91,6 +94,7 @@ class Problem:
         *,
         ghost_penalty: float | None = None,
         min_support_fraction: float | None = DEFAULT.min_support_fraction,
+        aggregation: float | None = DEFAULT.aggregation,
         kinematics: str = DEFAULT.kinematics,
         slave: int = DEFAULT.slave,
         pairing: str = DEFAULT.pairing,
@@ -126,6 +130,7 @@ class Problem:
             multipliers=[m for m in multipliers if m[0] > 0],
             min_support_fraction=min_support_fraction,
             tip_radius=tip_radius,
+            aggregation=aggregation,
         )
         check_ghosts(self.mesh)
         #: Loads, supports and Dirichlet data (``loads.bcs``), and the pseudo-time
@@ -309,7 +314,10 @@ class Problem:
             for name, law in self.laws.items()
             if (p := law.prolongation(self.contexts[name], self.space)) is not None
         ]
-        return prolongation_matrix(self.space, combine_prolongations(prolongations, self.mesh.comm))
+        fixed = None if self.space.aggregation is None else self.loads.dirichlet_dofs()
+        return prolongation_matrix(
+            self.space, combine_prolongations(prolongations, self.mesh.comm), fixed
+        )
 
     def restriction(self):
         """Deprecated name of :meth:`prolongation` (it returns ``R`` with ``x = R y``)."""

@@ -144,10 +144,12 @@ def refine(
 
 def reduced_columns(space: EnrichedSpace, R: PETSc.Mat) -> np.ndarray:
     """The global reduced column of each local (owned and ghost) dof of ``W`` that is
-    one (an identity or tied column of ``R``), else -1. Collective (ghost update)."""
+    one (an identity or tied column of ``R``), else -1 (an inactive dof, or a combination
+    of columns: a multiplier prolongation's or an aggregated dof). Collective (ghost
+    update)."""
     indptr, cols, _ = R.getValuesCSR()
     n_owned = indptr.size - 1
-    has = np.diff(indptr) > 0
+    has = np.diff(indptr) == 1
     column = np.full(n_owned, -1.0)
     column[has] = cols[indptr[:-1][has]]
     carrier = dolfinx.fem.Function(space.W)

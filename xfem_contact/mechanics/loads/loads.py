@@ -160,6 +160,13 @@ class Loads:
             self.bcs.append(dolfinx.fem.dirichletbc(g, dofs_of(sub)))
         return g
 
+    def dirichlet_dofs(self) -> np.ndarray:
+        """The local dofs of the problem's space ``W`` that carry a Dirichlet condition
+        (owned and ghost, with repeats), shape ``(m,)``. Not collective."""
+        return np.concatenate(
+            [np.zeros(0, np.int64)] + [bc.dof_indices()[0].astype(np.int64) for bc in self.bcs]
+        )
+
     def _subspace(self, side, component: int | None):
         sub = self.fields.subspace(side)
         if component is None:

@@ -1,0 +1,310 @@
+"""Cell aggregation against small cuts: conditioning, accuracy, the Williams crack.
+
+Part ``conditioning``: the 2-norm condition number of the Jacobi-scaled reduced matrix
+(:mod:`xfem_contact.solvers.scaling`) of a bonded circle (paper case 2's setting: unit
+square, E = 100 MPa, nu = 0.3, rigid modes removed at three points) on n = 8, 16, 32
+cells per side, over circles at random centres and radii, two thirds of them passing
+within ``eps h`` of a mesh node (``eps`` log-uniform in 1e-10 .. 1e-2; the node inside,
+or outside: tiny cuts of either side on purpose), for P1 and P2 on triangles and
+quadrilaterals, three treatments of small cuts: none (``ghost_penalty=0``), cell
+aggregation (``aggregation=0.25``, ``ghost_penalty=0``) and the default ghost penalty
+alone. Prints, per element, treatment and n, the largest ``C = cond h^2`` (h = 1/n) and
+its median, and the count of outliers (``C`` above ten times the median of the
+aggregated samples of that element and n).
+
+Condition numbers: the extreme eigenvalues of the symmetric scaled matrix (dense below
+1500 unknowns, else SLEPc: Krylov-Schur, shift-and-invert at 0 with an LU for the least
+in modulus).
+
+Part ``accuracy``: the contact pressure's relative L2 error of paper case 2 (sticking,
+P2 on quadrilaterals and triangles, n = 10, 20, 40) and case 3 (the annulus, alpha = 0,
+P2 on curved Q2 cells, 4 x 16, 8 x 32, 16 x 64) with the default treatment (ghost
+penalty 0.01), none (no ghost penalty, the dofs of empty support dropped), aggregation on
+top of the ghost penalty, and aggregation alone.
+
+Part ``crack``: the Williams crack on Q2 quadrilaterals (geometric tip enrichment,
+r_e = 0.3), n = 32, 64, 128, without and with ``aggregation=0.25``: the energy error,
+its rate and the condition number of the matrix the solver factors (tip-transformed;
+``bench/crack_convergence.py``'s estimate, n <= 64).
+
+Run: ``python bench/aggregation.py [--parts conditioning accuracy crack] [--circles 30]
+[--sizes 8 16 32]``; writes ``bench/results/aggregation.{json,md}`` (conditioning),
+``bench/results/aggregation_accuracy.md`` and ``bench/results/aggregation_crack.md``.
+"""
+
+import xfem_contact  # noqa: F401  (before dolfinx)
+
+# isort: split
+import argparse
+import json
+import math
+import pathlib
+import time
+
+import dolfinx.mesh
+import numpy as np
+from mpi4py import MPI
+from petsc4py import PETSc
+from slepc4py import SLEPc
+
+from xfem_contact.cases.cracks import williams_case, williams_energy_error
+from xfem_contact.cases.paper import (
+    annulus_pressure_error,
+    annulus_problem,
+    inclusion_errors,
+    inclusion_problem,
+)
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.forms import form
+from xfem_contact.io.progress import note
+from xfem_contact.mechanics.laws import Bonded
+from xfem_contact.mechanics.materials import Material
+from xfem_contact.mechanics.problem import Problem
+from xfem_contact.solvers.assembly import ReducedMatrix
+from xfem_contact.solvers.scaling import saddle_point_scaling
+
+RESULTS = pathlib.Path(__file__).resolve().parent / "results"
+ELEMENTS = [("triangle", 1), ("triangle", 2), ("quadrilateral", 1), ("quadrilateral", 2)]
+#: label: (ghost penalty, aggregation threshold)
+TREATMENTS = {
+    "none": (0.0, None),
+    "aggregation 0.25": (0.0, 0.25),
+    "ghost penalty 0.01": (0.01, None),
+}
+#: A sample is an outlier above this multiple of the aggregated samples' median C
+OUTLIER = 10.0
+
+
+def circles(count: int, n: int, rng) -> list[tuple[float, float, float]]:
+    """Random circles inside the unit square; two in three pass within ``eps h`` of a
+    node (inside, then outside), ``eps`` log-uniform in 1e-10 .. 1e-2."""
+    out = []
+    for k in range(count):
+        cx, cy = rng.uniform(0.35, 0.65, 2)
+        r = rng.uniform(0.12, 0.3)
+        if k % 3:
+            angle = rng.uniform(0.0, 2.0 * math.pi)
+            point = np.array([cx + r * math.cos(angle), cy + r * math.sin(angle)])
+            node = np.round(point * n) / n
+            eps = 10.0 ** rng.uniform(-10.0, -2.0)
+            r = math.hypot(*(node - (cx, cy))) + (1.0 if k % 3 == 1 else -1.0) * eps / n
+        out.append((float(cx), float(cy), float(r)))
+    return out
+
+
+def circle(centre, radius):
+    """The signed distance to a circle, as a level set."""
+    return lambda x: np.hypot(x[0] - centre[0], x[1] - centre[1]) - radius
+
+
+def bonded_circle(mesh, centre, radius, degree, ghost_penalty, aggregation) -> Problem:
+    """The bonded circle of the module docstring (move it with ``update_interface``:
+    the forms are compiled once)."""
+    cut = CutMesh(mesh, circle(centre, radius), degree=2)
+    problem = Problem(
+        cut,
+        degree,
+        Material(100e6, 0.3),
+        Bonded(),
+        ghost_penalty=ghost_penalty,
+        aggregation=aggregation,
+    )
+    problem.loads.add_point_displacement([0.5, 0.0], 0.0, 0)
+    problem.loads.add_point_displacement([0.5, 1.0], 0.0, 0)
+    problem.loads.add_point_displacement([0.0, 0.5], 0.0, 1)
+    return problem
+
+
+def scaled_condition(problem: Problem) -> float:
+    """2-norm condition number of the scaled reduced matrix ``D R^T A R D`` (serial)."""
+    R = problem.prolongation()
+    matrix = ReducedMatrix(form(problem.bilinear_form()), problem.loads.bcs, R)
+    matrix.assemble()
+    A = matrix.release()
+    D = saddle_point_scaling(A)
+    A.diagonalScale(D, D)
+    try:
+        if A.getSize()[0] <= 1500:
+            dense = A.convert("dense").getDenseArray()
+            s = np.abs(np.linalg.eigvalsh(0.5 * (dense + dense.T)))
+            return float(s.max() / s.min())
+        return _extreme(A, largest=True) / _extreme(A, largest=False)
+    finally:
+        for obj in (R, A, D):
+            obj.destroy()
+
+
+def _extreme(A: PETSc.Mat, largest: bool) -> float:
+    """The largest or least modulus of an eigenvalue of the symmetric ``A`` (SLEPc)."""
+    eps = SLEPc.EPS().create(A.getComm())
+    eps.setOperators(A)
+    eps.setProblemType(SLEPc.EPS.ProblemType.HEP)
+    eps.setDimensions(1)
+    eps.setTolerances(1e-8, 2000)
+    if largest:
+        eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_MAGNITUDE)
+    else:
+        eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+        eps.setTarget(0.0)
+        st = eps.getST()
+        st.setType(SLEPc.ST.Type.SINVERT)
+        ksp = st.getKSP()
+        ksp.setType("preonly")
+        ksp.getPC().setType("lu")
+        ksp.getPC().setFactorSolverType("mumps")
+    eps.solve()
+    if eps.getConverged() < 1:
+        raise RuntimeError("the eigenvalue solver did not converge")
+    value = abs(eps.getEigenvalue(0))
+    eps.destroy()
+    return float(value)
+
+
+#: label: problem options of the accuracy part
+ACCURACY_TREATMENTS = {
+    "ghost penalty 0.01 (default)": {},
+    "none (ghost penalty 0)": {"ghost_penalty": 0.0},
+    "ghost penalty 0.01 + aggregation 0.25": {"aggregation": 0.25},
+    "aggregation 0.25 alone": {"aggregation": 0.25, "ghost_penalty": 0.0},
+}
+
+
+def accuracy() -> None:
+    """The accuracy part (module docstring): prints and writes a Markdown table."""
+    cases = [
+        (f"case 2, {cell}, n = {n}", lambda o, n=n, c=cell: _case2(n, c, o))
+        for cell in ("quadrilateral", "triangle")
+        for n in (10, 20, 40)
+    ]
+    cases += [
+        (f"case 3, {nr} x {na}", lambda o, nr=nr, na=na: _case3(nr, na, o))
+        for nr, na in ((4, 16), (8, 32), (16, 64))
+    ]
+    lines = [
+        "| case | " + " | ".join(ACCURACY_TREATMENTS) + " |",
+        "|---|" + "---|" * len(ACCURACY_TREATMENTS),
+    ]
+    for name, run in cases:
+        errors = []
+        for options in ACCURACY_TREATMENTS.values():
+            try:
+                errors.append(f"{run(options):.3e}")
+            except Exception as error:  # reported, not hidden
+                errors.append(f"failed: {type(error).__name__}")
+        lines.append(f"| {name} | " + " | ".join(errors) + " |")
+        note(lines[-1])
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "aggregation_accuracy.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def _case2(n, cell, options) -> float:
+    problem = inclusion_problem(n, 2, "sticking", cell, **options)
+    problem.solve()
+    return inclusion_errors(problem, problem.w).pressure
+
+
+def _case3(n_radial, n_angular, options) -> float:
+    problem = annulus_problem(n_radial, n_angular, 2, **options)
+    problem.solve()
+    return annulus_pressure_error(problem)
+
+
+def crack() -> None:
+    """The crack part (module docstring): prints and writes a Markdown table."""
+    import crack_convergence  # the bench next to this one
+
+    lines = [
+        "| aggregation | n | energy error | rate | condition number |",
+        "|---|---|---|---|---|",
+    ]
+    for threshold in (None, 0.25):
+        errors = []
+        for n in (32, 64, 128):
+            case = williams_case(n, 2, tip_radius=0.3, cell="quadrilateral", aggregation=threshold)
+            case.problem.solve()
+            errors.append(williams_energy_error(case))
+            rate = "" if len(errors) < 2 else f"{math.log2(errors[-2] / errors[-1]):.2f}"
+            kappa = crack_convergence.condition_number(case.problem) if n <= 64 else math.nan
+            lines.append(f"| {threshold} | {n} | {errors[-1]:.3e} | {rate} | {kappa:.2e} |")
+            note(lines[-1])
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "aggregation_crack.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument(
+        "--parts", nargs="+", default=["conditioning", "accuracy", "crack"], help="parts"
+    )
+    parser.add_argument("--circles", type=int, default=30, help="circles per mesh")
+    parser.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32], help="n")
+    parser.add_argument("--elements", nargs="+", default=[f"{c}:{d}" for c, d in ELEMENTS])
+    args = parser.parse_args()
+    if "accuracy" in args.parts:
+        accuracy()
+    if "conditioning" in args.parts:
+        conditioning(args)
+    if "crack" in args.parts:
+        crack()
+
+
+def conditioning(args) -> None:
+    """The conditioning part (module docstring): prints and writes a Markdown table."""
+    elements = [(e.split(":")[0], int(e.split(":")[1])) for e in args.elements]
+    rows = []
+    for cell, degree in elements:
+        for n in args.sizes:
+            kind = dolfinx.mesh.CellType[cell]
+            mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n, kind)
+            samples = circles(args.circles, n, np.random.default_rng(1000 + n))
+            C = {label: [] for label in TREATMENTS}
+            start = time.perf_counter()
+            for label, (ghost_penalty, aggregation) in TREATMENTS.items():
+                problem = bonded_circle(mesh, (0.5, 0.5), 0.2, degree, ghost_penalty, aggregation)
+                for cx, cy, r in samples:
+                    problem.update_interface(circle((cx, cy), r))
+                    C[label].append(scaled_condition(problem) / n**2)
+            reference = float(np.median(C["aggregation 0.25"]))
+            for label, values in C.items():
+                v = np.array(values)
+                rows.append(
+                    {
+                        "cell": cell,
+                        "degree": degree,
+                        "n": n,
+                        "treatment": label,
+                        "C_max": float(v.max()),
+                        "C_median": float(np.median(v)),
+                        "outliers": int((v > OUTLIER * reference).sum()),
+                        "C": values,
+                    }
+                )
+                note(
+                    f"{cell:13s} P{degree} n={n:3d} {label:19s}: C = cond h^2 max {v.max():.3e} "
+                    f"median {np.median(v):.3e}, outliers {rows[-1]['outliers']}/{v.size} "
+                    f"({time.perf_counter() - start:.1f} s)"
+                )
+    lines = [
+        "| cell | P | treatment | "
+        + " | ".join(f"n={n}: max / median C" for n in args.sizes)
+        + " | outliers |",
+        "|---|---|---|" + "---|" * len(args.sizes) + "---|",
+    ]
+    for cell, degree in elements:
+        for label in TREATMENTS:
+            key = (cell, degree, label)
+            sel = [r for r in rows if (r["cell"], r["degree"], r["treatment"]) == key]
+            cells = " | ".join(f"{r['C_max']:.2e} / {r['C_median']:.2e}" for r in sel)
+            outliers = sum(r["outliers"] for r in sel)
+            total = args.circles * len(sel)
+            lines.append(f"| {cell} | {degree} | {label} | {cells} | {outliers}/{total} |")
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "aggregation.md").write_text("\n".join(lines) + "\n")
+    (RESULTS / "aggregation.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
