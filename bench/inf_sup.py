@@ -52,12 +52,13 @@ def label(degree: int, multiplier: int) -> str:
     return f"P{degree}-P{multiplier}"
 
 
-#: label: (lbb, ghost penalty; None: the default)
+#: label: (lbb, ghost penalty, cell aggregation; None: the default)
 TREATMENTS = {
-    "none": ("none", None),
-    "restriction": ("restriction", None),
-    "stabilized": ("stabilized", None),
-    "stabilized, ghost 0.1": ("stabilized", 0.1),
+    "none": ("none", None, None),
+    "restriction": ("restriction", None, None),
+    "stabilized": ("stabilized", None, None),
+    "stabilized, ghost 0.1": ("stabilized", 0.1, None),
+    "stabilized, aggregation 0.25": ("stabilized", None, 0.25),
 }
 
 
@@ -86,7 +87,7 @@ def plot(rows: list[dict], elements: list, path: pathlib.Path) -> None:
     )
     for ax, element in zip(axes[0], elements, strict=True):
         cell, degree, multiplier = element
-        for lbb in TREATMENTS:
+        for lbb in dict.fromkeys(r["lbb"] for r in rows):
             sel = [r for r in rows if _key(r) == (*element, lbb)]
             ns = [r["n"] for r in sel]
             ax.loglog(ns, [max(r["beta_min"], 1e-8) for r in sel], "o-", label=f"{lbb} (least)")
@@ -143,12 +144,22 @@ def main() -> None:
         default=list(DEFAULT_ELEMENTS),
         help="these elements (default P1-P1 P2-P1; others: results in inf_sup_<elements>.*)",
     )
+    parser.add_argument(
+        "--treatments",
+        nargs="+",
+        choices=list(TREATMENTS),
+        default=list(TREATMENTS),
+        help="these LBB treatments (default all; fewer: results in inf_sup_<...>_<treatments>.*)",
+    )
     args = parser.parse_args()
     elements = [e for e in ELEMENTS if label(*e[1:]) in args.elements]
-    default = sorted(args.elements) == sorted(DEFAULT_ELEMENTS)
+    treatments = {k: v for k, v in TREATMENTS.items() if k in args.treatments}
+    default = sorted(args.elements) == sorted(DEFAULT_ELEMENTS) and len(treatments) == len(
+        TREATMENTS
+    )
     rows = []
     for cell, degree, multiplier in elements:
-        for lbb, (treatment, ghost_penalty) in TREATMENTS.items():
+        for lbb, (treatment, ghost_penalty, aggregation) in treatments.items():
             for n in args.sizes:
                 mesh = dolfinx.mesh.create_unit_square(
                     MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType[cell]
@@ -159,7 +170,14 @@ def main() -> None:
                     cut = CutMesh(mesh, circle, degree=2)
                     law = Bonded(lbb=treatment, multiplier_degree=multiplier)
                     material = Material(100e6, 0.3)
-                    problem = Problem(cut, degree, material, law, ghost_penalty=ghost_penalty)
+                    problem = Problem(
+                        cut,
+                        degree,
+                        material,
+                        law,
+                        ghost_penalty=ghost_penalty,
+                        aggregation=aggregation,
+                    )
                     b2.append(inf_sup_constant(problem).beta_squared)
                 b = np.sqrt(np.maximum(b2, 0.0))
                 rows.append(
@@ -187,7 +205,7 @@ def main() -> None:
         "|---|---|---|" + "---|" * len(args.sizes) + "---|---|",
     ]
     for cell, degree, multiplier in elements:
-        for lbb in TREATMENTS:
+        for lbb in treatments:
             sel = [r for r in rows if _key(r) == (cell, degree, multiplier, lbb)]
             mins = [r["beta_min"] for r in sel]
             slope = (
@@ -200,7 +218,10 @@ def main() -> None:
                 f"| {cell} | {label(degree, multiplier)} | {lbb} | {cells} | {slope:.2f} | "
                 f"{sum(r['indefinite'] for r in sel)}/{args.circles * len(sel)} |"
             )
-    name = "inf_sup" if default else "_".join(["inf_sup", *args.elements])
+    parts = list(args.elements)
+    if len(treatments) < len(TREATMENTS):
+        parts += [t.replace(", ", "_").replace(" ", "_") for t in treatments]
+    name = "inf_sup" if default else "_".join(["inf_sup", *parts])
     if default:
         lines += tetrahedra(args.tet_sizes)
     RESULTS.mkdir(exist_ok=True)
