@@ -322,12 +322,20 @@ def composite_sphere_problem(
     exact = composite_sphere_exact(1, inside=inside)
     problem.loads.add_displacement("boundary", {s: exact for s in (-1, 1)})
     if contact:
-        c = np.asarray(SPHERE_CENTRE)
-        for axis, components in ((0, (1, 2)), (1, (2,))):
-            point = c + np.eye(3)[axis] / n
-            for k in components:
-                problem.loads.add_point_displacement(point.tolist(), 0.0, k)
+        hold_spins(problem, 1.0 / n)
     return problem
+
+
+def hold_spins(problem, offset: float) -> None:
+    """Hold the three spins of a ball about ``SPHERE_CENTRE`` by point constraints at
+    the mesh nodes ``c + offset e_x`` (``u_y = u_z = 0``) and ``c + offset e_y``
+    (``u_z = 0``, m), on both sides' fields: a radial field meets them, and so does a
+    field symmetric about the planes through ``c``."""
+    c = np.asarray(SPHERE_CENTRE)
+    for axis, components in ((0, (1, 2)), (1, (2,))):
+        for k in components:
+            point = c + offset * np.eye(3)[axis]
+            problem.loads.add_point_displacement(point.tolist(), 0.0, k)
 
 
 def composite_sphere_errors(problem: ElasticityProblem) -> dict[int, float]:
