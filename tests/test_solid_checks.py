@@ -7,6 +7,8 @@ finer meshes are in ``bench/composite_sphere.py``, ``bench/sphere_oscillation.py
 
 import numpy as np
 import pytest
+from mpi4py import MPI
+from parallel import gathered_fields, max_relative_difference
 
 from xfem_contact.cases.solid import (
     COMPOSITE_RADIUS,
@@ -105,3 +107,14 @@ def test_friction_limits_on_the_sphere():
         differences.append(np.abs(slipping - frictionless).max() / np.abs(frictionless).max())
     print(f"\nmu = 0 against frictionless, n = 2, 4: {differences}")
     assert differences[1] < differences[0] < 0.35
+
+
+@pytest.mark.mpi
+def test_concentric_spheres_parallel_equals_serial():
+    fields = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        problem = composite_sphere_problem(4, 1, "frictionless", comm=comm)
+        problem.solve()
+        fields.append(gathered_fields(problem))
+    differences = max_relative_difference(*fields)
+    assert all(v <= 1e-10 for v in differences.values()), differences
