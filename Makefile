@@ -62,6 +62,7 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/cut3d.py --sizes 4 8 16 32
 	$(PY) bench/cut3d.py --fuzz 10000 --sizes
 	$(PY) bench/cut3d_assembly.py --sizes 16 --quadrature-degrees 2 4 6
+	$(PY) bench/robustness3d.py --write
 	@if test -x $(PEER_PY); then $(PY) bench/peer_cut3d.py --peer-python $(PEER_PY); \
 	else echo "skipped bench/peer_cut3d.py (the ngsxfem peer): 'make bench-peer' creates $(PEER_VENV) and runs it"; fi
 
