@@ -11,9 +11,10 @@ iterations, gives a NaN, or has a pressure error above 3x the median of its law 
 shape (spheres and ellipsoids apart: their curvatures differ); a failure without a
 warning or an error is a silent one.
 
-Run: ``python bench/robustness3d.py [--count 100] [--n 4] [--laws sticking ...]
-[--seed 0] [--write]``; prints one row per run, the iteration histogram and the
-failures per law; ``--write`` writes ``bench/results/robustness3d.{json,md}``.
+Run: ``python bench/robustness3d.py [--count 100] [--n 4] [--degree 2] [--cell
+tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--write]``; prints one row
+per run, the iteration histogram and the failures per law; ``--write`` writes
+``bench/results/robustness3d.{json,md}`` (``robustness3d_hexahedron.*`` on hexahedra).
 """
 
 import argparse
@@ -77,7 +78,7 @@ def quadric(placement: dict):
     return levelset, normals
 
 
-def run(placement: dict, law: str, n: int, degree: int) -> dict:
+def run(placement: dict, law: str, n: int, degree: int, cell: str = "tetrahedron") -> dict:
     """One solve: its Newton iterations, convergence, pressure error, NaN and the
     warnings or the error it raised."""
     options, stress = LAWS[law]
@@ -87,7 +88,9 @@ def run(placement: dict, law: str, n: int, degree: int) -> dict:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            problem = uniform_stress_problem(n, degree, law, levelset, stress=stress, **options)
+            problem = uniform_stress_problem(
+                n, degree, law, levelset, cell, stress=stress, **options
+            )
             report = problem.solve()
             row["iterations"], row["converged"] = report.iterations, bool(report.converged)
             row["nan"] = bool(not np.all(np.isfinite(problem.w.x.array)))
@@ -152,7 +155,7 @@ def summary(rows: list[dict]) -> dict:
 
 def markdown(table: dict, rows: list[dict], args, done: int) -> str:
     lines = [
-        f"# Random inclusions, P{args.degree} tetrahedra, n = {args.n} "
+        f"# Random inclusions, degree {args.degree} {args.cell}s, n = {args.n} "
         f"({done} placements, seed {args.seed})",
         "",
         "| law | runs | failures | silent failures | runs with a warning | Newton iterations: "
@@ -184,6 +187,7 @@ def main() -> None:
     parser.add_argument("--count", type=int, default=100, help="placements")
     parser.add_argument("--n", type=int, default=4, help="cells per edge (even)")
     parser.add_argument("--degree", type=int, default=2, help="displacement degree")
+    parser.add_argument("--cell", default="tetrahedron", help="tetrahedron or hexahedron")
     parser.add_argument("--laws", nargs="+", default=list(LAWS), choices=list(LAWS))
     parser.add_argument("--seed", type=int, default=0, help="of the random placements")
     parser.add_argument("--write", action="store_true", help="write bench/results/")
@@ -193,7 +197,7 @@ def main() -> None:
     rows = []
     for index, placement in enumerate(placements(args.count, args.seed)):
         for law in args.laws:
-            row = run(placement, law, args.n, args.degree) | {"index": index}
+            row = run(placement, law, args.n, args.degree, args.cell) | {"index": index}
             rows.append(row)
             error = "-" if row["error"] is None else f"{row['error']:.2e}"
             print(
@@ -221,14 +225,16 @@ def report(rows: list[dict]) -> dict:
 
 
 def write(rows: list[dict], args, done: int) -> dict:
-    """Write ``bench/results/robustness3d.{json,md}`` of the ``done`` placements run;
-    the summary."""
+    """Write ``bench/results/robustness3d.{json,md}`` (``robustness3d_hexahedron.*`` on
+    hexahedra) of the ``done`` placements run; the summary."""
     table = report(rows)
     RESULTS.mkdir(exist_ok=True)
-    record = {"n": args.n, "degree": args.degree, "count": done, "seed": args.seed}
+    name = "robustness3d" if args.cell == "tetrahedron" else f"robustness3d_{args.cell}"
+    record = {"n": args.n, "degree": args.degree, "cell": args.cell, "count": done}
+    record["seed"] = args.seed
     record |= {"summary": table, "runs": rows}
-    (RESULTS / "robustness3d.json").write_text(json.dumps(record, indent=1, default=str))
-    (RESULTS / "robustness3d.md").write_text(markdown(table, rows, args, done))
+    (RESULTS / f"{name}.json").write_text(json.dumps(record, indent=1, default=str))
+    (RESULTS / f"{name}.md").write_text(markdown(table, rows, args, done))
     return table
 
 

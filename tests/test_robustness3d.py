@@ -1,5 +1,5 @@
 """A short sweep of random inclusions with each contact law (bench/robustness3d.py runs
-the long one): spheres and ellipsoids on P2 tetrahedra, n = 4; every solve converges in
+the long one): a sphere and an ellipsoid on P2 tetrahedra, n = 4; every solve converges in
 at most 15 Newton iterations with no NaN, no error raised and the pressure error of the
 exact uniform stress small (measured: spheres 1e-4 to 3e-4, ellipsoids 7e-5 to 2e-2)."""
 
@@ -16,7 +16,7 @@ _spec.loader.exec_module(robustness3d)
 
 def test_short_sweep_of_random_inclusions():
     rows = []
-    for index, placement in enumerate(robustness3d.placements(3, seed=0)):
+    for index, placement in enumerate(robustness3d.placements(2, seed=0)):
         for law in robustness3d.LAWS:
             rows.append(robustness3d.run(placement, law, n=4, degree=2) | {"index": index})
     table = robustness3d.report(rows)
