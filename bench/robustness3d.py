@@ -14,7 +14,8 @@ warning or an error is a silent one.
 Run: ``python bench/robustness3d.py [--count 100] [--n 4] [--degree 2] [--cell
 tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--write]``; prints one row
 per run, the iteration histogram and the failures per law; ``--write`` writes
-``bench/results/robustness3d.{json,md}`` (``robustness3d_hexahedron.*`` on hexahedra).
+``bench/results/robustness3d.{json,md}`` (``robustness3d_hexahedron.*`` on hexahedra),
+``--render`` rewrites the ``.md`` from the ``.json``.
 """
 
 import argparse
@@ -155,11 +156,11 @@ def summary(rows: list[dict]) -> dict:
 
 def markdown(table: dict, rows: list[dict], args, done: int) -> str:
     lines = [
-        f"# Random inclusions, degree {args.degree} {args.cell}s, n = {args.n} "
+        f"# Random inclusions, degree {args.degree} on {args.cell} cells, n = {args.n} "
         f"({done} placements, seed {args.seed})",
         "",
         "| law | runs | failures | silent failures | runs with a warning | Newton iterations: "
-        "runs | median pressure error | max | max / median of its shape | time (s) |",
+        "runs | median pressure error (both shapes) | max | max / median of its shape | time (s) |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for law, t in table.items():
@@ -171,10 +172,18 @@ def markdown(table: dict, rows: list[dict], args, done: int) -> str:
         )
     failed = [r for r in rows if r["failures"]]
     lines += ["", f"Failures: {len(failed)}."]
+    shapes = placements(done, args.seed)
+    h = 1.0 / args.n
     for r in failed:
+        shape = shapes[r["index"]]
+        where = (
+            f"centre {np.round(shape['centre'], 3).tolist()}, semi-axes / h "
+            f"{np.round(shape['axes'] / h, 2).tolist()}"
+        )
         lines.append(
-            f"- {r['law']} {r['shape']} #{r['index']}: {', '.join(r['failures'])}"
-            f" (warnings: {r['warnings'] or 'none'}; raised: {r['raised'] or 'nothing'})"
+            f"- {r['law']} {r['shape']} #{r['index']} ({where}): {', '.join(r['failures'])}"
+            f", pressure error {r['error']:.2e} against the median {r['median_error']:.2e}"
+            f" (warnings: {len(r['warnings']) or 'none'}; raised: {r['raised'] or 'nothing'})"
         )
     warned = sorted({w for r in rows for w in r["warnings"]})
     if warned:
@@ -191,7 +200,17 @@ def main() -> None:
     parser.add_argument("--laws", nargs="+", default=list(LAWS), choices=list(LAWS))
     parser.add_argument("--seed", type=int, default=0, help="of the random placements")
     parser.add_argument("--write", action="store_true", help="write bench/results/")
+    parser.add_argument(
+        "--render", action="store_true", help="rewrite the .md from the .json run before"
+    )
     args = parser.parse_args()
+    if args.render:
+        name = "robustness3d" if args.cell == "tetrahedron" else f"robustness3d_{args.cell}"
+        record = json.loads((RESULTS / f"{name}.json").read_text())
+        for key in ("n", "degree", "seed"):
+            setattr(args, key, record[key])
+        write(record["runs"], args, record["count"])
+        return
     if MPI.COMM_WORLD.size > 1:
         raise SystemExit("robustness3d: serial (one solve per placement)")
     rows = []
