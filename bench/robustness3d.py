@@ -185,9 +185,12 @@ def markdown(table: dict, rows: list[dict], args, done: int) -> str:
             f", pressure error {r['error']:.2e} against the median {r['median_error']:.2e}"
             f" (warnings: {len(r['warnings']) or 'none'}; raised: {r['raised'] or 'nothing'})"
         )
-    warned = sorted({w for r in rows for w in r["warnings"]})
-    if warned:
-        lines += ["", "Warnings seen:"] + [f"- {w}" for w in warned]
+    kinds = sorted({w.split(":")[0] for r in rows for w in r["warnings"]})
+    if kinds:
+        lines += ["", "Warnings seen (runs with one, and an example):"]
+        for kind in kinds:
+            seen = [w for r in rows for w in r["warnings"] if w.split(":")[0] == kind]
+            lines.append(f"- {kind}: {len(seen)} runs, e.g. {seen[0]}")
     return "\n".join(lines) + "\n"
 
 
