@@ -18,7 +18,7 @@ tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--write] [--name NAME]
 prints one row per run, the iteration histogram and the failures per law; ``--write``
 writes ``bench/results/robustness3d.{json,md}`` (``robustness3d_hexahedron.*`` on
 hexahedra, ``NAME.*`` with ``--name``),
-``--render`` rewrites the ``.md`` from the ``.json``.
+``--render`` rewrites the ``.md`` from the ``.json``, ``--resume`` goes on from it.
 """
 
 import argparse
@@ -186,10 +186,13 @@ def markdown(table: dict, rows: list[dict], args, done: int) -> str:
             f"centre {np.round(shape['centre'], 3).tolist()}, semi-axes / h "
             f"{np.round(shape['axes'] / h, 2).tolist()}"
         )
+        error = ""
+        if r["error"] is not None:
+            error = f", pressure error {r['error']:.2e} against the median {r['median_error']:.2e}"
         lines.append(
             f"- {r['law']} {r['shape']} #{r['index']} ({where}): {', '.join(r['failures'])}"
-            f", pressure error {r['error']:.2e} against the median {r['median_error']:.2e}"
-            f" (warnings: {len(r['warnings']) or 'none'}; raised: {r['raised'] or 'nothing'})"
+            f"{error} (warnings: {len(r['warnings']) or 'none'}; "
+            f"raised: {r['raised'] or 'nothing'})"
         )
     kinds = sorted({w.split(":")[0] for r in rows for w in r["warnings"]})
     if kinds:
@@ -213,6 +216,9 @@ def main() -> None:
     parser.add_argument(
         "--render", action="store_true", help="rewrite the .md from the .json run before"
     )
+    parser.add_argument(
+        "--resume", action="store_true", help="go on from the .json of a stopped sweep"
+    )
     args = parser.parse_args()
     if args.render:
         record = json.loads((RESULTS / f"{results_name(args)}.json").read_text())
@@ -222,8 +228,13 @@ def main() -> None:
         return
     if MPI.COMM_WORLD.size > 1:
         raise SystemExit("robustness3d: serial (one solve per placement)")
-    rows = []
+    rows, done = [], 0
+    if args.resume:  # the placements of a stopped sweep's results, with its seed and n
+        record = json.loads((RESULTS / f"{results_name(args)}.json").read_text())
+        rows, done = record["runs"], record["count"]
     for index, placement in enumerate(placements(args.count, args.seed)):
+        if index < done:
+            continue
         for law in args.laws:
             row = run(placement, law, args.n, args.degree, args.cell) | {"index": index}
             rows.append(row)
