@@ -103,6 +103,19 @@ def plane_errors(problem: ElasticityProblem) -> dict[int, float]:
     return errors
 
 
+def _sphere_levelset(levelset: str, R: float = SPHERE_RADIUS):
+    """The level set (numpy callable of ``x`` ``(3, n)``) named ``levelset`` (see
+    :func:`sphere_problem`) of the sphere about ``SPHERE_CENTRE`` of radius ``R`` (m)."""
+    c = np.asarray(SPHERE_CENTRE)
+    shapes = {
+        "distance": lambda x: np.sqrt(((x.T - c) ** 2).sum(axis=1)) - R,
+        "quadric": lambda x: (((x.T - c) ** 2).sum(axis=1) - R**2) / (2 * R),
+    }
+    if levelset not in shapes:
+        raise ValueError(f"levelset must be one of {sorted(shapes)}, got {levelset!r}")
+    return shapes[levelset]
+
+
 def sphere_problem(
     n: int,
     degree: int,
@@ -113,26 +126,36 @@ def sphere_problem(
     levelset: str = "distance",
     **options,
 ) -> ElasticityProblem:
-    """A sphere (``SPHERE_RADIUS``) in the unit cube (``n`` cells per edge, even),
-    one material on both sides, pressures ``-stress`` (Pa) on the three pairs of faces
-    and the six rigid modes held by point constraints the exact field satisfies
-    (``u_i = 0`` where ``x_i = 1/2``): the exact stress is ``diag(stress)``
-    everywhere, the exact contact traction ``sigma n``. ``law``: ``bonded``,
-    ``sticking`` (a contact law stays closed: every ``n.sigma.n < 0``), ...;
-    ``levelset``: ``"distance"`` (the signed distance, whose P2 interpolant's zero set
-    is a sphere to O(h^3)) or ``"quadric"`` (``(|x - c|^2 - R^2) / (2 R)``, which P2
-    represents exactly: the exact sphere and normal); ``options`` go to the problem."""
+    """A sphere (``SPHERE_RADIUS``) in the unit cube: :func:`uniform_stress_problem`
+    with ``levelset``: ``"distance"`` (the signed distance, whose P2 interpolant's zero
+    set is a sphere to O(h^3)) or ``"quadric"`` (``(|x - c|^2 - R^2) / (2 R)``, which P2
+    represents exactly: the exact sphere and normal)."""
+    return uniform_stress_problem(
+        n, degree, law, _sphere_levelset(levelset), cell, comm, stress, **options
+    )
+
+
+def uniform_stress_problem(
+    n: int,
+    degree: int,
+    law: str,
+    levelset,
+    cell: str = "tetrahedron",
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    stress: tuple[float, float, float] = TRIAXIAL,
+    **options,
+) -> ElasticityProblem:
+    """An inclusion (``levelset < 0``: a numpy callable of ``x`` ``(3, n)``, a closed
+    surface inside the cube) in the unit cube (``n`` cells per edge, even), one material
+    on both sides, pressures ``-stress`` (Pa) on the three pairs of faces and the six
+    rigid modes held by point constraints the exact field satisfies (``u_i = 0`` where
+    ``x_i = 1/2``): the exact stress is ``diag(stress)`` everywhere, the exact contact
+    traction ``sigma n``. ``law``: ``bonded``, ``sticking`` (a contact law stays closed:
+    every ``n.sigma.n < 0``), ...; ``options`` go to the problem."""
     if n % 2:
         raise ValueError(f"n must be even (the point constraints are mesh nodes), got {n}")
     mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
-    c, R = np.asarray(SPHERE_CENTRE), SPHERE_RADIUS
-    shapes = {
-        "distance": lambda x: np.sqrt(((x.T - c) ** 2).sum(axis=1)) - R,
-        "quadric": lambda x: (((x.T - c) ** 2).sum(axis=1) - R**2) / (2 * R),
-    }
-    if levelset not in shapes:
-        raise ValueError(f"levelset must be one of {sorted(shapes)}, got {levelset!r}")
-    cut = CutMesh(mesh, shapes[levelset], degree=2)
+    cut = CutMesh(mesh, levelset, degree=2)
     cls = ContactProblem if law in ContactProblem.LAWS else ElasticityProblem
     problem = cls(cut, degree, SOLID, law, **options)
     problem.stress = tuple(stress)
@@ -160,14 +183,38 @@ def sphere_errors(problem) -> tuple[float, float]:
     ``(I - n n) sigma n``; the Cartesian multiplier of ``bonded`` and of the 3D contact
     laws split on the exact sphere's ``n``), summed by the interface rule at its points
     (numpy). ``frictionless`` gives ``nan`` for the tangential one. Collective."""
+    return traction_errors(problem, lambda n: n @ np.diag(problem.stress))
+
+
+def sphere_normals(points: np.ndarray) -> np.ndarray:
+    """The unit normals ``(p, 3)`` at ``points`` ``(p, 3)`` (m) of the spheres about
+    ``SPHERE_CENTRE``."""
+    arm = points - np.asarray(SPHERE_CENTRE)
+    return arm / np.linalg.norm(arm, axis=1)[:, None]
+
+
+def interface_rule(problem, normals=sphere_normals) -> tuple:
+    """``(ctx, n, dA)`` of the one interface of a problem: its context, the exact unit
+    normal ``(p, 3)`` (``normals`` of the points: by default a sphere's about
+    ``SPHERE_CENTRE``) and the area (m^2) ``(p,)`` of each of this process's interface
+    rule points. Local."""
     (name,) = problem.laws
     ctx = problem.contexts[name]
     cut, rules = problem.cut, ctx.rules
     J = cut.maps.jacobian(rule_cells(cut, rules), rules.points)
-    dA = rules.weights * np.abs(np.linalg.det(J))  # area (m^2) of each point
-    arm = interface_points(cut, rules) - np.asarray(SPHERE_CENTRE)
-    n = arm / np.linalg.norm(arm, axis=1)[:, None]
-    traction = n @ np.diag(problem.stress)
+    dA = rules.weights * np.abs(np.linalg.det(J))
+    return ctx, normals(interface_points(cut, rules)), dA
+
+
+def traction_errors(problem, exact, normals=sphere_normals) -> tuple[float, float]:
+    """Relative L2 errors of the normal and the tangential traction of the multiplier on
+    the interface against ``exact``, a callable of the exact unit normals ``(p, 3)`` at
+    the interface rule's points giving the exact traction ``(p, 3)`` (Pa); ``normals``:
+    see :func:`interface_rule`; the rest as :func:`sphere_errors`. The tangential error
+    is relative to the exact pressure's norm where the exact tangential traction
+    vanishes, ``nan`` for ``frictionless``. Collective."""
+    ctx, n, dA = interface_rule(problem, normals)
+    traction = exact(n)
     p_ex = np.sum(traction * n, axis=1)
     t_ex = traction - p_ex[:, None] * n
     lam = ctx.values_at(problem.w, ctx.field)  # Cartesian (bonded, contact in 3D)
@@ -176,7 +223,7 @@ def sphere_errors(problem) -> tuple[float, float]:
         lam_t = lam - lam_n[:, None] * n
     else:  # frictionless: lambda_n alone
         lam_n, lam_t = lam[:, 0], None
-    comm = cut.mesh.comm
+    comm = problem.mesh.comm
 
     def total(values) -> float:
         return comm.allreduce(float(np.sum(values * dA)), op=MPI.SUM)
@@ -184,6 +231,128 @@ def sphere_errors(problem) -> tuple[float, float]:
     e_n = np.sqrt(total((lam_n - p_ex) ** 2) / total(p_ex**2))
     e_t = np.nan
     if lam_t is not None:
-        misfit = total(np.sum((lam_t - t_ex) ** 2, axis=1))
-        e_t = np.sqrt(misfit / total(np.sum(t_ex**2, axis=1)))
+        misfit, norm = total(np.sum((lam_t - t_ex) ** 2, axis=1)), total(np.sum(t_ex**2, axis=1))
+        e_t = np.sqrt(misfit / (norm if norm > 1e-20 * total(p_ex**2) else total(p_ex**2)))
     return float(e_n), float(e_t)
+
+
+#: Composite sphere: the ball's radius (m, about ``SPHERE_CENTRE``), its material (side
+#: -1; the matrix is ``SOLID``) and the strain ``A`` of the matrix's radial field
+#: (compression: the interface closed)
+COMPOSITE_RADIUS = 0.35
+INCLUSION = Material(300.0, 0.2)
+COMPOSITE_STRAIN = -1e-2
+
+
+def composite_sphere_coefficients(
+    inside: Material = INCLUSION, outside: Material = SOLID, strain: float = COMPOSITE_STRAIN
+) -> tuple[float, float, float]:
+    """``(A, B, C)`` of the composite sphere's radial displacement: ``u = C (x - c)`` in
+    the ball of radius ``R = COMPOSITE_RADIUS`` (side -1), ``u = (A + B / r^3) (x - c)``
+    outside (``A = strain``, B in m^3), continuous with a continuous radial traction at
+    ``r = R`` (3D Lame: ``sigma_rr = 3 K C`` inside, ``3 K A - 4 mu B / r^3`` outside, K
+    the bulk modulus)."""
+    R, A = COMPOSITE_RADIUS, strain
+    k_in = inside.lmbda + 2 * inside.mu / 3
+    k_out = outside.lmbda + 2 * outside.mu / 3
+    B = 3 * (k_out - k_in) * A * R**3 / (3 * k_in + 4 * outside.mu)
+    return A, B, A + B / R**3
+
+
+def composite_sphere_exact(side: int, ops=np, inside: Material = INCLUSION):
+    """The exact displacement (m) of ``side`` of :func:`composite_sphere_problem`: a
+    callable of points ``x`` (numpy ``(3, n)`` giving ``(3, n)``, or with ``ops=ufl`` the
+    spatial coordinate giving a UFL vector; numpy's side +1 is taken at ``r >= R / 2``
+    for its nodes near the centre, away from its part of the cube). ``inside``: the
+    ball's material."""
+    A, B, C = composite_sphere_coefficients(inside)
+    c = SPHERE_CENTRE
+
+    def u(x):
+        arm = [x[k] - c[k] for k in range(3)]
+        if side == -1:
+            factor = C
+        else:
+            r = (arm[0] ** 2 + arm[1] ** 2 + arm[2] ** 2) ** 0.5
+            if ops is np:  # finite at the centre: side +1's nodes inside the ball
+                r = np.maximum(r, COMPOSITE_RADIUS / 2)
+            factor = A + B / r**3
+        values = [factor * arm[k] for k in range(3)]
+        return ops.as_vector(values) if ops is not np else np.array(values)
+
+    return u
+
+
+def composite_sphere_pressure(inside: Material = INCLUSION) -> float:
+    """The exact (uniform) normal traction ``n.sigma.n = 3 K C`` (Pa) on the sphere of
+    :func:`composite_sphere_problem` with the ball's material ``inside`` (negative:
+    compression)."""
+    _, _, C = composite_sphere_coefficients(inside)
+    return 3 * (inside.lmbda + 2 * inside.mu / 3) * C
+
+
+def composite_sphere_problem(
+    n: int,
+    degree: int,
+    law: str = "bonded",
+    cell: str = "tetrahedron",
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    levelset: str = "quadric",
+    inside: Material = INCLUSION,
+    **options,
+) -> ElasticityProblem:
+    """A ball (``COMPOSITE_RADIUS``, material ``inside``) in the unit cube (``n`` cells
+    per edge, matrix ``SOLID``) under hydrostatic compression, the whole cube boundary
+    held by the exact composite-sphere displacement (:func:`composite_sphere_exact`).
+    ``law``: ``bonded``, or a contact law (``frictionless``, ``sticking``, ``coulomb``):
+    the exact field is radial, closed and free of tangential traction, so it is the
+    contact solution too (uniform pressure :func:`composite_sphere_pressure`: the
+    concentric spheres); with a contact law the ball's three spins are held at the nodes
+    ``c + e_x / n`` (``u_y = u_z = 0``) and ``c + e_y / n`` (``u_z = 0``), which the
+    exact field meets (``n`` even). ``levelset`` as :func:`sphere_problem`'s; ``options``
+    go to the problem."""
+    contact = law in ContactProblem.LAWS
+    if contact and n % 2:
+        raise ValueError(f"n must be even with a contact law (the spins' nodes), got {n}")
+    mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
+    cut = CutMesh(mesh, _sphere_levelset(levelset, COMPOSITE_RADIUS), degree=2)
+    cls = ContactProblem if contact else ElasticityProblem
+    problem = cls(cut, degree, {-1: inside, 1: SOLID}, law, **options)
+    problem.inside = inside
+    exact = composite_sphere_exact(1, inside=inside)
+    problem.loads.add_displacement("boundary", {s: exact for s in (-1, 1)})
+    if contact:
+        hold_spins(problem, 1.0 / n)
+    return problem
+
+
+def hold_spins(problem, offset: float) -> None:
+    """Hold the three spins of a ball about ``SPHERE_CENTRE`` by point constraints at
+    the mesh nodes ``c + offset e_x`` (``u_y = u_z = 0``) and ``c + offset e_y``
+    (``u_z = 0``, m), on both sides' fields: a radial field meets them, and so does a
+    field symmetric about the planes through ``c``."""
+    c = np.asarray(SPHERE_CENTRE)
+    for axis, components in ((0, (1, 2)), (1, (2,))):
+        for k in components:
+            point = c + offset * np.eye(3)[axis]
+            problem.loads.add_point_displacement(point.tolist(), 0.0, k)
+
+
+def composite_sphere_errors(problem: ElasticityProblem) -> dict[int, float]:
+    """Relative L2 error of each side's displacement on its own part of the cube against
+    :func:`composite_sphere_exact` (UFL, by the cut rules). Collective."""
+    errors = {}
+    fields = problem.space.split(problem.w)
+    x = ufl.SpatialCoordinate(problem.mesh)
+    for side, u_h in ((-1, fields[0]), (1, fields[1])):
+        exact = composite_sphere_exact(side, ufl, problem.inside)(x)
+        dx, e = problem.cut.dx(side), u_h - exact
+        ratio = integrate(ufl.dot(e, e) * dx) / integrate(ufl.dot(exact, exact) * dx)
+        errors[side] = float(np.sqrt(ratio))
+    return errors
+
+
+def composite_sphere_traction_errors(problem) -> tuple[float, float]:
+    """:func:`traction_errors` against the composite sphere's uniform pressure (the
+    tangential error relative to the pressure: its exact value is zero). Collective."""
+    return traction_errors(problem, lambda n: composite_sphere_pressure(problem.inside) * n)
