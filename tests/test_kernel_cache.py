@@ -46,3 +46,20 @@ def test_a_new_layout_version_recompiles(tmp_path, monkeypatch):
     assert all(f"kernel key {k}," in code_new for k in keys_new)
     assert value_new == pytest.approx(value, rel=1e-14)  # the new kernels read the rules
     assert len(list(tmp_path.glob("libffcx_forms_*.c"))) == 2
+
+
+def test_dolfinx_configuration_files_take_precedence_over_the_defaults(tmp_path, monkeypatch):
+    """A user's ``dolfinx_jit_options.json`` (DOLFINx's documented configuration: the
+    config home's, then the working directory's over it) sets the compile flags of the
+    cut forms too, over :data:`forms.JIT_DEFAULTS`."""
+    home, work = tmp_path / "config", tmp_path / "work"
+    (home / "dolfinx").mkdir(parents=True)
+    work.mkdir()
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(home))
+    monkeypatch.chdir(work)
+    assert forms.configured_jit_options() == {}
+    (home / "dolfinx" / "dolfinx_jit_options.json").write_text(
+        '{"cffi_extra_compile_args": ["-O0"], "timeout": 7}'
+    )
+    (work / "dolfinx_jit_options.json").write_text('{"timeout": 9}')
+    assert forms.configured_jit_options() == {"cffi_extra_compile_args": ["-O0"], "timeout": 9}

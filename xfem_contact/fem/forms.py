@@ -14,6 +14,9 @@ degree; ``None`` for the others. Forms are compiled once per signature with the
 from __future__ import annotations
 
 import collections.abc
+import json
+import os
+import pathlib
 import typing
 
 import dolfinx.fem
@@ -31,11 +34,31 @@ from xfem_contact.codegen.compat import analyze_ufl_objects, compute_ir, get_opt
 from xfem_contact.codegen.tables import RuntimeIntegral, runtime_integral
 from xfem_contact.quadrature.cell_rules import CellRules
 
-#: DOLFINx JIT options under those a caller gives: kernels compiled with -O1, not
-#: DOLFINx's -O2 (about half the compile time of the cut forms' large kernels for
-#: the same assembly time; see the docs' performance notes), and a wait of up to
-#: 5 min (not 10 s) for a module another process is compiling (parallel test runs)
+#: DOLFINx JIT options under those of DOLFINx's configuration files and those a caller
+#: gives: kernels compiled with -O1, not DOLFINx's -O2 (about half the compile time of
+#: the cut forms' large kernels for the same assembly time; see the docs' performance
+#: notes), and a wait of up to 5 min (not 10 s) for a module another process is
+#: compiling (parallel test runs)
 JIT_DEFAULTS = {"cffi_extra_compile_args": ["-O1", "-g0"], "timeout": 300}
+
+
+def configured_jit_options() -> dict:
+    """The JIT options of DOLFINx's configuration files, which DOLFINx documents in
+    :func:`dolfinx.jit.get_options`: ``$XDG_CONFIG_HOME/dolfinx/dolfinx_jit_options.json``
+    (``~/.config`` without the variable), then ``./dolfinx_jit_options.json`` over it.
+    They take precedence over :data:`JIT_DEFAULTS`. Read at each call (two small files
+    at most, once per compiled signature)."""
+    home = pathlib.Path(os.environ.get("XDG_CONFIG_HOME", pathlib.Path.home() / ".config"))
+    options: dict = {}
+    for path in (
+        home / "dolfinx" / "dolfinx_jit_options.json",
+        pathlib.Path.cwd() / "dolfinx_jit_options.json",
+    ):
+        if path.is_file():
+            options |= json.loads(path.read_text())
+    return options
+
+
 _STANDARD_ID0 = 1000
 _RUNTIME_ID0 = 2000
 _TYPES = {
@@ -179,7 +202,7 @@ def _runtime_kernels(ufl_form: ufl.Form, options: dict, cell) -> dict[int, Runti
 def _compile(
     comm, ufl_form: ufl.Form, options: dict, jit_options: dict | None
 ) -> tuple[_Compiled, CompiledForm]:
-    jit_options = JIT_DEFAULTS | (jit_options or {})
+    jit_options = JIT_DEFAULTS | configured_jit_options() | (jit_options or {})
     key = (
         ufl_form.signature(),
         tuple(sorted((k, str(v)) for k, v in options.items())),
@@ -239,7 +262,8 @@ def form(
         form_compiler_options: FFCx options (``scalar_type`` defaults to
             ``dolfinx.default_scalar_type``; ``language`` and the layout version
             :data:`~xfem_contact.codegen.runtime_abi.LAYOUT_OPTION` are set here).
-        jit_options: DOLFINx JIT options (over :data:`JIT_DEFAULTS`).
+        jit_options: DOLFINx JIT options (over :data:`JIT_DEFAULTS` and
+            :func:`configured_jit_options`).
 
     Returns:
         A :class:`dolfinx.fem.Form` (or a nested list of them) for
