@@ -16,34 +16,26 @@ import dolfinx.fem
 import numpy as np
 import ufl
 
-from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.cut_state import CutState
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.enrichment import EnrichedSpace
-from xfem_contact.fem.forms import form
 from xfem_contact.fem.prolongation import prolongation_matrix
 from xfem_contact.mechanics.bulk import BULK_MODELS, KINEMATICS, cell_size, check_ghosts
 from xfem_contact.mechanics.composition import Materials, interface_laws, side_and_law_materials
 from xfem_contact.mechanics.contexts import interface_context, samples, status_counts
 from xfem_contact.mechanics.defaults import DEFAULT
-from xfem_contact.mechanics.fieldsplit_data import (
-    fieldsplit_dofs,
-    rigid_modes,
-    vertex_interpolation,
-)
 from xfem_contact.mechanics.laws import InterfaceLaw, large_sliding
 from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loads import Loads, SideFields
 from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
-from xfem_contact.solvers.linear import solve_reduced, tip_transform
+from xfem_contact.mechanics.solving import linear_solve, newton_solver
 from xfem_contact.solvers.log_lines import lines_to
-from xfem_contact.solvers.newton import NewtonFailure, ReducedNewton, weak_method
+from xfem_contact.solvers.newton import NewtonFailure, ReducedNewton
 from xfem_contact.solvers.options import (
     Facts,
     checked_prefix,
     problem_options,
-    uses_fieldsplit,
 )
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 
@@ -392,51 +384,18 @@ class Problem:
             self._checked_loads = self.loads.revision
         petsc_options = self.solver_options()
         if self.linear:
-            a, L = form(self.bilinear_form()), form(self.loads.linear_form())
-            timer, residuals = phase("linear solve"), []
             try:
-                w, reason = solve_reduced(
-                    a,
-                    L,
-                    self.loads.bcs,
-                    self.space,
-                    petsc_options,
-                    self.petsc_options_prefix,
-                    residuals=residuals,
-                )
+                self._last_report = linear_solve(self, petsc_options)
             except LinearSolveFailure as failure:  # self.w is untouched
                 self._last_report = failure.report
                 raise
-            self.w.x.array[:] = w.x.array
-            self._last_report = SolveReport(
-                residuals,
-                reason=reason,
-                total_time=seconds(timer),
-                w=self.w,
-                space=self.space,
-            )
             return self._last_report
         changed = self._options_changed or self._newton_loads != self.loads.revision
         if self._newton is not None and changed:
             self._newton.destroy()  # loads or solver options changed since it was built
             self._newton = None
         if self._newton is None:
-            fieldsplit = uses_fieldsplit(petsc_options)
-            self._newton = ReducedNewton(
-                self.residual(self.w),
-                self.w,
-                self.loads.bcs,
-                self.prolongation(),
-                petsc_options,
-                self.petsc_options_prefix,
-                status=weak_method(self.interface_status),
-                fieldsplit_dofs=fieldsplit_dofs(self.space) if fieldsplit else None,
-                near_nullspace=rigid_modes(self.space) if fieldsplit else None,
-                interpolation=vertex_interpolation(self.space) if fieldsplit else None,
-                couplings=list(self.couplings.values()),
-                field_space=self.space.field_space,
-                transform=tip_transform(self.space, off=fieldsplit or bool(self.couplings)),
-            )
+            self._newton = newton_solver(self, petsc_options)
             self._newton_loads, self._options_changed = self.loads.revision, False
         accepted = self.w.x.array.copy()
         t = self.loads.time
