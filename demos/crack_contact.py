@@ -49,6 +49,7 @@ from xfem_contact.io.crack_report import Reference, crack_table, load_words, tip
 from xfem_contact.io.meshes import ghosted_partitioner
 from xfem_contact.io.output import write_fields, write_json, write_lips
 from xfem_contact.io.plots import plot_lips
+from xfem_contact.io.progress import printer
 from xfem_contact.mechanics.fracture import GrowthPath, TipIntegrals, effective_modulus
 from xfem_contact.mechanics.laws import make_law
 from xfem_contact.mechanics.materials import Material
@@ -103,7 +104,7 @@ def main():
     parser.add_argument("--no-progress", action="store_true", help="print no progress lines")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
-    say = print if comm.rank == 0 and not args.no_progress else (lambda *a: None)
+    say = printer(not args.no_progress, comm)
     out = pathlib.Path(args.out)
     a, beta, sigma, friction = 0.1, math.pi / 4, 10e6, 0.3
     start = time.perf_counter()

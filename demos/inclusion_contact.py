@@ -34,6 +34,7 @@ from mpi4py import MPI
 from xfem_contact.cases.paper import INCLUSION_CENTRE, inclusion_errors, inclusion_problem
 from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
 from xfem_contact.io.plots import Series, line_plot
+from xfem_contact.io.progress import add_output_arguments, printer
 from xfem_contact.solvers.log_lines import lines_to
 from xfem_contact.solvers.options import LINEAR_PRESETS, preset
 
@@ -91,18 +92,10 @@ def main():
         help="linear solver of the Newton steps: MUMPS (LDL^T of a symmetric Jacobian, "
         "else LU), or GMRES + band multigrid (default %(default)s)",
     )
-    parser.add_argument(
-        "--out",
-        default="results/inclusion_contact",
-        help="folder of the results: VTX, .vtu, PNG, summary.json (default %(default)s)",
-    )
-    parser.add_argument(
-        "--json", default=None, help="path of the JSON summary (default OUT/summary.json)"
-    )
-    parser.add_argument("--quiet", action="store_true", help="print no progress lines")
+    add_output_arguments(parser, "results/inclusion_contact", "VTX, .vtu, PNG, summary.json")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
-    say = (lambda *a: None) if args.quiet or comm.rank else print
+    say = printer(not args.quiet, comm)
     out = pathlib.Path(args.out)
     timings = {}
     start = time.perf_counter()

@@ -42,7 +42,7 @@ from xfem_contact.cases.rotation import (
 )
 from xfem_contact.io.output import write_fields, write_json, write_lips
 from xfem_contact.io.plots import Series, line_plot
-from xfem_contact.io.progress import progress
+from xfem_contact.io.progress import add_output_arguments, printer, progress
 from xfem_contact.mechanics.laws import SLIDING_LAWS
 from xfem_contact.mechanics.loads import load_steps
 from xfem_contact.mechanics.sliding.coupling import PAIRING_UPDATES
@@ -103,15 +103,7 @@ def arguments():
         choices=list(PAIRING_UPDATES),
         help="pair the lips at every Newton iterate or once per load step (default %(default)s)",
     )
-    parser.add_argument(
-        "--out",
-        default="results/rotating_inclusion",
-        help="folder of the results: VTX, .vtu, PNG, summary.json (default %(default)s)",
-    )
-    parser.add_argument(
-        "--json", default=None, help="path of the JSON summary (default OUT/summary.json)"
-    )
-    parser.add_argument("--quiet", action="store_true", help="print no progress lines")
+    add_output_arguments(parser, "results/rotating_inclusion", "VTX, .vtu, PNG, summary.json")
     parser.add_argument("--no-progress", action="store_true", help="show no progress bar")
     return parser.parse_args()
 
@@ -222,7 +214,7 @@ def solve(args, degree: int, say, comm) -> tuple[dict, dict]:
 def main() -> int:
     args = arguments()
     comm = MPI.COMM_WORLD
-    say = (lambda *a: None) if args.quiet or comm.rank else print
+    say = printer(not args.quiet, comm)
     degrees = [1, 2] if args.degree == "both" else [int(args.degree)]
     say(
         f"paper case 3 turned by {args.alpha:.4f} rad in {args.steps} steps: "

@@ -35,6 +35,7 @@ from xfem_contact.cases.solid import sphere_errors, sphere_problem
 from xfem_contact.io.interface_data import interface_point_data
 from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
 from xfem_contact.io.pictures import render_folder
+from xfem_contact.io.progress import add_output_arguments, printer
 from xfem_contact.mechanics.stress import StressFields
 from xfem_contact.solvers.log_lines import lines_to
 
@@ -80,19 +81,11 @@ def main():
         default=0.3,
         help="Coulomb friction coefficient, with --law coulomb (default %(default)s)",
     )
-    parser.add_argument(
-        "--out",
-        default="results/sphere_contact",
-        help="folder of the results: VTX, .vtu, PNG, summary.json (default %(default)s)",
-    )
-    parser.add_argument(
-        "--json", default=None, help="path of the JSON summary (default OUT/summary.json)"
-    )
+    add_output_arguments(parser, "results/sphere_contact", "VTX, .vtu, PNG, summary.json")
     parser.add_argument("--no-png", action="store_true", help="write no pictures")
-    parser.add_argument("--quiet", action="store_true", help="print no progress lines")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
-    say = (lambda *a: None) if args.quiet or comm.rank else print
+    say = printer(not args.quiet, comm)
     out = pathlib.Path(args.out)
     timings = {}
     start = time.perf_counter()

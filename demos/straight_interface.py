@@ -37,6 +37,7 @@ from xfem_contact.cases.paper import straight_interface_exact, straight_interfac
 from xfem_contact.fem.evaluation import evaluate_at_rules, interface_points
 from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
 from xfem_contact.io.plots import Series, line_plot
+from xfem_contact.io.progress import add_output_arguments, printer
 
 # %% [markdown]
 # ## The run
@@ -69,18 +70,10 @@ def main():
         help="cells along y, odd so that the interface stays inside a row of cells "
         "(default %(default)s)",
     )
-    parser.add_argument(
-        "--out",
-        default="results/straight_interface",
-        help="folder of the results: VTX, .vtu, PNG, summary.json (default %(default)s)",
-    )
-    parser.add_argument(
-        "--json", default=None, help="path of the JSON summary (default OUT/summary.json)"
-    )
-    parser.add_argument("--quiet", action="store_true", help="print no progress lines")
+    add_output_arguments(parser, "results/straight_interface", "VTX, .vtu, PNG, summary.json")
     args = parser.parse_args()
     comm = MPI.COMM_WORLD
-    say = (lambda *a: None) if args.quiet or comm.rank else print
+    say = printer(not args.quiet, comm)
     out = pathlib.Path(args.out)
     timings = {}
 

@@ -1,5 +1,6 @@
 """A progress bar over load steps on a terminal only, and log lines printed above it."""
 
+import argparse
 import subprocess
 import sys
 
@@ -53,3 +54,18 @@ def test_no_bar_into_a_pipe():
     assert done.returncode == 0, done.stderr
     assert done.stdout == "line 0\nline 1\nline 2\n"
     assert "piped" not in done.stderr and "\r" not in done.stderr
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_a_scripts_printer_prints_on_the_first_process_when_enabled(capsys, enabled):
+    say = progress_module.printer(enabled)
+    say("a progress line")
+    assert ("a progress line" in capsys.readouterr().out) == enabled
+
+
+def test_output_arguments_give_out_json_and_quiet():
+    parser = argparse.ArgumentParser()
+    progress_module.add_output_arguments(parser, "results/x", "VTX, summary.json")
+    args = parser.parse_args(["--quiet"])
+    assert (args.out, args.json, args.quiet) == ("results/x", None, True)
+    assert "VTX, summary.json" in parser.format_help()

@@ -3,14 +3,16 @@
 :func:`progress` wraps an iterable in a tqdm bar on the first process: a notebook
 widget in Jupyter when ``ipywidgets`` is there, a text bar when stderr is a terminal,
 none otherwise (a pipe or a file gets the plain log lines only), when disabled, or on
-the other processes. :func:`note` prints a line without breaking the bar.
+the other processes. :func:`note` prints a line without breaking the bar; :func:`printer` and
+:func:`add_output_arguments` give scripts their progress lines and output flags.
 """
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import sys
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 
 from mpi4py import MPI
 from tqdm import std
@@ -57,3 +59,26 @@ def progress(
 def note(message: str) -> None:
     """Print ``message`` on stdout above a running text bar (tqdm's ``write``)."""
     std.tqdm.write(message)
+
+
+def printer(enabled: bool = True, comm: MPI.Comm = MPI.COMM_WORLD) -> Callable[..., None]:
+    """``print`` on rank 0 of ``comm`` when ``enabled``, else a function that prints
+    nothing: the progress lines of a script. Not collective."""
+    return print if enabled and comm.rank == 0 else _silent
+
+
+def _silent(*args, **kwargs) -> None:
+    pass
+
+
+def add_output_arguments(parser: argparse.ArgumentParser, out: str, contents: str) -> None:
+    """Add a script's output flags to ``parser``: ``--out`` (the results folder, default
+    ``out``, holding ``contents``), ``--json`` (the summary's path, default
+    OUT/summary.json) and ``--quiet`` (no progress lines)."""
+    parser.add_argument(
+        "--out", default=out, help=f"folder of the results: {contents} (default %(default)s)"
+    )
+    parser.add_argument(
+        "--json", default=None, help="path of the JSON summary (default OUT/summary.json)"
+    )
+    parser.add_argument("--quiet", action="store_true", help="print no progress lines")
