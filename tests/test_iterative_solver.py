@@ -41,7 +41,7 @@ def test_band_and_interpolation():
     """The band holds every multiplier and lies in the cut region; the interpolation
     from the vertex unknowns reproduces a bilinear displacement exactly, in the
     scaled reduced unknowns the solver works with; the set-up keeps no copies it
-    does not need."""
+    does not need (the band's rows once, no ``R^T R`` matrix)."""
     problem = inclusion_problem(10, 2, "sticking")
     problem.petsc_options = preset("iterative")
     problem.solve()
@@ -69,6 +69,15 @@ def test_band_and_interpolation():
     # P_full; no interpolation arrays once the prolongations are built
     assert newton.jacobian.R is None
     assert context.P.getType() == "submatrix" and context._interpolation is None
+    # the band's rows stored once: on the band, and outside it (no band columns there)
+    band_rows = newton.J_r.createSubMatrix(context.band, context.all_columns)
+    stored = [m.getInfo()["nz_used"] for m in (band_rows, context.J_bb, context.J_bo)]
+    assert stored[0] == stored[1] + stored[2] and stored[2] > 0
+    assert not np.any(np.isin(context.band.getIndices(), context.outside.getIndices()))
+    band_rows.destroy()
+    # the start of a solve from w: R selects dofs, R^T R = D^2 is kept as a vector
+    assert newton._projection.getSize() == newton.J_r.getSize()[0]
+    assert np.allclose(newton._projection.getArray(), newton.D.getArray() ** 2, rtol=1e-15)
 
 
 @pytest.mark.parametrize("degree, bound", [(2, 20), (1, 18)])

@@ -221,7 +221,8 @@ class ReducedNewton:
         )
         self.snes.setMonitor(lambda snes, it, norm: this()._monitor(snes, it, norm))
         self.report = NewtonReport()
-        self._projection: PETSc.KSP | None = None
+        #: ``R^T R``'s solver, or its diagonal for an ``R`` that selects dofs
+        self._projection: PETSc.KSP | PETSc.Vec | None = None
 
     def _update(self, y: PETSc.Vec) -> None:
         x = self.w.x.petsc_vec
@@ -305,8 +306,12 @@ class ReducedNewton:
 
     def _start_from_w(self) -> None:
         """``y`` from the current ``w``: the least-squares ``(R^T R)^-1 R^T w`` (exact
-        when ``w`` lies in the range of ``R``, e.g. after a previous solve)."""
-        if self._projection is None:  # R is fixed: R^T R and its solver are made once
+        when ``w`` lies in the range of ``R``, e.g. after a previous solve). For an ``R``
+        that selects dofs ``R^T R = D^2``, a diagonal: no matrix, no Krylov solve."""
+        if self._projection is None and self.jacobian.direct:
+            self._projection = self.D.copy()  # R^T R = D^2, made once
+            self._projection.pointwiseMult(self.D, self.D)
+        elif self._projection is None:  # R is fixed: R^T R and its solver are made once
             RtR = self.R.transposeMatMult(self.R)
             self._projection = PETSc.KSP().create(self.R.getComm())
             self._projection.setOperators(RtR)
@@ -316,7 +321,10 @@ class ReducedNewton:
             RtR.destroy()  # the KSP keeps its reference
         rhs = self.R.createVecRight()
         self.R.multTranspose(self.w.x.petsc_vec, rhs)
-        self._projection.solve(rhs, self.y)
+        if isinstance(self._projection, PETSc.Vec):
+            self.y.pointwiseDivide(rhs, self._projection)
+        else:
+            self._projection.solve(rhs, self.y)
         rhs.destroy()
 
     def final_residual(self) -> float:
