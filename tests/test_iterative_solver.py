@@ -41,7 +41,7 @@ def test_band_and_interpolation():
     """The band holds every multiplier and lies in the cut region; the interpolation
     from the vertex unknowns reproduces a bilinear displacement exactly, in the
     scaled reduced unknowns the solver works with; the set-up keeps no copies it
-    does not need (the band's rows once, no ``R^T R`` matrix)."""
+    does not need (the band's rows once, no ``R^T R`` kept)."""
     problem = inclusion_problem(10, 2, "sticking")
     problem.petsc_options = preset("iterative")
     problem.solve()
@@ -75,9 +75,11 @@ def test_band_and_interpolation():
     assert stored[0] == stored[1] + stored[2] and stored[2] > 0
     assert not np.any(np.isin(context.band.getIndices(), context.outside.getIndices()))
     band_rows.destroy()
-    # the start of a solve from w: R selects dofs, R^T R = D^2 is kept as a vector
-    assert newton._projection.getSize() == newton.J_r.getSize()[0]
-    assert np.allclose(newton._projection.getArray(), newton.D.getArray() ** 2, rtol=1e-15)
+    # the start of a solve from w keeps no R^T R nor its solver, and recovers y from w
+    assert not hasattr(newton, "_projection")
+    y = newton.y.copy()
+    newton._start_from_w()
+    assert np.allclose(newton.y.getArray(), y.getArray(), rtol=0.0, atol=1e-12 * y.norm())
 
 
 @pytest.mark.parametrize("degree, bound", [(2, 20), (1, 18)])
