@@ -20,7 +20,10 @@ Writes ``bench/results/scale3d.{json,md}`` (``--name``: another stem).
 Run: ``python bench/scale3d.py [--sizes 4 8] [--ranks 1] [--direct-max 8]`` (``make
 bench``); the measured studies: ``--sizes 8 16 24 --direct-max 12 --name
 scale3d_large``, ``--sizes 34 --solvers plain iterative --name scale3d_1m`` (over a
-million dofs) and ``--sizes 12 --ranks 1 2 --direct-max 12 --name scale3d_ranks``.
+million dofs; ``scale3d_1m_memory`` the same again), ``--sizes 40 --solvers plain
+iterative --name scale3d_1_6m``, ``--sizes 50 --solvers plain iterative --name scale3d_3m``
+(3.1 M dofs: about 13 GB for the iterative preset) and ``--sizes 12 --ranks 1 2
+--direct-max 12 --name scale3d_ranks``. ``bench/memory3d.py`` shows where the memory goes.
 """
 
 import argparse

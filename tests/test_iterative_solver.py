@@ -41,7 +41,7 @@ def test_band_and_interpolation():
     """The band holds every multiplier and lies in the cut region; the interpolation
     from the vertex unknowns reproduces a bilinear displacement exactly, in the
     scaled reduced unknowns the solver works with; the set-up keeps no copies it
-    does not need."""
+    does not need (the band's rows once, no ``R^T R`` kept)."""
     problem = inclusion_problem(10, 2, "sticking")
     problem.petsc_options = preset("iterative")
     problem.solve()
@@ -69,6 +69,17 @@ def test_band_and_interpolation():
     # P_full; no interpolation arrays once the prolongations are built
     assert newton.jacobian.R is None
     assert context.P.getType() == "submatrix" and context._interpolation is None
+    # the band's rows stored once: on the band, and outside it (no band columns there)
+    band_rows = newton.J_r.createSubMatrix(context.band, context.all_columns)
+    stored = [m.getInfo()["nz_used"] for m in (band_rows, context.J_bb, context.J_bo)]
+    assert stored[0] == stored[1] + stored[2] and stored[2] > 0
+    assert not np.any(np.isin(context.band.getIndices(), context.outside.getIndices()))
+    band_rows.destroy()
+    # the start of a solve from w keeps no R^T R nor its solver, and recovers y from w
+    assert not hasattr(newton, "_projection")
+    y = newton.y.copy()
+    newton._start_from_w()
+    assert np.allclose(newton.y.getArray(), y.getArray(), rtol=0.0, atol=1e-12 * y.norm())
 
 
 @pytest.mark.parametrize("degree, bound", [(2, 20), (1, 18)])

@@ -23,7 +23,8 @@ aggregate, and the multipliers couple only through the band. With the band solve
 exactly and the bulk by the p-multigrid, the Krylov iteration count does not grow with
 the mesh size nor with tiny cuts (measured by ``bench/iterative.py``). The band has
 O(N) unknowns and the coarse level a quarter of the displacements'; the copies made
-are the band's rows, the multipliers' rows ``B`` and the coarse level.
+are the band's rows (once: their band columns ``J_bb``, factored and multiplied, and
+the others ``J_bo``), the multipliers' rows ``B`` and the coarse level.
 
 Sub-solver options live under the PC's prefix plus ``bmg_u_`` (the PCMG, or GAMG for
 degree 1) and ``bmg_band_`` (the band's LU); the rows ``band_u``, ``band_u_degree1`` and
@@ -102,12 +103,16 @@ class BandMultigrid:
         self.ksp_u.solve(r_u, x_u)
         r.restoreSubVector(self.u, r_u)
         x.restoreSubVector(self.u, x_u)
-        self.J_b.mult(x, self.r_b)  # (J x)_b: the band rows only
+        # (J x)_b: the band rows only, J_bb x_b + J_bo x_o (o: the unknowns outside)
+        x_o = x.getSubVector(self.outside)
+        self.J_bo.mult(x_o, self.r_b)
+        x.restoreSubVector(self.outside, x_o)
+        x_b = x.getSubVector(self.band)
+        self.J_bb.multAdd(x_b, self.r_b, self.r_b)
         r_b = r.getSubVector(self.band)
         self.r_b.aypx(-1.0, r_b)
         r.restoreSubVector(self.band, r_b)
         self.ksp_band.solve(self.r_b, self.x_b)
-        x_b = x.getSubVector(self.band)
         x_b.axpy(1.0, self.x_b)
         x.restoreSubVector(self.band, x_b)
 
@@ -142,8 +147,11 @@ class BandMultigrid:
         # the multipliers' rows: on u for degree 1, on all columns for degree 2 (``B P``
         # as ``B_all P_full``: P_full's rows outside u are zero)
         self.B = J.createSubMatrix(multipliers, self.all_columns if self._degree2 else self.u)
+        # the band's rows once: on the band (factored, and multiplied) and outside it
+        outside = np.setdiff1d(np.arange(first, last), self.band.getIndices())
+        self.outside = PETSc.IS().createGeneral(outside.astype(PETSc.IntType), comm=comm)
         self.J_bb = J.createSubMatrix(self.band, self.band)
-        self.J_b = J.createSubMatrix(self.band, self.all_columns)
+        self.J_bo = J.createSubMatrix(self.band, self.outside)
         self.r_b, self.x_b = self.J_bb.createVecLeft(), self.J_bb.createVecRight()
         self.ksp_band = PETSc.KSP().create(comm)
         self.ksp_band.setOptionsPrefix(prefix + PRESETS["band"].prefix)
@@ -152,7 +160,8 @@ class BandMultigrid:
         self.ksp_u.setOptionsPrefix(prefix + PRESETS["band_u"].prefix)
         space = PETSc.NullSpace().create(vectors=self._modes, comm=comm)
         self.P = self.A_c = None
-        self._objects = [self.all_columns, multipliers, self.B, self.J_bb, self.J_b]
+        self._objects = [self.all_columns, multipliers, self.B, self.outside, self.J_bb]
+        self._objects.append(self.J_bo)
         self._objects += [self.r_b, self.x_b, self.ksp_band, self.ksp_u, space]
         if not self._degree2:  # degree 1: GAMG on the augmented block
             self.u_preset = PRESETS["band_u_degree1"]

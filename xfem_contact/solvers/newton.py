@@ -221,7 +221,6 @@ class ReducedNewton:
         )
         self.snes.setMonitor(lambda snes, it, norm: this()._monitor(snes, it, norm))
         self.report = NewtonReport()
-        self._projection: PETSc.KSP | None = None
 
     def _update(self, y: PETSc.Vec) -> None:
         x = self.w.x.petsc_vec
@@ -305,19 +304,20 @@ class ReducedNewton:
 
     def _start_from_w(self) -> None:
         """``y`` from the current ``w``: the least-squares ``(R^T R)^-1 R^T w`` (exact
-        when ``w`` lies in the range of ``R``, e.g. after a previous solve)."""
-        if self._projection is None:  # R is fixed: R^T R and its solver are made once
-            RtR = self.R.transposeMatMult(self.R)
-            self._projection = PETSc.KSP().create(self.R.getComm())
-            self._projection.setOperators(RtR)
-            self._projection.setType("cg")
-            self._projection.getPC().setType("jacobi")
-            self._projection.setTolerances(rtol=1e-14, atol=0.0, max_it=1000)
-            RtR.destroy()  # the KSP keeps its reference
+        when ``w`` lies in the range of ``R``, e.g. after a previous solve), by CG on
+        ``R^T R``; the matrix and its solver are destroyed afterwards (they would stay
+        allocated through the Newton solve, whose peak memory they would add to)."""
+        RtR = self.R.transposeMatMult(self.R)
+        projection = PETSc.KSP().create(self.R.getComm())
+        projection.setOperators(RtR)
+        projection.setType("cg")
+        projection.getPC().setType("jacobi")
+        projection.setTolerances(rtol=1e-14, atol=0.0, max_it=1000)
         rhs = self.R.createVecRight()
         self.R.multTranspose(self.w.x.petsc_vec, rhs)
-        self._projection.solve(rhs, self.y)
-        rhs.destroy()
+        projection.solve(rhs, self.y)
+        for obj in (projection, RtR, rhs):
+            obj.destroy()
 
     def final_residual(self) -> float:
         """``|D R^T F(w)|`` at the current iterate (collective)."""
@@ -382,8 +382,6 @@ class ReducedNewton:
         if self.tip is not None:
             self.tip.destroy()
         self.jacobian_forms.destroy()
-        if self._projection is not None:
-            self._projection.destroy()
 
 
 _GLOBAL, _SAME = PETSc.Mat.InfoType.GLOBAL_SUM, PETSc.Mat.Structure.SAME_NONZERO_PATTERN
