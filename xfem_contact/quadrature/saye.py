@@ -13,13 +13,18 @@ On a box ``U = [lo, hi]`` of the reference cube, with ``psi`` the cell's level s
    valid pairs the one whose certified slopes are steepest wins: the lower bound of
    ``|d psi / d x_k3|`` relative to the bound of ``|grad psi|``, and of
    ``|d psi / d x_k2|`` relative to the face gradient for face functions with zeros
-   (steep slopes keep the roots smooth functions of the outer coordinates).
+   (steep slopes keep the roots smooth functions of the outer coordinates). Scores within
+   :data:`SCORE_TOLERANCE` of the best are ties, won by the steepest mean slope along
+   ``k3`` (the mean of ``|d psi / d x_k3|``'s coefficients relative to the same bound),
+   then by the first pair in a fixed order (``k3`` then ``k2`` ascending), so that a
+   round-off change of the coefficients does not change the rule.
 3. Nested one-dimensional Gauss-Legendre rules (``order`` points per interval): along
    ``k1`` on the intervals between the roots of ``psi`` on the four box edges parallel to
-   ``k1``; at each such point, along ``k2`` between the roots of the two face functions;
-   at each of those, along ``k3`` between the roots of ``psi`` itself. Each innermost
-   interval goes to the side of ``psi`` at its midpoint, and each root ``w`` of the
-   height line gives an interface point with area vector
+   ``k1`` (roots within :data:`BREAK_TOLERANCE` of each other are one); at each such point,
+   along ``k2`` between the roots of the two face functions; at each of those, along
+   ``k3`` between the roots of ``psi`` itself. Each innermost interval goes to the side
+   of ``psi`` at its midpoint, and each root ``w`` of the height line gives an interface
+   point with area vector
    ``grad psi / |d psi / d x_k3|`` (reference coordinates) and the weight of its line.
    Every integrand is smooth between the breakpoints, so the rules converge at the rate
    of Gauss-Legendre rules; all weights are positive.
@@ -77,6 +82,16 @@ __all__ = [
 
 MAX_DEPTH = 6
 """Default number of box subdivision levels of :func:`hex_cut_rules`."""
+
+SCORE_TOLERANCE = 1e-9
+"""Scores of axis choices (slope ratios in ``[0, 1]``) closer than this to the best are
+ties (see the module, step 2): round-off in the level set's coefficients (a few ulps)
+does not change the choice, hence the rule."""
+
+BREAK_TOLERANCE = 1e-12
+"""Breakpoints of the outer lines (levels 1 and 2) closer than this, relative to the line's
+length, are one: the same crossing found on two edges of a symmetric box gives one
+breakpoint, not an interval of a few ulps whose presence round-off decides."""
 
 _PAIRS = [(k3, k2) for k3 in range(3) for k2 in range(3) if k2 != k3]
 
@@ -281,8 +296,9 @@ def _choose_axes(
     size = [np.abs(d).reshape(m, -1) for d in D]
     steepest = np.maximum.reduce([a.max(axis=1) for a in size])
     margin = [a.min(axis=1) / np.where(steepest > 0, steepest, 1.0) for a in size]
+    mean = [a.mean(axis=1) / np.where(steepest > 0, steepest, 1.0) for a in size]
     monotone = [_certain(d)[0] for d in D]
-    best, score = np.full(m, -1), np.full(m, -np.inf)
+    scores = np.full((len(_PAIRS), m), -np.inf)  # -inf: not valid
     for index, (k3, k2) in enumerate(_PAIRS):
         k1 = 3 - k3 - k2
         valid = monotone[k3].copy()
@@ -300,15 +316,21 @@ def _choose_axes(
             pair_score = np.minimum(
                 pair_score, np.where(face_sign | face_zero, np.inf, face_margin)
             )
-        better = valid & (pair_score > score)
-        best = np.where(better, index, best)
-        score = np.where(better, pair_score, score)
-    height, hscore = np.full(m, -1), np.full(m, -np.inf)
-    for k in range(3):
-        better = monotone[k] & (margin[k] > hscore)
-        height = np.where(better, k, height)
-        hscore = np.where(better, margin[k], hscore)
-    return best, height
+        scores[index] = np.where(valid, pair_score, -np.inf)
+    height_scores = np.where(monotone, margin, -np.inf)
+    second = np.array([mean[k3] for k3, _ in _PAIRS])
+    return _first_best(scores, second), _first_best(height_scores, np.array(mean))
+
+
+def _first_best(scores: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """Per column of ``scores`` ``(candidates, m)`` (``-inf``: not valid): of the candidates
+    whose score is within :data:`SCORE_TOLERANCE` of the column's best, those whose
+    ``second`` score (same shape) is within it of theirs, the first; -1 where none is
+    valid."""
+    near = (scores > -np.inf) & (scores >= scores.max(axis=0) - SCORE_TOLERANCE)
+    second = np.where(near, second, -np.inf)
+    near &= second >= second.max(axis=0) - SCORE_TOLERANCE
+    return np.where(near.any(axis=0), near.argmax(axis=0), -1)
 
 
 def _subdivide(cell, lo, hi):
@@ -335,8 +357,11 @@ def _tensor_rule(cell, lo, hi, gauss):
     return np.repeat(cell, wq.size), X.reshape(-1, 3), W.reshape(-1)
 
 
-def _pieces(roots: np.ndarray, lo: np.ndarray, hi: np.ndarray, gauss):
+def _pieces(roots: np.ndarray, lo: np.ndarray, hi: np.ndarray, gauss, merge: bool = False):
     """Gauss rules on the intervals of ``[lo, hi]`` between ``roots`` ``(m, r)`` (NaN: none).
+    With ``merge``, breakpoints closer than :data:`BREAK_TOLERANCE` ``(hi - lo)`` to the
+    previous one (or to ``hi``) are that one: roots equal but for round-off (the same
+    crossing seen from two edges of a symmetric box) make no extra interval.
 
     Returns:
         ``(owner, x, w, piece, mid)``: per point its line, coordinate and weight, and per
@@ -345,6 +370,14 @@ def _pieces(roots: np.ndarray, lo: np.ndarray, hi: np.ndarray, gauss):
     x, w = gauss
     breaks = np.concatenate([lo[:, None], roots, hi[:, None]], axis=1)
     breaks = np.sort(np.where(np.isnan(breaks), hi[:, None], breaks), axis=1)
+    if merge:
+        close = BREAK_TOLERANCE * (hi - lo)
+        for k in range(1, breaks.shape[1] - 1):
+            near = breaks[:, k] - breaks[:, k - 1] <= close
+            breaks[near, k] = breaks[near, k - 1]
+        for k in range(breaks.shape[1] - 2, 0, -1):
+            near = hi - breaks[:, k] <= close
+            breaks[near, k] = hi[near]
     a, length = breaks[:, :-1], np.diff(breaks, axis=1)
     line, k = np.nonzero(length > 0)
     start, size = a[line, k], length[line, k]
@@ -369,7 +402,8 @@ def _box_rules(C, cell, lo, hi, k3, k2, gauss, parts):
         X = np.zeros((m, 3))
         X[:, k2], X[:, k3] = v, w
         roots.append(line_roots(line_coefficients(C1, k1, X), lo[:, k1], hi[:, k1]))
-    box1, u, w1, _, _ = _pieces(np.concatenate(roots, axis=1), lo[:, k1], hi[:, k1], gauss)
+    roots = np.concatenate(roots, axis=1)
+    box1, u, w1, _, _ = _pieces(roots, lo[:, k1], hi[:, k1], gauss, merge=True)
     # level 2: along k2 at each u, breakpoints at the roots of the two face functions
     roots = []
     C1 = C1[box1]
@@ -377,7 +411,8 @@ def _box_rules(C, cell, lo, hi, k3, k2, gauss, parts):
         X = np.zeros((u.size, 3))
         X[:, k1], X[:, k3] = u, end[box1, k3]
         roots.append(line_roots(line_coefficients(C1, k2, X), lo[box1, k2], hi[box1, k2]))
-    p1, v, w2, _, _ = _pieces(np.concatenate(roots, axis=1), lo[box1, k2], hi[box1, k2], gauss)
+    roots = np.concatenate(roots, axis=1)
+    p1, v, w2, _, _ = _pieces(roots, lo[box1, k2], hi[box1, k2], gauss, merge=True)
     box2 = box1[p1]
     W = w1[p1] * w2
     X = np.zeros((v.size, 3))
