@@ -5,7 +5,10 @@ front (named interfaces, their union, the shared level-set Function) and the sam
 ids, so that :class:`~xfem_contact.fem.cutmesh.CutMesh` serves both. The rules come from
 :func:`~xfem_contact.quadrature.cut3d_rules.cut_rules_3d` on the nodal values of the
 interpolated level set: exact sub-tetrahedra for P1 tetrahedra, Saye's rules for Q1/Q2
-hexahedra and P2 tetrahedra. There are no sub-cells to keep: ``geometry`` is ``None``.
+hexahedra and P2 tetrahedra. A level set given as a callable is interpolated as well (the
+cut cells, Saye's boxes and axes are the interpolant's), and with degree 2 Saye's rules
+take their roots and the interface's area vectors from the callable itself: they follow its
+exact zero set. There are no sub-cells to keep: ``geometry`` is ``None``.
 """
 
 from __future__ import annotations
@@ -59,6 +62,8 @@ def cut_state_3d(
     cut_cells = owned[side == 0]
     cut_time, timer = seconds(timer), phase("cut rules")
 
+    exact = maps.exact(cut_cells)  # None for a Function: the interpolant's zero set
+
     def rules_of(rows: np.ndarray):
         return cut_rules_3d(
             cell,
@@ -66,6 +71,7 @@ def cut_state_3d(
             maps.nodal_values(cut_cells[rows]),
             quadrature_degree,
             lambda r, X: maps.jacobian(cut_cells[rows][r], X),
+            exact=None if exact is None else lambda r, X: exact(rows[r], X),
         )
 
     def rules_of_cut_cells():

@@ -54,11 +54,15 @@ class CutMesh:
     Args:
         mesh: A triangle, quadrilateral, tetrahedron or hexahedron mesh (affine,
             distorted or curved), of one cell kind.
-        levelset: A callable ``phi(x)`` (``x`` of shape ``(3, n)``) or a scalar DOLFINx
-            Function. With a callable the interface nodes lie on its exact zero set; with
-            a Function, on its interpolant's (in 3D the rules always follow the
-            interpolant's zero set). Several interfaces: a mapping ``{name:
-            callable}``, cut as one level set ``min_i phi_i`` (checked apart, see
+        levelset: A callable ``phi(x)`` (``x`` of shape ``(3, n)``, read-only on a 3D
+            mesh; one value per point) or a scalar DOLFINx Function. Either is
+            interpolated in ``degree``, and the interpolant classifies the cells. With a
+            callable the interface nodes lie on its exact zero set (in 3D with
+            ``degree=2``: Saye's rules take their roots on every line and the interface's
+            area vectors from the callable, so they integrate its exact sides and zero set;
+            P1/Q1 cuts follow the interpolant); with a Function, on its interpolant's.
+            Several interfaces: a mapping ``{name: callable}``, cut as one level set
+            ``min_i phi_i`` (checked apart, see
             :func:`xfem_contact.geometry.levelset.union`), each with its own measure
             (:meth:`interface_measure`) and rules.
         degree: Lagrange degree (1 or 2) the level set is interpolated in (P1/P2 on
