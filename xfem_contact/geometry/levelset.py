@@ -268,7 +268,7 @@ class CellMaps:
             return None
 
         def phi(rows: np.ndarray, X: np.ndarray) -> np.ndarray:
-            x = self.push_forward(cells[rows], X)
+            x = self._exact_points(cells[rows], X)
             x3 = np.zeros((3, x.shape[0]))
             x3[: self._gdim] = x.T
             values = _values(self._exact, x3, self._gdim)
@@ -283,6 +283,21 @@ class CellMaps:
             return values
 
         return phi
+
+    def _exact_points(self, cells, X) -> npt.NDArray[np.float64]:
+        """``x = F_cell(X)`` where the exact level set is evaluated, shape ``(m, gdim)``: on
+        straight tetrahedra and hexahedra by the closed-form vertex functions, summed node
+        by node, so that a point gets the same bits whatever the other points of the batch
+        (Basix's tabulation of a batch differs by ulps with its size, which the gradient's
+        central differences would amplify into a partition-dependent rule)."""
+        if self._gdim < 3 or self._cmap.degree != 1:
+            return self.push_forward(cells, X)
+        N = _vertex_basis(self.mesh.topology.cell_name(), X)
+        nodes = self._geom[cells]
+        x = N[:, :1] * nodes[:, 0]
+        for i in range(1, N.shape[1]):
+            x += N[:, i : i + 1] * nodes[:, i]
+        return x
 
 
 def union(
