@@ -21,8 +21,8 @@ nodal values):
 ``--levelset function callable`` measures the degree-2 rows twice: with the level set's
 nodal values only (what a P2/Q2 ``Function`` gives) and with the level set as a callable,
 whose exact zero set Saye's rules then follow (roots on every line and the interface's
-gradient from the callable; cells, boxes and axes from the interpolant), as ``CutMesh`` does
-for a callable::
+gradient from the callable; cells, boxes and axes from the interpolant), as
+``CutMesh(..., exact_zero_set=True)`` does::
 
     python bench/cut3d.py --sizes 8 16 32 --kinds tet-P2 hex-Q2 --levelset function callable
 
@@ -172,7 +172,7 @@ def sphere_p2_tets(
 ) -> tuple[float, float, int, float]:
     """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P2 level set,
     Saye's rules on its four hexahedra; with ``callable_`` following the level set's exact
-    zero set, as ``CutMesh`` does for a callable)."""
+    zero set, as ``CutMesh(..., exact_zero_set=True)`` does)."""
     vertices = kuhn_mesh(n, PERTURB)
     J = np.transpose(vertices[:, 1:] - vertices[:, :1], (0, 2, 1))
     detJ = np.abs(np.linalg.det(J))

@@ -1,7 +1,7 @@
 """A short fuzz of random 3D cuts (bench/cut3d.py runs the long one): spheres, ellipsoids,
 tori and planes, a third through a node exactly; every weight positive and the side
 volumes adding up to the cell volume to 1e-12, with no failure; the P2 / Q2 rules also on
-the exact zero sets of the random level sets (as CutMesh makes them for a callable)."""
+the exact zero sets of the random level sets (CutMesh's exact_zero_set)."""
 
 import importlib.util
 import pathlib

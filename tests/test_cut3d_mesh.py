@@ -160,15 +160,16 @@ def test_named_interfaces_and_update():
 @pytest.mark.mpi
 @pytest.mark.parallel
 @pytest.mark.parametrize("cell", list(CELLS_3D))
-@pytest.mark.parametrize("degree", [1, 2])
-def test_one_rank_equals_two(cell, degree):
+@pytest.mark.parametrize("degree, exact", [(1, None), (2, None), (2, True)])
+def test_one_rank_equals_two(cell, degree, exact):
     """Volumes, areas and an assembled vector (gathered, sorted by dof position) of a
-    sphere cut by a P1/Q1 or P2/Q2 level set agree on all ranks and on one to 1e-13 (on
-    tetrahedra with the default compressed rules)."""
+    sphere cut by a P1/Q1 or P2/Q2 level set (also on its exact zero set) agree on all
+    ranks and on one to 1e-13 (on tetrahedra with the default compressed rules)."""
     results = {}
     for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
         mesh = cube(4, cell, comm)
-        cut = CutMesh(mesh, lambda x: np.sqrt(((x - 0.5) ** 2).sum(axis=0)) - R, degree=degree)
+        sphere = lambda x: np.sqrt(((x - 0.5) ** 2).sum(axis=0)) - R  # noqa: E731
+        cut = CutMesh(mesh, sphere, degree=degree, exact_zero_set=exact)
         V = dolfinx.fem.functionspace(mesh, ("Lagrange", 2))
         v = ufl.TestFunction(V)
         x = ufl.SpatialCoordinate(mesh)
@@ -281,30 +282,41 @@ def test_a_bad_callable_is_refused_in_one_line():
 
     for cell in CELLS_3D:
         with pytest.raises(ValueError, match=r"NaN or inf at x = \(.*\), a point of a cut cell"):
-            CutMesh(cube(4, cell), holes, degree=2)
+            CutMesh(cube(4, cell), holes, degree=2, exact_zero_set=True)
+    with pytest.raises(ValueError, match=r"^exact_zero_set: a P1/Q1 cut in 3D follows"):
+        CutMesh(mesh, plane, degree=1, exact_zero_set=True)
+    phi = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 2)))
+    phi.interpolate(plane)
+    with pytest.raises(ValueError, match=r"^exact_zero_set=True: the level set is a Function"):
+        CutMesh(mesh, phi, degree=2, exact_zero_set=True)
 
 
 @pytest.mark.parametrize("cell", list(CELLS_3D))
 def test_a_callable_level_set_is_cut_on_its_exact_zero_set(cell):
     """The sphere as a callable and as its P2/Q2 interpolant (the same cells, boxes and
-    axes): with the callable, Saye's rules follow the exact sphere, and the volume and area
-    errors fall well below the interpolant's (a P1/Q1 cut is the interpolant's either
-    way)."""
+    axes): by default the callable is cut as its interpolant; with ``exact_zero_set``,
+    Saye's rules follow the exact sphere, and the volume and area errors fall well below
+    the interpolant's."""
     mesh = cube(8, cell)
     sphere = lambda x: np.sqrt(((x - 0.5) ** 2).sum(axis=0)) - R  # noqa: E731
     phi = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 2)))
     phi.interpolate(sphere)
     errors = {}
-    for name, levelset in (("function", phi), ("callable", sphere)):
-        cut = CutMesh(mesh, levelset, degree=2)
+    for name, levelset, exact in (
+        ("function", phi, None),
+        ("callable", sphere, None),
+        ("exact", sphere, True),
+    ):
+        cut = CutMesh(mesh, levelset, degree=2, exact_zero_set=exact)
         volume = total(mesh, 1.0 * cut.dx(-1))
         area = total(mesh, 1.0 * cut.dGamma)
-        errors[name] = np.abs([volume / (4 / 3 * np.pi * R**3) - 1, area / (4 * np.pi * R**2) - 1])
+        errors[name] = np.array(
+            [volume / (4 / 3 * np.pi * R**3) - 1, area / (4 * np.pi * R**2) - 1]
+        )
     print(errors)
-    assert (errors["callable"] <= errors["function"] / 4).all(), errors
-    assert (errors["callable"] <= 2e-5).all(), errors
-    ones = [total(mesh, 1.0 * CutMesh(mesh, f, degree=1).dGamma) for f in (sphere, phi)]
-    assert abs(ones[0] - ones[1]) <= 1e-13 * ones[1]
+    np.testing.assert_allclose(errors["callable"], errors["function"], rtol=1e-9)
+    assert (np.abs(errors["exact"]) <= np.abs(errors["function"]) / 4).all(), errors
+    assert (np.abs(errors["exact"]) <= 2e-5).all(), errors
 
 
 def test_level_set_dof_points_do_not_depend_on_the_cell():
