@@ -18,6 +18,14 @@ nodal values):
 
     python bench/cut3d.py --sizes 4 8 16 32
 
+``--levelset function callable`` measures the degree-2 rows twice: with the level set's
+nodal values only (what a P2/Q2 ``Function`` gives) and with the level set as a callable,
+whose exact zero set Saye's rules then follow (roots on every line and the interface's
+gradient from the callable; cells, boxes and axes from the interpolant), as
+``CutMesh(..., exact_zero_set=True)`` does::
+
+    python bench/cut3d.py --sizes 8 16 32 --kinds tet-P2 hex-Q2 --levelset function callable
+
 ``--order k`` sets the Gauss points per interval of Saye's rules (P2 tetrahedra and
 hexahedra; default 4, as ``quadrature_degree = 6`` in ``CutMesh``). ``--min-depth 1``
 splits every sub-box of the P2 tetrahedra's hexahedra that the interface
@@ -26,7 +34,8 @@ may cross before Saye's rules (:func:`~xfem_contact.quadrature.curved_tet_rules.
 The fuzz (``--fuzz N``) cuts ``N`` reference cells per kind by random spheres, ellipsoids,
 tori and planes (a third of them moved to pass exactly through a node) and counts the
 failures: a non-positive weight, side volumes missing the cell volume by more than 1e-12,
-or an exception other than the documented refusal of a singular zero set (counted apart)::
+or an exception other than the documented refusal of a singular zero set (counted apart);
+with ``--levelset callable`` also those of the P2 / Q2 rules on the exact zero sets::
 
     python bench/cut3d.py --fuzz 10000 --sizes
 """
@@ -35,6 +44,7 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import resource
 import time
 
 import basix
@@ -158,10 +168,11 @@ def sphere_tets(n: int, degree: int = 4, shape: str = "sphere") -> tuple[float, 
 
 
 def sphere_p2_tets(
-    n: int, order: int | None = None, shape: str = "sphere"
+    n: int, order: int | None = None, shape: str = "sphere", callable_: bool = False
 ) -> tuple[float, float, int, float]:
     """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P2 level set,
-    Saye's rules on its four hexahedra)."""
+    Saye's rules on its four hexahedra; with ``callable_`` following the level set's exact
+    zero set, as ``CutMesh(..., exact_zero_set=True)`` does)."""
     vertices = kuhn_mesh(n, PERTURB)
     J = np.transpose(vertices[:, 1:] - vertices[:, :1], (0, 2, 1))
     detJ = np.abs(np.linalg.det(J))
@@ -173,8 +184,16 @@ def sphere_p2_tets(
     start = time.process_time()
     side = classify_p2_tets(phi)
     cut = np.flatnonzero(side == 0)
+
+    def exact(rows, X):
+        return SHAPES[shape][0](vertices[cut[rows], 0] + np.einsum("mij,mj->mi", J[cut[rows]], X))
+
     rules = p2_tet_cut_rules(
-        phi[cut], order or ORDER, min_depth=MIN_DEPTH, jacobian=lambda rows, X: J[cut[rows]]
+        phi[cut],
+        order or ORDER,
+        min_depth=MIN_DEPTH,
+        jacobian=lambda rows, X: J[cut[rows]],
+        exact=exact if callable_ else None,
     )
     elapsed = time.process_time() - start
     volume = detJ[side == -1].sum() / 6.0
@@ -184,9 +203,10 @@ def sphere_p2_tets(
 
 
 def sphere_hexes(
-    n: int, degree: int, order: int | None = None, shape: str = "sphere"
+    n: int, degree: int, order: int | None = None, shape: str = "sphere", callable_: bool = False
 ) -> tuple[float, float, int, float]:
-    """Volume, area, cut-cell count and CPU seconds on ``n^3`` hexahedra (Q``degree``)."""
+    """Volume, area, cut-cell count and CPU seconds on ``n^3`` hexahedra (Q``degree``; with
+    ``callable_`` and degree 2, following the level set's exact zero set)."""
     h = 1.0 / n
     element = basix.create_element(
         basix.ElementFamily.P, basix.CellType.hexahedron, degree, basix.LagrangeVariant.gll_warped
@@ -196,7 +216,18 @@ def sphere_hexes(
     side = classify_hexes(phi, degree)
     cut = np.flatnonzero(side == 0)
     J = np.broadcast_to(h * np.eye(3), (cut.size, 3, 3))
-    rules = hex_cut_rules(phi[cut], degree, order or ORDER, jacobian=lambda rows, X: J[rows])
+    corners = origins(n)[cut]
+
+    def exact(rows, X):
+        return SHAPES[shape][0](corners[rows] + h * X)
+
+    rules = hex_cut_rules(
+        phi[cut],
+        degree,
+        order or ORDER,
+        jacobian=lambda rows, X: J[rows],
+        exact=exact if callable_ and degree == 2 else None,
+    )
     elapsed = time.process_time() - start
     volume = ((side == -1).sum() + rules.minus.weights.sum()) * h**3
     area = rules.interface.weights.sum() * h**3
@@ -227,9 +258,10 @@ def random_level_set(rng: np.random.Generator):
     return torus
 
 
-def fuzz_cells(kind: str, count: int, seed: int = 0) -> dict[str, int]:
+def fuzz_cells(kind: str, count: int, seed: int = 0, callable_: bool = False) -> dict[str, int]:
     """Failures of the rules of ``count`` random cuts of one reference cell of ``kind``:
-    ``{"cases", "cut", "weights", "volume", "errors", "refused", "reduced"}``."""
+    ``{"cases", "cut", "weights", "volume", "errors", "refused", "reduced"}``; with
+    ``callable_`` (P2 tetrahedra, Q2 hexahedra), of the rules on the exact zero sets."""
     rng = np.random.default_rng(seed)
     cell = {
         "tet-P1": ("tetrahedron", 1),
@@ -243,11 +275,26 @@ def fuzz_cells(kind: str, count: int, seed: int = 0) -> dict[str, int]:
         cell[1],
         basix.LagrangeVariant.gll_warped,
     )
-    phi = np.array([random_level_set(rng)(element.points) for _ in range(count)])
+    functions = [random_level_set(rng) for _ in range(count)]
+    phi = np.array([f(element.points) for f in functions])
     through = rng.random(count) < 1 / 3
     node = rng.integers(0, element.points.shape[0], size=count)
-    phi[through] -= phi[through, node[through], None]  # zero at a node, exactly
+    shift = np.where(through, phi[np.arange(count), node], 0.0)
+    phi[through] -= shift[through, None]  # zero at a node, exactly
     phi[through, node[through]] = 0.0
+
+    def exact_of(cells: np.ndarray):
+        """The exact level sets of ``cells`` as a function of ``(rows, X)``."""
+
+        def exact(rows, X):
+            values = np.empty(rows.size)
+            for row in np.unique(rows):
+                at = rows == row
+                values[at] = functions[cells[row]](X[at]) - shift[cells[row]]
+            return values
+
+        return exact if callable_ and kind in ("tet-P2", "hex-Q2") else None
+
     volume = 1.0 / 6.0 if cell[0] == "tetrahedron" else 1.0
     counts = dict.fromkeys(("cases", "cut", "weights", "volume", "errors", "refused", "reduced"), 0)
     counts["cases"] = count
@@ -255,11 +302,12 @@ def fuzz_cells(kind: str, count: int, seed: int = 0) -> dict[str, int]:
     for start in range(0, count, batch):
         rows = np.arange(start, min(start + batch, count))
         try:
-            _check_batch(kind, phi[rows], volume, counts)
+            _check_batch(kind, phi[rows], volume, counts, exact_of(rows))
         except Exception:  # noqa: BLE001 - find the failing cells one by one
             for row in rows:
+                one = rows[row - start : row - start + 1]
                 try:
-                    _check_batch(kind, phi[row : row + 1], volume, counts)
+                    _check_batch(kind, phi[one], volume, counts, exact_of(one))
                 except ValueError as error:
                     counts["refused" if "singular point" in str(error) else "errors"] += 1
                 except Exception:  # noqa: BLE001 - a fuzz counts every failure
@@ -267,8 +315,11 @@ def fuzz_cells(kind: str, count: int, seed: int = 0) -> dict[str, int]:
     return counts
 
 
-def _check_batch(kind: str, phi: np.ndarray, volume: float, counts: dict[str, int]) -> None:
-    """Rules of cells ``phi``; adds their failures to ``counts`` (raises before adding)."""
+def _check_batch(
+    kind: str, phi: np.ndarray, volume: float, counts: dict[str, int], exact=None
+) -> None:
+    """Rules of cells ``phi`` (following ``exact`` if given); adds their failures to
+    ``counts`` (raises before adding)."""
     n = phi.shape[0]
     if kind == "tet-P1":
         geometry = cut_tets(phi)
@@ -279,7 +330,10 @@ def _check_batch(kind: str, phi: np.ndarray, volume: float, counts: dict[str, in
         ]
         reduced = 0
     else:
-        found = p2_tet_cut_rules(phi) if kind == "tet-P2" else hex_cut_rules(phi, int(kind[-1]))
+        if kind == "tet-P2":
+            found = p2_tet_cut_rules(phi, exact=exact)
+        else:
+            found = hex_cut_rules(phi, int(kind[-1]), exact=exact)
         rules = [found.minus, found.plus, found.interface]
         reduced = found.reduced.size
     minus, plus = (np.bincount(r.point_rows, r.weights, minlength=n) for r in rules[:2])
@@ -331,6 +385,14 @@ def main() -> None:
         help="forced box splits of the P2 tetrahedra's rules (p2_tet_cut_rules min_depth)",
     )
     parser.add_argument(
+        "--levelset",
+        nargs="+",
+        default=["function"],
+        choices=["function", "callable"],
+        help="the degree-2 level set as its interpolant's nodal values (a P2/Q2 Function) "
+        "and/or as a callable (rules on its exact zero set); degree 1 cuts the interpolant",
+    )
+    parser.add_argument(
         "--order",
         type=int,
         default=4,
@@ -339,29 +401,37 @@ def main() -> None:
     args = parser.parse_args()
     global PERTURB, MIN_DEPTH, ORDER
     PERTURB, MIN_DEPTH, ORDER = args.perturb, args.min_depth, args.order
-    for kind in args.kinds if args.fuzz else []:
+    for kind, levelset in itertools.product(args.kinds if args.fuzz else [], args.levelset):
+        if levelset == "callable" and kind in ("tet-P1", "hex-Q1"):
+            continue
         start = time.perf_counter()
-        counts = fuzz_cells(kind, args.fuzz)
+        counts = fuzz_cells(kind, args.fuzz, callable_=levelset == "callable")
         failures = counts["weights"] + counts["volume"] + counts["errors"]
+        label = f" ({levelset})" if kind in ("tet-P2", "hex-Q2") else ""
         print(
-            f"fuzz {kind}: {counts} -> {failures} failure(s) ({time.perf_counter() - start:.1f} s)"
+            f"fuzz {kind}{label}: {counts} -> {failures} failure(s) "
+            f"({time.perf_counter() - start:.1f} s)"
         )
     runs = {
-        "tet-P1": sphere_tets,
-        "tet-P2": sphere_p2_tets,
-        "hex-Q1": lambda n, shape: sphere_hexes(n, 1, shape=shape),
-        "hex-Q2": lambda n, shape: sphere_hexes(n, 2, shape=shape),
+        "tet-P1": lambda n, shape, c: sphere_tets(n, shape=shape),
+        "tet-P2": lambda n, shape, c: sphere_p2_tets(n, shape=shape, callable_=c),
+        "hex-Q1": lambda n, shape, c: sphere_hexes(n, 1, shape=shape),
+        "hex-Q2": lambda n, shape, c: sphere_hexes(n, 2, shape=shape, callable_=c),
     }
-    for shape, kind in itertools.product(args.shapes, args.kinds if args.sizes else []):
+    cases = itertools.product(args.shapes, args.kinds if args.sizes else [], args.levelset)
+    for shape, kind, levelset in cases:
+        if levelset == "callable" and kind in ("tet-P1", "hex-Q1"):
+            continue  # degree 1: the interpolant's cut either way
         _, exact_volume, exact_area = SHAPES[shape]
-        print(f"\n{kind}: {shape}")
+        label = f" ({levelset})" if kind in ("tet-P2", "hex-Q2") else ""
+        print(f"\n{kind}: {shape}{label}")
         print(
             f"{'n':>5} {'cut cells':>10} {'volume err':>11} {'rate':>5} {'area err':>11} "
             f"{'rate':>5} {'cpu s':>7}"
         )
         previous = None
         for n in args.sizes:
-            volume, area, ncut, elapsed = runs[kind](n, shape=shape)
+            volume, area, ncut, elapsed = runs[kind](n, shape, levelset == "callable")
             ev = abs(volume - exact_volume) / exact_volume
             ea = abs(area - exact_area) / exact_area
             rates = ["", ""]
@@ -377,6 +447,8 @@ def main() -> None:
                 flush=True,
             )
             previous = (n, ev, ea)
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"\npeak memory {peak:.0f} MB")
 
 
 if __name__ == "__main__":

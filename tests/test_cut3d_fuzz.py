@@ -1,6 +1,7 @@
 """A short fuzz of random 3D cuts (bench/cut3d.py runs the long one): spheres, ellipsoids,
 tori and planes, a third through a node exactly; every weight positive and the side
-volumes adding up to the cell volume to 1e-12, with no failure."""
+volumes adding up to the cell volume to 1e-12, with no failure; the P2 / Q2 rules also on
+the exact zero sets of the random level sets (CutMesh's exact_zero_set)."""
 
 import importlib.util
 import pathlib
@@ -14,10 +15,18 @@ _spec.loader.exec_module(cut3d)
 
 
 @pytest.mark.parametrize(
-    "kind, count", [("tet-P1", 2000), ("hex-Q1", 1000), ("hex-Q2", 500), ("tet-P2", 500)]
+    "kind, count, exact",
+    [
+        ("tet-P1", 2000, False),
+        ("hex-Q1", 1000, False),
+        ("hex-Q2", 500, False),
+        ("tet-P2", 500, False),
+        ("hex-Q2", 150, True),
+        ("tet-P2", 150, True),
+    ],
 )
-def test_fuzz(kind, count):
-    counts = cut3d.fuzz_cells(kind, count, seed=7)
-    print(kind, counts)
+def test_fuzz(kind, count, exact):
+    counts = cut3d.fuzz_cells(kind, count, seed=7, callable_=exact)
+    print(kind, exact, counts)
     assert counts["cut"] > count // 4  # the cases do cut cells
     assert counts["weights"] == counts["volume"] == counts["errors"] == 0, counts

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 from cut3d_reference import box_edges, box_planes, box_vertices, clip, exponents, simplex_moments
 
-from xfem_contact.quadrature.saye import classify_hexes, hex_cut_rules
+from xfem_contact.geometry.tensor_levelset import coefficients
+from xfem_contact.quadrature.saye import classify_hexes, hex_cut_rules, saye_points
 
 EXPS = exponents(4)
 UNIT = box_planes((0, 0, 0), (1, 1, 1)), box_vertices((0, 0, 0), (1, 1, 1)), box_edges()
@@ -139,6 +140,26 @@ def test_sphere_q2_converges_at_rate_4():
     assert (rates[-1] >= 3.8).all(), rates
     # at or below the isoparametric peer on hexes: 5.5e-5 (1/16), 3.7e-6 (1/32)
     assert errors[2, 0] <= 5.5e-5 and errors[3, 0] <= 3.7e-6
+
+
+def test_round_off_does_not_change_the_rules():
+    """Spheres centred on the cube's diagonal (or its x = y plane) give axis choices of
+    equal scores; a few ulps of change in the level set's coefficients (as a different
+    cell numbering gives) must keep the chosen axes, hence the rules to round-off."""
+    rng = np.random.default_rng(1)
+    a, b = rng.uniform(-0.8, 1.8, size=(2, 200))
+    centres = np.stack([a, a, np.where(np.arange(200) % 2, a, b)], axis=1)
+    radii = rng.uniform(0.2, 1.5, size=200)
+    phi = np.linalg.norm(nodes(2)[None] - centres[:, None], axis=2) - radii[:, None]
+    phi = phi[classify_hexes(phi, 2) == 0]
+    C = coefficients(phi, 2)
+    ulps = rng.integers(-4, 5, size=C.shape) * np.finfo(float).eps
+    rules, moved = saye_points(C, 3), saye_points(C * (1.0 + ulps), 3)
+    for side in ("minus", "plus", "interface"):
+        ours, theirs = getattr(rules, side), getattr(moved, side)
+        assert np.array_equal(ours[0], theirs[0]), side  # the same points per cell
+        for column, other in zip(ours[1:], theirs[1:], strict=True):
+            np.testing.assert_allclose(column, other, rtol=0, atol=1e-12, err_msg=side)
 
 
 def test_singular_point_refused():

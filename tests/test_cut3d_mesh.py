@@ -160,15 +160,16 @@ def test_named_interfaces_and_update():
 @pytest.mark.mpi
 @pytest.mark.parallel
 @pytest.mark.parametrize("cell", list(CELLS_3D))
-@pytest.mark.parametrize("degree", [1, 2])
-def test_one_rank_equals_two(cell, degree):
+@pytest.mark.parametrize("degree, exact", [(1, None), (2, None), (2, True)])
+def test_one_rank_equals_two(cell, degree, exact):
     """Volumes, areas and an assembled vector (gathered, sorted by dof position) of a
-    sphere cut by a P1/Q1 or P2/Q2 level set agree on all ranks and on one to 1e-13 (on
-    tetrahedra with the default compressed rules)."""
+    sphere cut by a P1/Q1 or P2/Q2 level set (also on its exact zero set) agree on all
+    ranks and on one to 1e-13 (on tetrahedra with the default compressed rules)."""
     results = {}
     for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
         mesh = cube(4, cell, comm)
-        cut = CutMesh(mesh, lambda x: np.sqrt(((x - 0.5) ** 2).sum(axis=0)) - R, degree=degree)
+        sphere = lambda x: np.sqrt(((x - 0.5) ** 2).sum(axis=0)) - R  # noqa: E731
+        cut = CutMesh(mesh, sphere, degree=degree, exact_zero_set=exact)
         V = dolfinx.fem.functionspace(mesh, ("Lagrange", 2))
         v = ufl.TestFunction(V)
         x = ufl.SpatialCoordinate(mesh)
@@ -251,8 +252,71 @@ def test_bad_input_is_refused_in_one_line():
     with pytest.raises(ValueError, match="^tangent: cracks are cut on triangle") as error:
         CutMesh(mesh, plane, tangent=plane)
     vector = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (3,))))
-    with pytest.raises(InterfaceError, match="must be scalar"):
+    with pytest.raises(InterfaceError, match=r"levelset: a Function of value shape \(3,\) is"):
         CutMesh(mesh, vector)
+    other = dolfinx.fem.Function(dolfinx.fem.functionspace(cube(2, "hexahedron"), ("P", 2)))
+    with pytest.raises(InterfaceError, match="levelset: the Function lives on another mesh"):
+        CutMesh(mesh, other)
+
+
+def test_a_bad_callable_is_refused_in_one_line():
+    """2D callables on a 3D mesh where they can be told (one that reads x[0], x[1] only is
+    a cylinder, a valid 3D level set), and a callable that is finite at the nodes but not
+    at the points of a cut cell where the rules evaluate it."""
+    mesh = cube(2, "tetrahedron")
+    hint = r"failed on points x of shape \(3, \d+\) \(a 3D mesh: x\[0\], x\[1\], x\[2\]"
+    cases = [
+        (lambda x: np.hypot(*x) - 0.5, hint + r".*read-only\): output array is read-only"),
+        (lambda x: (lambda a, b: a + b - 1.0)(*x), hint),
+        (lambda x: x.T @ np.array([1.0, 1.0]) - 1.0, hint),
+        (lambda x: x[2:] - 0.3, r"one value per point, shape \(\d+,\) .*returned shape \(1, "),
+    ]
+    for levelset, message in cases:
+        with pytest.raises(ValueError, match=message) as error:
+            CutMesh(mesh, levelset, degree=2)
+        assert "\n" not in str(error.value)
+
+    def holes(x):  # finite on the grid of spacing 1/8 (the P2 nodes of cube(4)), NaN between
+        on_grid = np.abs(8 * x[0] - np.round(8 * x[0])) < 1e-9
+        return np.where(on_grid, x[2] - 0.3, np.nan)
+
+    for cell in CELLS_3D:
+        with pytest.raises(ValueError, match=r"NaN or inf at x = \(.*\), a point of a cut cell"):
+            CutMesh(cube(4, cell), holes, degree=2, exact_zero_set=True)
+    with pytest.raises(ValueError, match=r"^exact_zero_set: a P1/Q1 cut in 3D follows"):
+        CutMesh(mesh, plane, degree=1, exact_zero_set=True)
+    phi = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 2)))
+    phi.interpolate(plane)
+    with pytest.raises(ValueError, match=r"^exact_zero_set=True: the level set is a Function"):
+        CutMesh(mesh, phi, degree=2, exact_zero_set=True)
+
+
+@pytest.mark.parametrize("cell", list(CELLS_3D))
+def test_a_callable_level_set_is_cut_on_its_exact_zero_set(cell):
+    """The sphere as a callable and as its P2/Q2 interpolant (the same cells, boxes and
+    axes): by default the callable is cut as its interpolant; with ``exact_zero_set``,
+    Saye's rules follow the exact sphere, and the volume and area errors fall well below
+    the interpolant's."""
+    mesh = cube(8, cell)
+    sphere = lambda x: np.sqrt(((x - 0.5) ** 2).sum(axis=0)) - R  # noqa: E731
+    phi = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 2)))
+    phi.interpolate(sphere)
+    errors = {}
+    for name, levelset, exact in (
+        ("function", phi, None),
+        ("callable", sphere, None),
+        ("exact", sphere, True),
+    ):
+        cut = CutMesh(mesh, levelset, degree=2, exact_zero_set=exact)
+        volume = total(mesh, 1.0 * cut.dx(-1))
+        area = total(mesh, 1.0 * cut.dGamma)
+        errors[name] = np.array(
+            [volume / (4 / 3 * np.pi * R**3) - 1, area / (4 * np.pi * R**2) - 1]
+        )
+    print(errors)
+    np.testing.assert_allclose(errors["callable"], errors["function"], rtol=1e-9)
+    assert (np.abs(errors["exact"]) <= np.abs(errors["function"]) / 4).all(), errors
+    assert (np.abs(errors["exact"]) <= 2e-5).all(), errors
 
 
 def test_level_set_dof_points_do_not_depend_on_the_cell():

@@ -129,6 +129,23 @@ def test_sphere_p2():
     assert rates[0] >= 3.8  # volume; the area's rate on this mesh is 3.0 (docs/cut3d.md)
 
 
+def test_round_off_does_not_change_the_rules():
+    """Spheres centred on the line x = y = z are symmetric in the tetrahedron's hexahedra:
+    a few ulps of change in the nodal values (as a different cell numbering gives) keep
+    the rules to round-off (the same points per cell, at the same places)."""
+    rng = np.random.default_rng(2)
+    a, radii = rng.uniform(-0.8, 1.5, size=200), rng.uniform(0.2, 1.5, size=200)
+    phi = np.linalg.norm(nodes()[None] - a[:, None, None], axis=2) - radii[:, None]
+    phi = phi[classify_p2_tets(phi) == 0]
+    ulps = rng.integers(-4, 5, size=phi.shape) * np.finfo(float).eps
+    rules, moved = p2_tet_cut_rules(phi, 3), p2_tet_cut_rules(phi * (1.0 + ulps), 3)
+    for side in ("minus", "plus", "interface"):
+        ours, theirs = getattr(rules, side), getattr(moved, side)
+        assert np.array_equal(ours.offsets, theirs.offsets), side
+        np.testing.assert_allclose(ours.points, theirs.points, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(ours.weights, theirs.weights, rtol=0, atol=1e-12)
+
+
 def test_singular_point_refused():
     x = nodes() - 0.2
     phi = (x[:, 0] ** 2 + x[:, 1] ** 2 - x[:, 2] ** 2)[None]

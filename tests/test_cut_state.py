@@ -9,6 +9,7 @@ import ast
 import dataclasses
 import pathlib
 
+import dolfinx.fem
 import dolfinx.mesh
 import numpy as np
 import pytest
@@ -138,3 +139,25 @@ def test_one_crack_path():
     assert fracture.GrowthPath.__name__ == "GrowthPath"
     with pytest.warns(DeprecationWarning, match="GrowthPath"):
         assert fracture.CrackPath is fracture.GrowthPath
+
+
+def test_exact_zero_set_in_2d():
+    """In 2D a callable is cut on its exact zero set by default (interface nodes on it);
+    ``exact_zero_set=False`` cuts it as its interpolant, as a Function is cut."""
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 6, 6)
+    circle = lambda x: np.hypot(x[0] - 0.5, x[1] - 0.5) - 0.3  # noqa: E731
+    phi = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 2)))
+    phi.interpolate(circle)
+
+    def length(cut):
+        form = xfem_contact.form(1.0 * cut.dGamma)
+        return mesh.comm.allreduce(dolfinx.fem.assemble_scalar(form))
+
+    exact = 2 * np.pi * 0.3
+    default, interpolant, function = (
+        length(CutMesh(mesh, levelset, degree=2, exact_zero_set=flag))
+        for levelset, flag in ((circle, None), (circle, False), (phi, None))
+    )
+    print(default - exact, interpolant - exact, function - exact)
+    assert abs(interpolant - function) <= 1e-12 * exact
+    assert abs(default - exact) < abs(function - exact) / 4, (default, function, exact)

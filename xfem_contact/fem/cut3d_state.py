@@ -5,7 +5,10 @@ front (named interfaces, their union, the shared level-set Function) and the sam
 ids, so that :class:`~xfem_contact.fem.cutmesh.CutMesh` serves both. The rules come from
 :func:`~xfem_contact.quadrature.cut3d_rules.cut_rules_3d` on the nodal values of the
 interpolated level set: exact sub-tetrahedra for P1 tetrahedra, Saye's rules for Q1/Q2
-hexahedra and P2 tetrahedra. There are no sub-cells to keep: ``geometry`` is ``None``.
+hexahedra and P2 tetrahedra. A level set given as a callable is interpolated as well (the
+cut cells, Saye's boxes and axes are the interpolant's); with ``exact_zero_set`` and degree
+2, Saye's rules take their roots and the interface's area vectors from the callable itself:
+they follow its exact zero set. There are no sub-cells to keep: ``geometry`` is ``None``.
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ def cut_state_3d(
     degree: int,
     quadrature_degree: int,
     previous: CutState | None,
+    exact_zero_set: bool = False,
 ) -> CutState:
     """The cut of a 3D ``mesh`` by ``levelset`` following ``previous`` (the first cut for
     ``None``). Arguments as :class:`~xfem_contact.fem.cutmesh.CutMesh`'s. Collective.
@@ -59,6 +63,8 @@ def cut_state_3d(
     cut_cells = owned[side == 0]
     cut_time, timer = seconds(timer), phase("cut rules")
 
+    exact = maps.exact(cut_cells) if exact_zero_set else None  # None for a Function too
+
     def rules_of(rows: np.ndarray):
         return cut_rules_3d(
             cell,
@@ -66,6 +72,7 @@ def cut_state_3d(
             maps.nodal_values(cut_cells[rows]),
             quadrature_degree,
             lambda r, X: maps.jacobian(cut_cells[rows][r], X),
+            exact=None if exact is None else lambda r, X: exact(rows[r], X),
         )
 
     def rules_of_cut_cells():

@@ -107,6 +107,7 @@ def cut_state(
     quadrature_degree: int,
     tip_points: int,
     previous: CutState | None,
+    exact_zero_set: bool = True,
 ) -> CutState:
     """The cut of ``mesh`` by ``levelset`` (and a crack's ``tangent``), following
     ``previous`` (its interface names, its level-set Functions, its revision + 1);
@@ -129,7 +130,10 @@ def cut_state(
     cut_cells = owned[side == 0]
     ncut = cut_cells.size
     geometry = cut.subtriangulate(
-        cell_name, degree, maps.nodal_values(cut_cells), exact=maps.exact(cut_cells)
+        cell_name,
+        degree,
+        maps.nodal_values(cut_cells),
+        exact=maps.exact(cut_cells) if exact_zero_set else None,
     )
     cut_time, timer = seconds(timer), phase("cut rules")
     q = quadrature_degree

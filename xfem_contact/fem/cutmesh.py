@@ -54,11 +54,12 @@ class CutMesh:
     Args:
         mesh: A triangle, quadrilateral, tetrahedron or hexahedron mesh (affine,
             distorted or curved), of one cell kind.
-        levelset: A callable ``phi(x)`` (``x`` of shape ``(3, n)``) or a scalar DOLFINx
-            Function. With a callable the interface nodes lie on its exact zero set; with
-            a Function, on its interpolant's (in 3D the rules always follow the
-            interpolant's zero set). Several interfaces: a mapping ``{name:
-            callable}``, cut as one level set ``min_i phi_i`` (checked apart, see
+        levelset: A callable ``phi(x)`` (``x`` of shape ``(3, n)``, read-only on a 3D
+            mesh; one value per point) or a scalar DOLFINx Function. Either is
+            interpolated in ``degree``, and the interpolant classifies the cells; the cut
+            follows the callable's exact zero set or the interpolant's (see
+            ``exact_zero_set``). Several interfaces: a mapping ``{name: callable}``, cut
+            as one level set ``min_i phi_i`` (checked apart, see
             :func:`xfem_contact.geometry.levelset.union`), each with its own measure
             (:meth:`interface_measure`) and rules.
         degree: Lagrange degree (1 or 2) the level set is interpolated in (P1/P2 on
@@ -91,6 +92,16 @@ class CutMesh:
             :attr:`rules` stay the full rules. A
             (measure, degree) is compressed once per cut, when a form first needs it,
             timed as DOLFINx's ``"xfem_contact: rule compression"``.
+        exact_zero_set: With a callable level set, whether the cut follows its exact zero
+            set (``True``) or its interpolant's (``False``, as for a Function). In 2D the
+            interface nodes then lie on the callable's zero set; in 3D (``degree=2``),
+            Saye's rules take the roots on their lines, the sides of their height
+            intervals and the interface's area vectors from the callable, so they integrate
+            its exact sides and zero set. The forms' :attr:`normal` and the enrichment stay
+            the interpolant's, so that a surface integral of the exact zero set meets a
+            normal of the interpolant's: on a 3D sphere under hydrostatic pressure the
+            contact pressure is then no longer uniform to round-off. Default: ``True`` in
+            2D, ``False`` in 3D. ``True`` needs a callable, and in 3D ``degree=2``.
 
     Example:
         >>> cut = CutMesh(mesh, lambda x: np.hypot(x[0], x[1]) - 0.5)
@@ -106,6 +117,7 @@ class CutMesh:
         tangent: LevelSetCallable | dolfinx.fem.Function | None = None,
         tip_points: int = 24,
         compression: bool | None = None,
+        exact_zero_set: bool | None = None,
     ):
         tdim = mesh.topology.dim
         kinds = [t.name for t in mesh.topology.entity_types[tdim]]
@@ -118,6 +130,14 @@ class CutMesh:
             raise ValueError(
                 f"mesh: cells of kind {kinds[0]!r} cannot be cut; valid: {list(CELLS)}"
             )
+        if exact_zero_set and tdim == 3 and degree == 1:
+            raise ValueError(
+                "exact_zero_set: a P1/Q1 cut in 3D follows the level set's interpolant (planar "
+                "on tetrahedra); valid: degree=2, or exact_zero_set=False"
+            )
+        #: Whether a callable level set is cut on its exact zero set (see the constructor)
+        self.exact_zero_set = tdim == 2 if exact_zero_set is None else bool(exact_zero_set)
+        self._exact_required = bool(exact_zero_set)
         if tdim == 3 and tangent is not None:
             raise ValueError("tangent: cracks are cut on triangle and quadrilateral meshes only")
         if quadrature_degree is None:
@@ -170,11 +190,21 @@ class CutMesh:
                 "tangent: a crack's cut takes its tangential level set psi (the crack "
                 "is phi = 0 where psi < 0); an interface's none"
             )
+        if self._exact_required and isinstance(levelset, dolfinx.fem.Function):
+            raise ValueError(
+                "exact_zero_set=True: the level set is a Function (nodal values, no exact "
+                "zero set); valid: a callable level set, or exact_zero_set=False"
+            )
+        exact = self.exact_zero_set
         if self.mesh.topology.dim == 3:
             args3 = (self.degree, self.quadrature_degree)
-            return cut_state_3d(self.mesh, levelset, *args3, previous=previous)
+            return cut_state_3d(
+                self.mesh, levelset, *args3, previous=previous, exact_zero_set=exact
+            )
         args = (self.degree, self.quadrature_degree, self.tip_points)
-        return cut_state(self.mesh, levelset, tangent, *args, previous=previous)
+        return cut_state(
+            self.mesh, levelset, tangent, *args, previous=previous, exact_zero_set=exact
+        )
 
     def _install(self, state: CutState) -> None:
         """Make ``state`` the current cut and rebuild what is derived from it."""

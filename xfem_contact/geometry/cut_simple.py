@@ -24,18 +24,12 @@ coordinates of the cell handed in. The side polygons are then triangulated by
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
-import numpy.typing as npt
 
 from xfem_contact.geometry.cut_subcells import side_triangles
 from xfem_contact.geometry.cut_topology import CellData, edge_coefficients
+from xfem_contact.geometry.exact_lines import ExactLevelSet
 from xfem_contact.geometry.roots import bracketed_root, newton_bracketed
-
-ExactLevelSet = Callable[[npt.NDArray[np.int64], npt.NDArray[np.float64]], npt.NDArray[np.float64]]
-"""``exact(rows (m,), X (m, 2)) -> (m,)``: the exact level set at reference points
-``X`` of the cut cells ``rows`` (row numbers of ``phi``)."""
 
 _EPS = np.finfo(np.float64).eps
 

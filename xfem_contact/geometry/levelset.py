@@ -50,8 +50,13 @@ ZERO_TOLERANCE = 64 * np.finfo(np.float64).eps
 
 
 def _values(levelset: LevelSetCallable, x: np.ndarray, gdim: int = 2) -> np.ndarray:
-    """``levelset(x)`` checked: one float per point of ``x`` (shape ``(3, n)``)."""
-    hint = "" if gdim < 3 else " (a 3D mesh: x[0], x[1], x[2] are x, y, z)"
+    """``levelset(x)`` checked: one float per point of ``x`` (shape ``(3, n)``). On a 3D mesh
+    ``x`` is passed read-only: a 2D callable that writes into ``x[2]`` (``np.hypot(*x)``
+    takes it for its output) fails instead of returning a cylinder's values."""
+    hint = "" if gdim < 3 else " (a 3D mesh: x[0], x[1], x[2] are x, y, z; x is read-only)"
+    if gdim == 3:
+        x = x.view()
+        x.flags.writeable = False
     try:
         values = np.asarray(levelset(x), dtype=np.float64)
     except (TypeError, ValueError, IndexError) as error:
@@ -121,9 +126,16 @@ def interpolate(
     phi = dolfinx.fem.Function(V, name="levelset")
     if isinstance(levelset, dolfinx.fem.Function):
         if levelset.function_space.mesh is not mesh:
-            raise ValueError("The level-set Function lives on another mesh")
+            raise ValueError(
+                "levelset: the Function lives on another mesh; valid: a scalar Function on "
+                "the cut mesh, or a callable phi(x)"
+            )
         if levelset.function_space.value_size != 1:
-            raise ValueError("The level-set Function must be scalar")
+            shape = levelset.function_space.value_shape
+            raise ValueError(
+                f"levelset: a Function of value shape {tuple(shape)} is not a level set; valid: "
+                "a scalar Function (value shape ()), or a callable phi(x)"
+            )
         phi.interpolate(levelset)
         exact = None
     elif callable(levelset):
@@ -256,12 +268,36 @@ class CellMaps:
             return None
 
         def phi(rows: np.ndarray, X: np.ndarray) -> np.ndarray:
-            x = self.push_forward(cells[rows], X)
+            x = self._exact_points(cells[rows], X)
             x3 = np.zeros((3, x.shape[0]))
             x3[: self._gdim] = x.T
-            return np.asarray(self._exact(x3), dtype=np.float64)
+            values = _values(self._exact, x3, self._gdim)
+            bad = np.flatnonzero(~np.isfinite(values))
+            if bad.size:
+                where = ", ".join(f"{v:.6g}" for v in x3[: self._gdim, bad[0]])
+                raise ValueError(
+                    f"The level set is NaN or inf at x = ({where}), a point of a cut cell "
+                    "(or next to one, where its gradient is taken): give one that is finite "
+                    "on and around the mesh"
+                )
+            return values
 
         return phi
+
+    def _exact_points(self, cells, X) -> npt.NDArray[np.float64]:
+        """``x = F_cell(X)`` where the exact level set is evaluated, shape ``(m, gdim)``: on
+        straight tetrahedra and hexahedra by the closed-form vertex functions, summed node
+        by node, so that a point gets the same bits whatever the other points of the batch
+        (Basix's tabulation of a batch differs by ulps with its size, which the gradient's
+        central differences would amplify into a partition-dependent rule)."""
+        if self._gdim < 3 or self._cmap.degree != 1:
+            return self.push_forward(cells, X)
+        N = _vertex_basis(self.mesh.topology.cell_name(), X)
+        nodes = self._geom[cells]
+        x = N[:, :1] * nodes[:, 0]
+        for i in range(1, N.shape[1]):
+            x += N[:, i : i + 1] * nodes[:, i]
+        return x
 
 
 def union(

@@ -34,6 +34,7 @@ import numpy as np
 import numpy.typing as npt
 
 from xfem_contact.geometry.cut_topology import nodal_values
+from xfem_contact.geometry.exact_lines import ExactLevelSet
 from xfem_contact.geometry.tensor_levelset import coefficients
 from xfem_contact.quadrature.rules import RuleSet
 from xfem_contact.quadrature.saye import MAX_DEPTH, CutRules, certified_sides, saye_points
@@ -164,6 +165,7 @@ def p2_tet_cut_rules(
     max_depth: int = MAX_DEPTH,
     min_depth: int = 0,
     jacobian: Jacobian | None = None,
+    exact: ExactLevelSet | None = None,
 ) -> CutRules:
     """Rules of both sides and of the interface of tetrahedra with P2 level sets.
 
@@ -176,6 +178,10 @@ def p2_tet_cut_rules(
             the points of the cut boxes by about four.
         jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule;
             ``None``: reference cells.
+        exact: ``(rows, X) -> (m,)``: the level set that ``phi`` interpolates, at points
+            ``X`` ``(m, 3)`` of the reference tetrahedron of cells ``rows``; the rules
+            then follow its zero set (as
+            :func:`~xfem_contact.quadrature.saye.hex_cut_rules`'s); ``None``: ``phi``'s.
 
     Returns:
         A :class:`~xfem_contact.quadrature.saye.CutRules`: points in the reference
@@ -205,6 +211,7 @@ def p2_tet_cut_rules(
                 min_depth=min_depth,
                 kind="tetrahedron",
                 first=start,
+                exact=None if exact is None else _on_cube(exact, k, start),
             )
             for side in ("minus", "plus"):
                 rows, U, w = getattr(points, side)
@@ -266,6 +273,16 @@ class _Buffer:
 
     def arrays(self) -> list[np.ndarray]:
         return [c[: self.size] for c in self.columns]
+
+
+def _on_cube(exact: ExactLevelSet, k: int, start: int) -> ExactLevelSet:
+    """``exact`` (of tetrahedron rows and points) on the cube of hexahedron ``k`` for the
+    rows of the batch from ``start``."""
+
+    def phi(rows: np.ndarray, U: np.ndarray) -> np.ndarray:
+        return exact(rows + start, _trilinear_map(U, _MONOMIALS[k])[0].T)
+
+    return phi
 
 
 def _merged(parts: list[tuple[np.ndarray, ...]]) -> list[np.ndarray]:

@@ -23,6 +23,7 @@ import numpy as np
 import numpy.typing as npt
 
 from xfem_contact.geometry.cut_tets import classify_tets, cut_tets
+from xfem_contact.geometry.exact_lines import ExactLevelSet
 from xfem_contact.quadrature.curved_tet_rules import classify_p2_tets, p2_tet_cut_rules
 from xfem_contact.quadrature.cut_tet_rules import tet_interface_rule, tet_side_rules
 from xfem_contact.quadrature.saye import CutRules, classify_hexes, hex_cut_rules
@@ -71,6 +72,7 @@ def cut_rules_3d(
     phi: npt.ArrayLike,
     quadrature_degree: int,
     jacobian: Jacobian | None = None,
+    exact: ExactLevelSet | None = None,
 ) -> CutRules:
     """Rules of both sides and of the interface of every cell (row of ``phi``).
 
@@ -82,6 +84,11 @@ def cut_rules_3d(
             P1 tetrahedra; Saye's rules take :func:`saye_order` points per interval.
         jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule;
             ``None``: reference cells.
+        exact: For ``degree = 2``: ``(rows, X) -> (m,)``, the level set that ``phi``
+            interpolates at reference points ``X`` ``(m, 3)`` of cells ``rows``; Saye's
+            rules then follow its zero set (see
+            :func:`~xfem_contact.quadrature.saye.hex_cut_rules`). Ignored for
+            ``degree = 1`` (the rules of the P1/Q1 interpolant).
 
     Returns:
         A :class:`~xfem_contact.quadrature.saye.CutRules` (``reduced`` lists the cells
@@ -89,10 +96,11 @@ def cut_rules_3d(
     """
     _check(cell, degree)
     order = saye_order(quadrature_degree)
+    exact = exact if degree == 2 else None
     if cell == "hexahedron":
-        return hex_cut_rules(phi, degree, order, jacobian=jacobian)
+        return hex_cut_rules(phi, degree, order, jacobian=jacobian, exact=exact)
     if degree == 2:
-        return p2_tet_cut_rules(phi, order, jacobian=jacobian)
+        return p2_tet_cut_rules(phi, order, jacobian=jacobian, exact=exact)
     cut = cut_tets(phi)
     q = quadrature_degree
     return CutRules(

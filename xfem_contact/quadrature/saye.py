@@ -13,13 +13,16 @@ On a box ``U = [lo, hi]`` of the reference cube, with ``psi`` the cell's level s
    valid pairs the one whose certified slopes are steepest wins: the lower bound of
    ``|d psi / d x_k3|`` relative to the bound of ``|grad psi|``, and of
    ``|d psi / d x_k2|`` relative to the face gradient for face functions with zeros
-   (steep slopes keep the roots smooth functions of the outer coordinates).
+   (steep slopes keep the roots smooth functions of the outer coordinates); near ties are
+   broken so that round-off does not change the choice
+   (:func:`~xfem_contact.quadrature.saye_axes.choose_axes`).
 3. Nested one-dimensional Gauss-Legendre rules (``order`` points per interval): along
    ``k1`` on the intervals between the roots of ``psi`` on the four box edges parallel to
-   ``k1``; at each such point, along ``k2`` between the roots of the two face functions;
-   at each of those, along ``k3`` between the roots of ``psi`` itself. Each innermost
-   interval goes to the side of ``psi`` at its midpoint, and each root ``w`` of the
-   height line gives an interface point with area vector
+   ``k1`` (roots within :data:`BREAK_TOLERANCE` of each other are one); at each such point,
+   along ``k2`` between the roots of the two face functions; at each of those, along
+   ``k3`` between the roots of ``psi`` itself. Each innermost interval goes to the side
+   of ``psi`` at its midpoint, and each root ``w`` of the height line gives an interface
+   point with area vector
    ``grad psi / |d psi / d x_k3|`` (reference coordinates) and the weight of its line.
    Every integrand is smooth between the breakpoints, so the rules converge at the rate
    of Gauss-Legendre rules; all weights are positive.
@@ -30,6 +33,11 @@ On a box ``U = [lo, hi]`` of the reference cube, with ``psi`` the cell's level s
    :attr:`CutRules.reduced`), and one with no monotone axis at all (a singular
    point of the zero set: a saddle or a cone) is refused with a ``ValueError`` naming
    the cell and the box.
+
+Given the level set that ``psi`` interpolates as a function (``exact``), the boxes and axes
+stay ``psi``'s, but the breakpoints of every line are the function's roots, the sides of the
+height intervals its signs, and the area vectors its gradient: the rules follow its zero set
+(:func:`hex_cut_rules`).
 
 Tolerance policy, as for tetrahedra (:mod:`xfem_contact.geometry.cut_tets`): ``psi < 0`` is
 side -1, ``psi >= 0`` side +1, decided by exact comparisons of Bernstein coefficients and
@@ -52,16 +60,18 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from xfem_contact.geometry import exact_lines
+from xfem_contact.geometry.exact_lines import ExactLevelSet, central_gradient
 from xfem_contact.geometry.tensor_levelset import (
     bernstein,
     coefficients,
-    derivative,
     evaluate,
     gradient,
     line_coefficients,
     line_roots,
 )
 from xfem_contact.quadrature.rules import RuleSet
+from xfem_contact.quadrature.saye_axes import PAIRS, choose_axes
 from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
 
 __all__ = [
@@ -78,7 +88,10 @@ __all__ = [
 MAX_DEPTH = 6
 """Default number of box subdivision levels of :func:`hex_cut_rules`."""
 
-_PAIRS = [(k3, k2) for k3 in range(3) for k2 in range(3) if k2 != k3]
+BREAK_TOLERANCE = 1e-12
+"""Breakpoints of the outer lines (levels 1 and 2) closer than this, relative to the line's
+length, are one: the same crossing found on two edges of a symmetric box gives one
+breakpoint, not an interval of a few ulps whose presence round-off decides."""
 
 
 @dataclass(frozen=True)
@@ -131,8 +144,16 @@ def hex_cut_rules(
     *,
     max_depth: int = MAX_DEPTH,
     jacobian: Jacobian | None = None,
+    exact: ExactLevelSet | None = None,
 ) -> CutRules:
     """Saye's rules of both sides and of the interface of every cell (see the module).
+
+    With ``exact``, the level set that ``phi`` interpolates, the boxes and their axes are
+    still chosen on the polynomial, but the breakpoints of every line are the exact level
+    set's roots near the polynomial's (:func:`~xfem_contact.geometry.exact_lines.line_roots`),
+    the side of each height interval is its sign at the midpoint, and the interface's area
+    vector is its gradient (:func:`~xfem_contact.geometry.exact_lines.central_gradient`):
+    the rules integrate the exact level set's sides and zero set in the cut cells.
 
     Args:
         phi: Nodal values, shape ``(ncells, (degree + 1)^3)`` (Basix ``gll_warped`` order).
@@ -142,6 +163,9 @@ def hex_cut_rules(
         max_depth: Box subdivision levels.
         jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule;
             ``None``: reference cells.
+        exact: ``(rows, X) -> (m,)``: the exact level set at reference points ``X``
+            ``(m, 3)`` of cells ``rows`` (see :data:`ExactLevelSet`); ``None``: the
+            polynomial's zero set.
 
     Returns:
         A :class:`CutRules`; a cell entirely on one side gets a tensor rule there.
@@ -152,7 +176,7 @@ def hex_cut_rules(
     """
     C = coefficients(phi, degree)
     ncells = C.shape[0]
-    points = saye_points(C, order, max_depth=max_depth)
+    points = saye_points(C, order, max_depth=max_depth, exact=exact)
     rows, X, w, area = points.interface
     return CutRules(
         rules_from_points(*points.minus, ncells),
@@ -188,6 +212,7 @@ def saye_points(
     min_depth: int = 0,
     kind: str = "hexahedron",
     first: int = 0,
+    exact: ExactLevelSet | None = None,
 ) -> SayePoints:
     """Saye's rules (see the module) of polynomials on the unit cube.
 
@@ -201,6 +226,10 @@ def saye_points(
             low degree in the cell's own coordinates).
         kind: The cells' name in error messages.
         first: The number of row 0 of ``C`` in error messages.
+        exact: The level set the polynomials interpolate, as a function of
+            ``(rows, U)`` (see :data:`ExactLevelSet`): the roots on every line, the sides
+            of the height intervals and the interface's area vectors are then its own
+            (see :func:`hex_cut_rules`); ``None``: the polynomials'.
 
     Returns:
         A :class:`SayePoints`.
@@ -237,7 +266,7 @@ def saye_points(
         if depth < min_depth:  # subdivide every box that the interface may cross
             pair, height = np.full(cell.size, -1), np.full(cell.size, -1)
         else:
-            pair, height = _choose_axes(C[cell], lo, hi, B)
+            pair, height = choose_axes(C[cell], lo, hi, B)
         if depth == max_depth:
             bad = np.flatnonzero((pair < 0) & (height < 0))
             if bad.size:
@@ -249,11 +278,11 @@ def saye_points(
                 )
             fallback = pair < 0
             reduced.append(cell[fallback])
-            pair = np.where(fallback, [_PAIRS.index((k, (k + 1) % 3)) for k in height], pair)
-        for index, (k3, k2) in enumerate(_PAIRS):
+            pair = np.where(fallback, [PAIRS.index((k, (k + 1) % 3)) for k in height], pair)
+        for index, (k3, k2) in enumerate(PAIRS):
             group = pair == index
             if group.any():
-                _box_rules(C, cell[group], lo[group], hi[group], k3, k2, gauss, parts)
+                _box_rules(C, cell[group], lo[group], hi[group], (k3, k2), gauss, parts, exact)
         subdivided = pair < 0
         cell, lo, hi = _subdivide(cell[subdivided], lo[subdivided], hi[subdivided])
     return SayePoints(
@@ -262,53 +291,6 @@ def saye_points(
         tuple(_gather(parts["interface"], (1, 3, 1, 3))),
         np.unique(np.concatenate(reduced)).astype(np.int64) if reduced else np.zeros(0, np.int64),
     )
-
-
-def _certain(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Strict sign certificates of Bernstein coefficients ``(m, ...)``: (one sign, all zero)."""
-    flat = B.reshape(B.shape[0], int(np.prod(B.shape[1:])))
-    return (flat > 0).all(axis=1) | (flat < 0).all(axis=1), (flat == 0).all(axis=1)
-
-
-def _choose_axes(
-    C: np.ndarray, lo: np.ndarray, hi: np.ndarray, B: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Index into ``_PAIRS`` of the best valid ``(k3, k2)`` per box (-1: none) and the best
-    monotone height axis alone (-1: none); ``B`` are the Bernstein coefficients of ``C``
-    on the boxes."""
-    m = C.shape[0]
-    D = [bernstein(derivative(C, k), lo, hi) for k in range(3)]
-    size = [np.abs(d).reshape(m, -1) for d in D]
-    steepest = np.maximum.reduce([a.max(axis=1) for a in size])
-    margin = [a.min(axis=1) / np.where(steepest > 0, steepest, 1.0) for a in size]
-    monotone = [_certain(d)[0] for d in D]
-    best, score = np.full(m, -1), np.full(m, -np.inf)
-    for index, (k3, k2) in enumerate(_PAIRS):
-        k1 = 3 - k3 - k2
-        valid = monotone[k3].copy()
-        pair_score = margin[k3].copy()
-        for end in (0, B.shape[1] - 1):
-            face_sign, face_zero = _certain(np.take(B, end, axis=k3 + 1))
-            face_slope = np.abs(np.take(D[k2], end, axis=k3 + 1)).reshape(m, -1)
-            face_monotone, _ = _certain(np.take(D[k2], end, axis=k3 + 1))
-            valid &= face_sign | face_zero | face_monotone
-            face_steepest = np.maximum(
-                face_slope.max(axis=1),
-                np.abs(np.take(D[k1], end, axis=k3 + 1)).reshape(m, -1).max(axis=1),
-            )
-            face_margin = face_slope.min(axis=1) / np.where(face_steepest > 0, face_steepest, 1.0)
-            pair_score = np.minimum(
-                pair_score, np.where(face_sign | face_zero, np.inf, face_margin)
-            )
-        better = valid & (pair_score > score)
-        best = np.where(better, index, best)
-        score = np.where(better, pair_score, score)
-    height, hscore = np.full(m, -1), np.full(m, -np.inf)
-    for k in range(3):
-        better = monotone[k] & (margin[k] > hscore)
-        height = np.where(better, k, height)
-        hscore = np.where(better, margin[k], hscore)
-    return best, height
 
 
 def _subdivide(cell, lo, hi):
@@ -335,8 +317,11 @@ def _tensor_rule(cell, lo, hi, gauss):
     return np.repeat(cell, wq.size), X.reshape(-1, 3), W.reshape(-1)
 
 
-def _pieces(roots: np.ndarray, lo: np.ndarray, hi: np.ndarray, gauss):
+def _pieces(roots: np.ndarray, lo: np.ndarray, hi: np.ndarray, gauss, merge: bool = False):
     """Gauss rules on the intervals of ``[lo, hi]`` between ``roots`` ``(m, r)`` (NaN: none).
+    With ``merge``, breakpoints closer than :data:`BREAK_TOLERANCE` ``(hi - lo)`` to the
+    previous one (or to ``hi``) are that one: roots equal but for round-off (the same
+    crossing seen from two edges of a symmetric box) make no extra interval.
 
     Returns:
         ``(owner, x, w, piece, mid)``: per point its line, coordinate and weight, and per
@@ -345,6 +330,14 @@ def _pieces(roots: np.ndarray, lo: np.ndarray, hi: np.ndarray, gauss):
     x, w = gauss
     breaks = np.concatenate([lo[:, None], roots, hi[:, None]], axis=1)
     breaks = np.sort(np.where(np.isnan(breaks), hi[:, None], breaks), axis=1)
+    if merge:
+        close = BREAK_TOLERANCE * (hi - lo)
+        for k in range(1, breaks.shape[1] - 1):
+            near = breaks[:, k] - breaks[:, k - 1] <= close
+            breaks[near, k] = breaks[near, k - 1]
+        for k in range(breaks.shape[1] - 2, 0, -1):
+            near = hi - breaks[:, k] <= close
+            breaks[near, k] = hi[near]
     a, length = breaks[:, :-1], np.diff(breaks, axis=1)
     line, k = np.nonzero(length > 0)
     start, size = a[line, k], length[line, k]
@@ -358,26 +351,38 @@ def _pieces(roots: np.ndarray, lo: np.ndarray, hi: np.ndarray, gauss):
     )
 
 
-def _box_rules(C, cell, lo, hi, k3, k2, gauss, parts):
-    """Nested Gauss rules of boxes sharing the axes ``k3`` (height) and ``k2``."""
+def _box_rules(C, cell, lo, hi, axes, gauss, parts, exact):
+    """Nested Gauss rules of boxes sharing the axes ``(k3, k2)`` (height first); the roots
+    on every line are ``exact``'s when given."""
+    k3, k2 = axes
     k1 = 3 - k3 - k2
     m = cell.size
+
+    def roots_of(C, axis, X, lo, hi, rows):
+        """Roots of the lines ``X + t e_axis`` of polynomials ``C`` in cells ``rows``."""
+        c = line_coefficients(C, axis, X)
+        if exact is None:
+            return line_roots(c, lo, hi)
+        return exact_lines.line_roots(lambda i, Y: exact(rows[i], Y), X, axis, lo, hi, c)
+
     # level 1: along k1, breakpoints at the roots of psi on the four edges parallel to k1
     roots = []
     C1 = C[cell]
     for v, w in itertools.product((lo[:, k2], hi[:, k2]), (lo[:, k3], hi[:, k3])):
         X = np.zeros((m, 3))
         X[:, k2], X[:, k3] = v, w
-        roots.append(line_roots(line_coefficients(C1, k1, X), lo[:, k1], hi[:, k1]))
-    box1, u, w1, _, _ = _pieces(np.concatenate(roots, axis=1), lo[:, k1], hi[:, k1], gauss)
+        roots.append(roots_of(C1, k1, X, lo[:, k1], hi[:, k1], cell))
+    roots = np.concatenate(roots, axis=1)
+    box1, u, w1, _, _ = _pieces(roots, lo[:, k1], hi[:, k1], gauss, merge=True)
     # level 2: along k2 at each u, breakpoints at the roots of the two face functions
     roots = []
     C1 = C1[box1]
     for end in (lo, hi):
         X = np.zeros((u.size, 3))
         X[:, k1], X[:, k3] = u, end[box1, k3]
-        roots.append(line_roots(line_coefficients(C1, k2, X), lo[box1, k2], hi[box1, k2]))
-    p1, v, w2, _, _ = _pieces(np.concatenate(roots, axis=1), lo[box1, k2], hi[box1, k2], gauss)
+        roots.append(roots_of(C1, k2, X, lo[box1, k2], hi[box1, k2], cell[box1]))
+    roots = np.concatenate(roots, axis=1)
+    p1, v, w2, _, _ = _pieces(roots, lo[box1, k2], hi[box1, k2], gauss, merge=True)
     box2 = box1[p1]
     W = w1[p1] * w2
     X = np.zeros((v.size, 3))
@@ -385,11 +390,14 @@ def _box_rules(C, cell, lo, hi, k3, k2, gauss, parts):
     C2 = C1[p1]
     lo3, hi3 = lo[box2, k3], hi[box2, k3]
     # level 3: along k3 at each (u, v), breakpoints at the roots of psi
-    r = line_roots(line_coefficients(C2, k3, X), lo3, hi3)
+    r = roots_of(C2, k3, X, lo3, hi3, cell[box2])
     p2, w, w3, piece, (pline, mid) = _pieces(r, lo3, hi3, gauss)
     Xmid = X[pline].copy()
     Xmid[:, k3] = mid
-    negative = evaluate(C2[pline], Xmid) < 0
+    if exact is None:
+        negative = evaluate(C2[pline], Xmid) < 0
+    else:
+        negative = exact(cell[box2[pline]], Xmid) < 0
     Xq = X[p2].copy()
     Xq[:, k3] = w
     weights = W[p2] * w3
@@ -401,7 +409,10 @@ def _box_rules(C, cell, lo, hi, k3, k2, gauss, parts):
         line = np.flatnonzero(~np.isnan(r[:, j]))
         Xs = X[line].copy()
         Xs[:, k3] = r[line, j]
-        grad = gradient(C2[line], Xs)
+        if exact is None:
+            grad = gradient(C2[line], Xs)
+        else:
+            grad = central_gradient(lambda Y, c=cell[box2[line]]: exact(c, Y), Xs)
         slope = grad[:, k3]
         at_lo, at_hi = r[line, j] == lo3[line], r[line, j] == hi3[line]
         bounding = ~(at_lo | at_hi) | (at_hi & (slope > 0)) | (at_lo & (slope < 0))
