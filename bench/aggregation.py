@@ -12,6 +12,13 @@ alone. Prints, per element, treatment and n, the largest ``C = cond h^2`` (h = 1
 its median, and the count of outliers (``C`` above ten times the median of the
 aggregated samples of that element and n).
 
+Part ``crack_conditioning``: the same over random straight cracks of the unit square
+(tip uniform in [0.3, 0.7]^2, any direction, running back to the boundary; two thirds
+passing within ``eps h`` of a node behind the tip), free lips, the boundary clamped,
+topological tip enrichment; the matrix is the one the solver factors, ``Z^T A Z`` of
+the tip transform (:mod:`xfem_contact.solvers.block_scaling`). ``--treatments`` picks
+the treatments of both parts.
+
 Condition numbers: the extreme eigenvalues of the symmetric scaled matrix (dense below
 1500 unknowns, else SLEPc: Krylov-Schur, shift-and-invert at 0 with an LU for the least
 in modulus).
@@ -27,8 +34,10 @@ r_e = 0.3), n = 32, 64, 128, without and with ``aggregation=0.25``: the energy e
 its rate and the condition number of the matrix the solver factors (tip-transformed;
 ``bench/crack_convergence.py``'s estimate, n <= 64).
 
-Run: ``python bench/aggregation.py [--parts conditioning accuracy crack] [--circles 30]
-[--sizes 8 16 32]``; writes ``bench/results/aggregation.{json,md}`` (conditioning),
+Run: ``python bench/aggregation.py [--parts conditioning crack_conditioning accuracy
+crack] [--circles 30] [--sizes 8 16 32] [--treatments none "aggregation 0.25"]``; writes
+``bench/results/aggregation.{json,md}`` (conditioning),
+``bench/results/aggregation_crack_conditioning.{json,md}``,
 ``bench/results/aggregation_accuracy.md`` and ``bench/results/aggregation_crack.md``.
 """
 
