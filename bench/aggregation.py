@@ -12,6 +12,13 @@ alone. Prints, per element, treatment and n, the largest ``C = cond h^2`` (h = 1
 its median, and the count of outliers (``C`` above ten times the median of the
 aggregated samples of that element and n).
 
+Part ``crack_conditioning``: the same over random straight cracks of the unit square
+(tip uniform in [0.3, 0.7]^2, any direction, running back to the boundary; two thirds
+passing within ``eps h`` of a node behind the tip), free lips, the boundary clamped,
+topological tip enrichment; the matrix is the one the solver factors, ``Z^T A Z`` of
+the tip transform (:mod:`xfem_contact.solvers.block_scaling`). ``--treatments`` picks
+the treatments of both parts.
+
 Condition numbers: the extreme eigenvalues of the symmetric scaled matrix (dense below
 1500 unknowns, else SLEPc: Krylov-Schur, shift-and-invert at 0 with an LU for the least
 in modulus).
@@ -27,8 +34,10 @@ r_e = 0.3), n = 32, 64, 128, without and with ``aggregation=0.25``: the energy e
 its rate and the condition number of the matrix the solver factors (tip-transformed;
 ``bench/crack_convergence.py``'s estimate, n <= 64).
 
-Run: ``python bench/aggregation.py [--parts conditioning accuracy crack] [--circles 30]
-[--sizes 8 16 32]``; writes ``bench/results/aggregation.{json,md}`` (conditioning),
+Run: ``python bench/aggregation.py [--parts conditioning crack_conditioning accuracy
+crack] [--circles 30] [--sizes 8 16 32] [--treatments none "aggregation 0.25"]``; writes
+``bench/results/aggregation.{json,md}`` (conditioning),
+``bench/results/aggregation_crack_conditioning.{json,md}``,
 ``bench/results/aggregation_accuracy.md`` and ``bench/results/aggregation_crack.md``.
 """
 
@@ -61,6 +70,7 @@ from xfem_contact.mechanics.laws import Bonded
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.problem import Problem
 from xfem_contact.solvers.assembly import ReducedMatrix
+from xfem_contact.solvers.block_scaling import scaled, tip_transform
 from xfem_contact.solvers.scaling import saddle_point_scaling
 
 RESULTS = pathlib.Path(__file__).resolve().parent / "results"
@@ -115,14 +125,74 @@ def bonded_circle(mesh, centre, radius, degree, ghost_penalty, aggregation) -> P
     return problem
 
 
+def cracks(count: int, n: int, rng) -> list[tuple[float, float, float]]:
+    """Random straight cracks ``(tip x, tip y, angle)`` of the unit square, from the tip
+    back to the boundary; two in three pass within ``eps h`` of a mesh node behind the
+    tip (on either side), ``eps`` log-uniform in 1e-10 .. 1e-2."""
+    out = []
+    for k in range(count):
+        tip = rng.uniform(0.3, 0.7, 2)
+        angle = rng.uniform(0.0, 2.0 * math.pi)
+        if k % 3:
+            d = np.array([math.cos(angle), math.sin(angle)])
+            normal = np.array([-d[1], d[0]])
+            behind = tip - rng.uniform(0.1, 0.25) * d
+            node = np.round(behind * n) / n
+            eps = 10.0 ** rng.uniform(-10.0, -2.0)
+            offset = (node - tip) @ normal - (1.0 if k % 3 == 1 else -1.0) * eps / n
+            tip = tip + offset * normal  # the crack's line now passes eps h off the node
+        out.append((float(tip[0]), float(tip[1]), float(angle)))
+    return out
+
+
+def crack_levelsets(tip, angle):
+    """``(phi, psi)``: signed distances to the crack's line and along it from the tip."""
+    d = (math.cos(angle), math.sin(angle))
+    phi = lambda x: -(x[0] - tip[0]) * d[1] + (x[1] - tip[1]) * d[0]  # noqa: E731
+    psi = lambda x: (x[0] - tip[0]) * d[0] + (x[1] - tip[1]) * d[1]  # noqa: E731
+    return phi, psi
+
+
+def free_crack(mesh, tip, angle, degree, ghost_penalty, aggregation) -> Problem:
+    """A crack with free lips in the unit square, its boundary clamped, topological tip
+    enrichment (the tip cell's nodes)."""
+    phi, psi = crack_levelsets(tip, angle)
+    cut = CutMesh(mesh, phi, degree=degree, tangent=psi)
+    problem = Problem(
+        cut,
+        degree,
+        Material(100e6, 0.3),
+        "free",
+        ghost_penalty=ghost_penalty,
+        aggregation=aggregation,
+    )
+    zero = lambda x: np.zeros((2, x.shape[1]))  # noqa: E731
+    on_boundary = lambda x: (  # noqa: E731
+        np.isclose(x[0], 0.0)
+        | np.isclose(x[0], 1.0)
+        | np.isclose(x[1], 0.0)
+        | np.isclose(x[1], 1.0)
+    )
+    problem.loads.add_displacement(on_boundary, {-1: zero, 1: zero})
+    return problem
+
+
 def scaled_condition(problem: Problem) -> float:
-    """2-norm condition number of the scaled reduced matrix ``D R^T A R D`` (serial)."""
+    """2-norm condition number of the scaled reduced matrix the solver factors (serial):
+    ``D R^T A R D`` (Jacobi), with a crack's tip enrichment ``Z^T R^T A R Z``
+    (:mod:`xfem_contact.solvers.block_scaling`)."""
     R = problem.prolongation()
     matrix = ReducedMatrix(form(problem.bilinear_form()), problem.loads.bcs, R)
     matrix.assemble()
     A = matrix.release()
-    D = saddle_point_scaling(A)
-    A.diagonalScale(D, D)
+    transform = tip_transform(problem.space)
+    if transform is None:
+        D = saddle_point_scaling(A)
+        A.diagonalScale(D, D)
+    else:
+        D = transform(R, A)
+        unscaled, A = A, scaled(A, D)
+        unscaled.destroy()
     try:
         if A.getSize()[0] <= 1500:
             dense = A.convert("dense").getDenseArray()
@@ -241,32 +311,49 @@ def main() -> None:
     parser.add_argument("--circles", type=int, default=30, help="circles per mesh")
     parser.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32], help="n")
     parser.add_argument("--elements", nargs="+", default=[f"{c}:{d}" for c, d in ELEMENTS])
+    parser.add_argument(
+        "--treatments", nargs="+", default=list(TREATMENTS), choices=list(TREATMENTS)
+    )
     args = parser.parse_args()
     if "accuracy" in args.parts:
         accuracy()
     if "conditioning" in args.parts:
         conditioning(args)
+    if "crack_conditioning" in args.parts:
+        conditioning(args, "crack")
     if "crack" in args.parts:
         crack()
 
 
-def conditioning(args) -> None:
-    """The conditioning part (module docstring): prints and writes a Markdown table."""
+def conditioning(args, kind: str = "interface") -> None:
+    """The conditioning part (module docstring): prints and writes a Markdown table,
+    for bonded circles (``kind = "interface"``) or free cracks (``"crack"``)."""
     elements = [(e.split(":")[0], int(e.split(":")[1])) for e in args.elements]
+    treatments = {label: TREATMENTS[label] for label in args.treatments}
     rows = []
     for cell, degree in elements:
         for n in args.sizes:
-            kind = dolfinx.mesh.CellType[cell]
-            mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n, kind)
-            samples = circles(args.circles, n, np.random.default_rng(1000 + n))
-            C = {label: [] for label in TREATMENTS}
+            mesh = dolfinx.mesh.create_unit_square(
+                MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType[cell]
+            )
+            make = circles if kind == "interface" else cracks
+            samples = make(args.circles, n, np.random.default_rng(1000 + n))
+            C = {label: [] for label in treatments}
             start = time.perf_counter()
-            for label, (ghost_penalty, aggregation) in TREATMENTS.items():
-                problem = bonded_circle(mesh, (0.5, 0.5), 0.2, degree, ghost_penalty, aggregation)
-                for cx, cy, r in samples:
-                    problem.update_interface(circle((cx, cy), r))
+            for label, (ghost_penalty, aggregation) in treatments.items():
+                if kind == "interface":
+                    problem = bonded_circle(
+                        mesh, (0.5, 0.5), 0.2, degree, ghost_penalty, aggregation
+                    )
+                else:
+                    problem = free_crack(mesh, (0.5, 0.5), 0.3, degree, ghost_penalty, aggregation)
+                for a, b, c in samples:
+                    if kind == "interface":
+                        problem.update_interface(circle((a, b), c))
+                    else:
+                        problem.update_interface(*crack_levelsets((a, b), c))
                     C[label].append(scaled_condition(problem) / n**2)
-            reference = float(np.median(C["aggregation 0.25"]))
+            reference = float(np.median(C.get("aggregation 0.25", next(iter(C.values())))))
             for label, values in C.items():
                 v = np.array(values)
                 rows.append(
@@ -293,7 +380,7 @@ def conditioning(args) -> None:
         "|---|---|---|" + "---|" * len(args.sizes) + "---|",
     ]
     for cell, degree in elements:
-        for label in TREATMENTS:
+        for label in treatments:
             key = (cell, degree, label)
             sel = [r for r in rows if (r["cell"], r["degree"], r["treatment"]) == key]
             cells = " | ".join(f"{r['C_max']:.2e} / {r['C_median']:.2e}" for r in sel)
@@ -301,8 +388,9 @@ def conditioning(args) -> None:
             total = args.circles * len(sel)
             lines.append(f"| {cell} | {degree} | {label} | {cells} | {outliers}/{total} |")
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "aggregation.md").write_text("\n".join(lines) + "\n")
-    (RESULTS / "aggregation.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))
+    name = "aggregation" if kind == "interface" else "aggregation_crack_conditioning"
+    (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
+    (RESULTS / f"{name}.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))
     print("\n".join(lines))
 
 

@@ -61,16 +61,20 @@ def test_aggregation_bounds_the_condition_without_ghost_penalty():
         assert err <= ERROR_FACTOR * err0, (f, err, err0)
 
 
-def _polynomial_at_dofs(space, p) -> np.ndarray:
-    """``p`` (vector-valued, of x, y) at the node and component of every local dof of
-    the displacement fields of ``space.W`` (NaN elsewhere)."""
+def _polynomial_at_dofs(space, polynomial) -> np.ndarray:
+    """``polynomial(d)`` (of degree ``d``: vector-valued of x, y) at the node and
+    component of every local dof of the displacement and multiplier fields of
+    ``space.W``, ``d`` each field's degree (NaN elsewhere)."""
     values = np.full(space.active.size, np.nan)
-    for field in (0, 1):
+    fields = [(0, space.degree), (1, space.degree)]
+    fields += [(f, space.multiplier_degrees[f]) for f, _, _ in space.multiplier_fields]
+    for field, degree in fields:
         V, parent = space.field_space(field)
         x = V.tabulate_dof_coordinates()
         bs = V.dofmap.index_map_bs
         k = np.arange(parent.size)
-        values[parent] = p(x[k // bs, 0], x[k // bs, 1])[k % bs, np.arange(k.size)]
+        p = polynomial(degree)(x[k // bs, 0], x[k // bs, 1])
+        values[parent] = p[k % bs, np.arange(k.size)]
     return values
 
 
@@ -78,9 +82,9 @@ def _polynomial_at_dofs(space, p) -> np.ndarray:
 @pytest.mark.parametrize("cell", ["quadrilateral", "triangle"])
 @pytest.mark.parametrize("degree", [1, 2])
 def test_extension_reproduces_polynomials(cell, degree):
-    """Each constrained dof is the root's polynomial at its node: for a polynomial of
-    the element's degree (complete on triangles, parallelogram maps on the quads) the
-    rows reproduce it exactly."""
+    """Each constrained dof (displacements and the multiplier) is the root's polynomial
+    at its node: for a polynomial of the field's degree (complete on triangles,
+    parallelogram maps on the quads) the rows reproduce it exactly."""
     problem = inclusion_problem(
         N, degree, "bonded", cell, radius=0.25 + 1e-6 / N, aggregation=THRESHOLD
     )
@@ -89,13 +93,16 @@ def test_extension_reproduces_polynomials(cell, degree):
     comm = problem.mesh.comm
     assert comm.allreduce(aggregation.dofs.size, op=MPI.SUM) > 0
 
-    def p(x, y):
-        linear = [1 + 2 * x - y, 0.5 - x + 4 * y]
-        if degree == 1:
-            return np.stack(linear)
-        return np.stack([linear[0] + 3 * x**2 + x * y, linear[1] - 2 * x * y + 4 * y**2])
+    def polynomial(d):
+        def p(x, y):
+            linear = [1 + 2 * x - y, 0.5 - x + 4 * y]
+            if d == 1:
+                return np.stack(linear)
+            return np.stack([linear[0] + 3 * x**2 + x * y, linear[1] - 2 * x * y + 4 * y**2])
 
-    values = _polynomial_at_dofs(space, p)
+        return p
+
+    values = _polynomial_at_dofs(space, polynomial)
     imap = space.W.dofmap.index_map
     # the sources' values from their owners
     wanted = np.unique(aggregation.sources)
@@ -135,3 +142,53 @@ def test_aggregation_is_the_same_on_one_and_two_ranks():
     count_self, error_self = run(MPI.COMM_SELF)
     assert count == count_self
     assert abs(error - error_self) <= 1e-8 * error_self
+
+
+def _bench():
+    """``bench/aggregation.py`` (its problems and condition number), imported by path."""
+    import importlib.util
+    import pathlib
+
+    path = pathlib.Path(__file__).resolve().parents[2] / "bench" / "aggregation.py"
+    spec = importlib.util.spec_from_file_location("bench_aggregation", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.serial
+def test_a_badly_cut_multiplier_is_aggregated():
+    """A bonded circle (Q2, 16 x 16, no ghost penalty) clipping a cell's corner far from
+    the multiplier's vertices: without the multiplier's aggregation its vertex
+    multiplier made the scaled matrix's smallest eigenvalue (C = cond h^2 = 2.2e4,
+    25 times the median of random circles)."""
+    import dolfinx.mesh
+
+    bench = _bench()
+    n = 16
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_SELF, n, n, dolfinx.mesh.CellType.quadrilateral)
+    generic = bench.bonded_circle(mesh, (0.5, 0.5), 0.2, 2, 0.0, THRESHOLD)
+    C0 = bench.scaled_condition(generic) / n**2
+    corner = bench.bonded_circle(mesh, (0.6461708, 0.5177562), 0.1690252, 2, 0.0, THRESHOLD)
+    C = bench.scaled_condition(corner) / n**2
+    print(f"C = cond h^2: {C:.3e}, generic circle {C0:.3e}")
+    assert C <= CONDITION_FACTOR * C0, (C, C0)
+
+
+@pytest.mark.serial
+def test_a_prescribed_dof_is_never_a_source():
+    """A crack (P1 triangles, 8 x 8, clamped boundary) whose badly cut cells' roots hold
+    Dirichlet dofs: a constrained dof reading them would turn their identity rows into
+    combinations (C = cond h^2 2.0e5 against 266 without aggregation)."""
+    import dolfinx.mesh
+
+    bench = _bench()
+    n = 8
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_SELF, n, n, dolfinx.mesh.CellType.triangle)
+    tip, angle = (0.36690109962184747, 0.6252202990915117), 1.3661707578174123
+    C = {}
+    for threshold in (None, THRESHOLD):
+        problem = bench.free_crack(mesh, tip, angle, 1, 0.0, threshold)
+        C[threshold] = bench.scaled_condition(problem) / n**2
+    print(f"C = cond h^2: {C[THRESHOLD]:.3e} with aggregation, {C[None]:.3e} without")
+    assert C[THRESHOLD] <= CONDITION_FACTOR * C[None], C

@@ -18,6 +18,15 @@ shortest extrapolation; ties by position). Every remaining unknown has a well cu
 in its support, so the scaled operator's conditioning does not depend on where the
 interface cuts.
 
+A multiplier field (Lagrange on the cut cells of its interface) is aggregated the same
+way, a cell's interface measure taking the place of its side area: a cell carrying the
+interface is badly cut for the multiplier when the interface's measure in it is below
+``threshold`` times ``|K|^((d-1)/d)`` (``|K|`` the cell's measure, ``d`` its dimension;
+a straight cut through the middle of a square cell measures 1). A multiplier dof whose
+interface cells are all badly cut takes a root's multiplier polynomial, the root found
+through the cells that carry the interface. Multiplier dofs that a law's multiplier
+prolongation (the LBB restriction) already replaces stay its own.
+
 A crack's cells are aggregated only where the crack crosses them: its tip cells, the
 cells cut by its extension ahead of a tip and the cells holding a tied dof (a node whose
 support the crack does not cut completely) are never badly cut, and tied dofs are never
@@ -83,6 +92,23 @@ class Aggregation(typing.NamedTuple):
         )
 
 
+    def without_sources(self, fixed: npt.NDArray[np.int64]) -> Aggregation:
+        """The same with the dofs whose extension reads a dof of ``fixed`` (global dofs
+        of ``W``, e.g. all processes' Dirichlet ones) left as unknowns: a prescribed
+        dof's column must stay its identity row's alone."""
+        reads = np.zeros(self.dofs.size, dtype=bool)
+        reads[self.rows[np.isin(self.sources, fixed)]] = True
+        keep = ~reads
+        position = np.cumsum(keep) - 1
+        entries = keep[self.rows]
+        return Aggregation(
+            self.dofs[keep],
+            position[self.rows[entries]],
+            self.sources[entries],
+            self.vals[entries],
+        )
+
+
 def check_threshold(threshold: float | None) -> None:
     """Refuse an aggregation threshold outside ``(0, 1)`` (None: off)."""
     if threshold is not None and not (isinstance(threshold, float | int) and 0 < threshold < 1):
@@ -119,8 +145,8 @@ def side_areas(cut: CutMesh, side: int, areas: npt.NDArray[np.float64]) -> np.nd
 def aggregate(
     space: EnrichedSpace, threshold: float, active: npt.NDArray[np.bool_]
 ) -> Aggregation:
-    """The constrained dofs of both displacement fields of ``space`` (module docstring).
-    Collective.
+    """The constrained dofs of both displacement fields and of the multiplier fields of
+    ``space`` (module docstring). Collective.
 
     Args:
         space: The enriched space (its ties, branch support and marks set).
@@ -131,10 +157,15 @@ def aggregate(
     cut = space.cut
     areas = cell_areas(cut)
     eligible = _eligible_cells(space)
-    parts = [
-        _side_aggregation(space, field, side, threshold, areas, eligible, active)
+    codes = [
+        (field, _cell_codes(cut, side, threshold, areas, eligible))
         for field, side in ((0, -1), (1, 1))
     ]
+    codes += [
+        (field, _interface_codes(cut, name, threshold, areas, eligible))
+        for field, _, name in space.multiplier_fields
+    ]
+    parts = [_field_aggregation(space, field, c, active) for field, c in codes]
     offsets = np.cumsum([0] + [p.dofs.size for p in parts])
     return Aggregation(
         np.concatenate([p.dofs for p in parts]),
@@ -173,14 +204,37 @@ def _cell_codes(cut, side, threshold, areas, eligible) -> npt.NDArray[np.float64
     return codes
 
 
-def _side_aggregation(space, field, side, threshold, areas, eligible, active) -> Aggregation:
+def _interface_codes(cut, name, threshold, areas, eligible) -> npt.NDArray[np.float64]:
+    """Per owned cell: :data:`_OUTSIDE` (no part of interface ``name``), :data:`_WELL`
+    or :data:`_BAD` for that interface's multiplier (module docstring)."""
+    rules = cut.interface_rules_of(name)
+    measure = np.zeros(cut.cell_sides.size)
+    measure[cut.cut_cells] = rules.sums(rules.weights * abs_det_at(cut, rules))
+    if cut.crack is not None:  # a crack's multipliers: the crossed cells only
+        measure[cut.cut_cells[cut.crack.kind != CROSSED]] = 0.0
+    tdim = cut.mesh.topology.dim
+    fraction = measure / areas ** ((tdim - 1) / tdim)
+    codes = np.where(measure > 0.0, _WELL, _OUTSIDE).astype(np.float64)
+    codes[(measure > 0.0) & eligible & (fraction < threshold)] = _BAD
+    return codes
+
+
+def _field_degree(space, field: int) -> int:
+    """The Lagrange degree of field ``field`` of ``space.W`` (a displacement or a
+    multiplier)."""
+    return space.multiplier_degrees.get(field, space.degree)
+
+
+def _field_aggregation(space, field, owned_codes, active) -> Aggregation:
+    """The constrained dofs of field ``field`` for the cell codes ``owned_codes`` (per
+    owned cell). Collective."""
     cut = space.cut
     mesh = cut.mesh
     comm = mesh.comm
     tdim, gdim = mesh.topology.dim, mesh.geometry.dim
     cell_map = mesh.topology.index_map(tdim)
     n_owned = cell_map.size_local
-    codes = _ghosted_cell_values(mesh, _cell_codes(cut, side, threshold, areas, eligible))
+    codes = _ghosted_cell_values(mesh, owned_codes)
     bad = np.flatnonzero(codes[:n_owned] == _BAD).astype(np.int32)
     well = np.flatnonzero(codes[:n_owned] == _WELL).astype(np.int32)
     W = space.W
@@ -208,12 +262,14 @@ def _side_aggregation(space, field, side, threshold, areas, eligible, active) ->
     root_table = _gather_roots(space, field, root_ids)
     # Each constrained owned dof: the root nearest its node among its badly cut cells'
     dofmap = W.sub(field).dofmap.list
-    element = basix.ufl.element("Lagrange", mesh.basix_cell(), space.degree).basix_element
+    degree = _field_degree(space, field)
+    element = basix.ufl.element("Lagrange", mesh.basix_cell(), degree).basix_element
     nodes = cut.maps.push_forward_lattice(bad, element.points).reshape(bad.size, -1, gdim)
+    bs = dofmap.shape[1] // element.dim  # the field's components
     mine = candidate[dofmap[bad].ravel()]
     local_dof = dofmap[bad].ravel()[mine]
     owner_cell = cell_map.local_to_global(np.repeat(bad, dofmap.shape[1]))[mine]
-    node = np.repeat(nodes, gdim, axis=1).reshape(-1, gdim)[mine]
+    node = np.repeat(nodes, bs, axis=1).reshape(-1, gdim)[mine]
     # a dof's cells are all badly cut, owned by some process: gather its (dof, root) pairs
     pairs = [(k, r) for k, c in enumerate(owner_cell) for r in sorted(candidates.get(int(c), ()))]
     pick = np.array([k for k, _ in pairs], dtype=np.int64)
@@ -230,10 +286,10 @@ def _side_aggregation(space, field, side, threshold, areas, eligible, active) ->
     unreached = comm.allreduce(int(np.sum(constrained[:n_dofs])) - int(dofs.size), op=MPI.SUM)
     if unreached:
         _logger.warning(
-            "aggregation: %d dofs of side %+d lie in badly cut cells no root reaches; "
+            "aggregation: %d dofs of field %d lie in badly cut cells no root reaches; "
             "they stay unknowns",
             unreached,
-            side,
+            field,
         )
     return Aggregation(dofs.astype(np.int64), rows, sources, vals)
 
@@ -396,18 +452,19 @@ def _extension_rows(space, dofs, roots, x, root_table, field):
     """Rows ``u_c = sum_j N_j^root(X_c) u_j`` of the dofs ``dofs`` (owned, local) whose
     nodes are ``x`` ``(m, gdim)`` in the roots ``roots`` (global ids)."""
     mesh = space.cut.mesh
-    gdim = mesh.geometry.dim
     rows_of_root = np.array([root_table.index[int(r)] for r in roots], dtype=np.int64)
     X = _pull_back(space.cut.maps.coordinate_element, root_table.nodes[rows_of_root], x)
-    element = basix.ufl.element("Lagrange", mesh.basix_cell(), space.degree).basix_element
+    degree = _field_degree(space, field)
+    element = basix.ufl.element("Lagrange", mesh.basix_cell(), degree).basix_element
     N = element.tabulate(0, X)[0, :, :, 0]  # (m, nodes)
     # the component of each constrained dof: its place in a cell's field dofs (node-major)
     dofmap = space.W.sub(field).dofmap.list
+    bs = dofmap.shape[1] // element.dim
     imap = space.W.dofmap.index_map
     component = np.full(imap.size_local + imap.num_ghosts, -1, dtype=np.int64)
-    component[dofmap.ravel()] = np.tile(np.arange(dofmap.shape[1]) % gdim, dofmap.shape[0])
+    component[dofmap.ravel()] = np.tile(np.arange(dofmap.shape[1]) % bs, dofmap.shape[0])
     comp = component[dofs]
-    sources = root_table.dofs[rows_of_root].reshape(dofs.size, -1, gdim)
+    sources = root_table.dofs[rows_of_root].reshape(dofs.size, -1, bs)
     sources = sources[np.arange(dofs.size), :, comp]  # (m, nodes)
     rows = np.repeat(np.arange(dofs.size, dtype=np.int64), N.shape[1])
     return rows, sources.ravel().astype(np.int64), N.ravel()

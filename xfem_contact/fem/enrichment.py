@@ -82,7 +82,8 @@ class EnrichedSpace:
         aggregation: Cell aggregation (:mod:`~xfem_contact.fem.aggregation`): a cut cell
             whose part on a side is below this fraction of its area is badly cut, and the
             dofs of that side's displacement in badly cut cells alone are extended from a
-            root cell's (:attr:`aggregation`); None: off.
+            root cell's (:attr:`aggregation`); the multipliers likewise, by the interface's
+            measure in a cell; None: off.
 
     A crack's multipliers live on the nodes of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillates, ``docs/crack_enrichment.md``). A crack

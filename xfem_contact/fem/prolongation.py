@@ -79,7 +79,12 @@ def prolongation_matrix(
         active[prolongation.dofs] = False
     aggregation = space.aggregation
     if aggregation is not None and fixed is not None:
-        aggregation = aggregation.without(np.asarray(fixed))
+        fixed = np.asarray(fixed, dtype=np.int64)
+        aggregation = aggregation.without(fixed)
+        owners = imap.local_to_global((fixed // bs).astype(np.int32)) * bs + fixed % bs
+        aggregation = aggregation.without_sources(np.concatenate(comm.allgather(owners)))
+    if aggregation is not None and prolongation is not None:  # the restriction's own
+        aggregation = aggregation.without(prolongation.dofs)
     if aggregation is not None:
         active[aggregation.dofs] = False
     selected = np.flatnonzero(active)

@@ -58,7 +58,7 @@ class Problem:
             ghost penalty (it extends the field), else those with support on their side.
         aggregation: Cell aggregation (see :class:`EnrichedSpace`): the side volume
             fraction below which a cut cell's dofs are extended from a root cell; None:
-            off. The Dirichlet dofs stay unknowns.
+            off. Dirichlet dofs, and dofs whose extension reads one, stay unknowns.
         kinematics: ``"small"`` (linear elasticity, small sliding) or ``"large"`` (Saint
             Venant-Kirchhoff bulk, contact laws in large sliding: the slave/master hybrid
             element of :mod:`xfem_contact.mechanics.sliding`).
