@@ -39,14 +39,7 @@ LAYERS = (
 #: in :data:`LONG_MODULES` with the reason it is one concept.
 LONG_MODULE_LINES = 500
 #: Modules allowed beyond :data:`LONG_MODULE_LINES`: path -> (lines at most, why one concept).
-LONG_MODULES: dict[str, tuple[int, str]] = {
-    "xfem_contact/fem/cutmesh.py": (
-        520,
-        "one class, the cut's public face (its constructor's options, measures, the "
-        "current state's accessors, integration parts); the cut itself, its rules and "
-        "boundary parts live in their own modules already",
-    ),
-}
+LONG_MODULES: dict[str, tuple[int, str]] = {}
 #: Modules allowed directly in ``xfem_contact/`` (``__init__.py`` included).
 MAX_ROOT_MODULES = 6
 

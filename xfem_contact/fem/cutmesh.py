@@ -17,6 +17,7 @@ from xfem_contact._deprecation import renamed_attribute
 from xfem_contact.fem import cut_boundary
 from xfem_contact.fem.crack_cut import Crack
 from xfem_contact.fem.cut3d_state import cut_state_3d
+from xfem_contact.fem.cut_options import cut_options
 from xfem_contact.fem.cut_state import INTERFACE, SIDE_MINUS, SIDE_PLUS, CutState, cut_state
 from xfem_contact.fem.degree_rules import DegreeRules
 from xfem_contact.fem.interface_cells import trace_nullity
@@ -31,8 +32,6 @@ _INTERFACE0 = 10  # measure ids of cut.interface_measure(name): _INTERFACE0 + in
 _BOUNDARY0 = 100  # measure ids of cut.ds(side, facets): _BOUNDARY0 + slot
 _CUT_CELLS0 = 50  # measure ids of cut.dx_cut(name): _CUT_CELLS0 + index, _CUT_CELLS0 - 1 all
 _counter = itertools.count()
-CELLS = ("triangle", "quadrilateral", "tetrahedron", "hexahedron")
-"""The cell kinds of the meshes :class:`CutMesh` cuts."""
 
 
 class CutMesh:
@@ -119,51 +118,21 @@ class CutMesh:
         compression: bool | None = None,
         exact_zero_set: bool | None = None,
     ):
-        tdim = mesh.topology.dim
-        kinds = [t.name for t in mesh.topology.entity_types[tdim]]
-        if len(kinds) > 1:
-            raise ValueError(
-                f"mesh: a mixed-topology mesh ({' + '.join(kinds)}) cannot be cut; valid: "
-                f"one cell kind of {list(CELLS)}"
-            )
-        if kinds[0] not in CELLS:
-            raise ValueError(
-                f"mesh: cells of kind {kinds[0]!r} cannot be cut; valid: {list(CELLS)}"
-            )
-        if exact_zero_set and tdim == 3 and degree == 1:
-            raise ValueError(
-                "exact_zero_set: a P1/Q1 cut in 3D follows the level set's interpolant (planar "
-                "on tetrahedra); valid: degree=2, or exact_zero_set=False"
-            )
+        options = cut_options(
+            mesh, degree, quadrature_degree, tangent is not None, compression, exact_zero_set
+        )
         #: Whether a callable level set is cut on its exact zero set (see the constructor)
-        self.exact_zero_set = tdim == 2 if exact_zero_set is None else bool(exact_zero_set)
-        self._exact_required = bool(exact_zero_set)
-        if tdim == 3 and tangent is not None:
-            raise ValueError("tangent: cracks are cut on triangle and quadrilateral meshes only")
-        if quadrature_degree is None:
-            quadrature_degree = 6 if tangent is None else 16
-        if quadrature_degree < 1:
-            raise ValueError(f"quadrature_degree must be >= 1, got {quadrature_degree}")
-        simplex = kinds[0] in ("triangle", "tetrahedron")
-        # Affine P1 tetrahedra: the exact cut gives the rules of a lower degree directly
-        affine = mesh.geometry.cmaps[0].degree == 1
-        self._planar = kinds[0] == "tetrahedron" and degree == 1 and affine
-        if compression is None:
-            compression = kinds[0] == "tetrahedron" and (degree == 2 or self._planar)
-        if compression and (not simplex or tangent is not None):
-            raise ValueError(
-                f"compression: rules are compressed on triangles and tetrahedra without a "
-                f"crack, not on {kinds[0]}s{' with a crack' if tangent is not None else ''}; "
-                "valid: compression=False"
-            )
+        self.exact_zero_set = options.exact_zero_set
+        self._exact_required = options.exact_required
+        self._planar = options.planar
         #: Whether the cut cells are integrated with compressed rules (see the constructor)
-        self.compression = bool(compression)
+        self.compression = options.compression
         self.mesh = mesh
         self.degree = degree
-        self.quadrature_degree = quadrature_degree
+        self.quadrature_degree = options.quadrature_degree
         self.id = next(_counter)
         self.tip_points = int(tip_points)
-        self._is_crack = tangent is not None
+        self._is_crack = options.crack
         self._boundary_sets: list[tuple[tuple[int, str], np.ndarray]] = []
         self._marker_space = marker_space(mesh)  # one for all the rules, all cuts
         self._install(self._next(levelset, tangent, previous=None))
