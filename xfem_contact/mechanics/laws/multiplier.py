@@ -99,13 +99,6 @@ class MultiplierLaw(InterfaceLaw):
     def prolongation(self, ctx: InterfaceContext, space):
         if self.lbb != "restriction":
             return None
-        if ctx.gdim != 2:
-            # its multiplier is wrong on the sphere (docs' mechanics page, "In 3D")
-            raise ValueError(
-                f"lbb='restriction' is not available on {ctx.gdim}D meshes (its vital vertices "
-                f"are not proven stable on tetrahedron or hexahedron edges); valid there: "
-                f"lbb='stabilized' or 'none'"
-            )
         return vital_vertex_prolongation(ctx.cut, space, ctx.field, ctx.name)
 
     # -- LBB terms ----------------------------------------------------------------------
