@@ -6,12 +6,15 @@ with the ghost penalty raised to the stabilisation's weight, 0.1, too), on n = 8
 third of them passing within 1e-6 h of a mesh node: tiny cuts on purpose). Prints, per
 element, treatment and n, the least and median beta and the count of indefinite pairs
 (beta^2 < 0), and the slope of the least beta in log n over the last pair; then P1-P1
-on tetrahedra cut by a sphere (``--tet-sizes``). Writes
-``bench/results/inf_sup.{json,md,png}``.
+on tetrahedra cut by a sphere (``--tet-sizes``) without LBB treatment, restricted and
+stabilised. Writes ``bench/results/inf_sup.{json,md,png}``.
 
 Run: ``python bench/inf_sup.py [--circles 50] [--sizes 8 16 32 64] [--elements P2-P2]``
 (``make bench``; default P1-P1 and P2-P1, with the tetrahedra; other ``--elements``
-write ``bench/results/inf_sup_<elements>.{json,md,png}``).
+write ``bench/results/inf_sup_<elements>.{json,md,png}``). The sphere alone, for
+other elements and cells: ``python bench/inf_sup.py --solid --cells tetrahedron
+hexahedron --elements P2-P1 --treatments none restriction stabilized --tet-sizes 4 8
+12`` (``bench/results/inf_sup_3d_<cells>_<elements>.{json,md}``, Q for P on hexahedra).
 """
 
 import xfem_contact  # noqa: F401  (before dolfinx)

@@ -8,7 +8,7 @@ oscillates, so every multiplier law takes an ``lbb`` option:
 - ``"stabilized"`` (default): the consistent Barbosa-Hughes term
   ``- s int (lambda - t(u)).(mu - t(v))`` (:meth:`MultiplierLaw.stabilization_form`);
 - ``"restriction"``: the vital-vertex reduction of the multiplier space
-  (:func:`xfem_contact.mechanics.lbb.vital_vertex_prolongation`);
+  (:func:`xfem_contact.mechanics.lbb_space.vital_vertex_prolongation`; 2D and 3D);
 - ``"none"``: neither (for studies: it oscillates or diverges).
 
 Besides, a tiny normal-gradient term (:meth:`MultiplierLaw.extension_form`) fixes
