@@ -14,7 +14,8 @@ Run: ``python bench/inf_sup.py [--circles 50] [--sizes 8 16 32 64] [--elements P
 write ``bench/results/inf_sup_<elements>.{json,md,png}``). The sphere alone, for
 other elements and cells: ``python bench/inf_sup.py --solid --cells tetrahedron
 hexahedron --elements P2-P1 --treatments none restriction stabilized --tet-sizes 4 8
-12`` (``bench/results/inf_sup_3d_<cells>_<elements>.{json,md}``, Q for P on hexahedra).
+12`` (``bench/results/inf_sup_3d_<cells>_<elements>.{json,md}``, Q for P on hexahedra;
+with fewer treatments the treatments and sizes join the name).
 """
 
 import xfem_contact  # noqa: F401  (before dolfinx)
@@ -303,7 +304,10 @@ def solid_only(args) -> None:
     lines, rows = solids(args.tet_sizes, args.cells, elements, treatments)
     command = "python bench/inf_sup.py " + " ".join(sys.argv[1:])
     lines = [f"`{command}`", *lines]
-    name = "_".join(["inf_sup_3d", *args.cells, *args.elements])
+    parts = [*args.cells, *args.elements]
+    if len(treatments) < len(SOLID_TREATMENTS):
+        parts += [*treatments, *map(str, args.tet_sizes)]
+    name = "_".join(["inf_sup_3d", *parts])
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
     (RESULTS / f"{name}.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))
