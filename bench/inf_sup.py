@@ -6,12 +6,16 @@ with the ghost penalty raised to the stabilisation's weight, 0.1, too), on n = 8
 third of them passing within 1e-6 h of a mesh node: tiny cuts on purpose). Prints, per
 element, treatment and n, the least and median beta and the count of indefinite pairs
 (beta^2 < 0), and the slope of the least beta in log n over the last pair; then P1-P1
-on tetrahedra cut by a sphere (``--tet-sizes``). Writes
-``bench/results/inf_sup.{json,md,png}``.
+on tetrahedra cut by a sphere (``--tet-sizes``) without LBB treatment, restricted and
+stabilised. Writes ``bench/results/inf_sup.{json,md,png}``.
 
 Run: ``python bench/inf_sup.py [--circles 50] [--sizes 8 16 32 64] [--elements P2-P2]``
 (``make bench``; default P1-P1 and P2-P1, with the tetrahedra; other ``--elements``
-write ``bench/results/inf_sup_<elements>.{json,md,png}``).
+write ``bench/results/inf_sup_<elements>.{json,md,png}``). The sphere alone, for
+other elements and cells: ``python bench/inf_sup.py --solid --cells tetrahedron
+hexahedron --elements P2-P1 --treatments none restriction stabilized --tet-sizes 4 8
+12`` (``bench/results/inf_sup_3d_<cells>_<elements>.{json,md}``, Q for P on hexahedra;
+with fewer treatments the treatments and sizes join the name).
 """
 
 import xfem_contact  # noqa: F401  (before dolfinx)
@@ -21,6 +25,7 @@ import argparse
 import json
 import math
 import pathlib
+import sys
 import time
 
 import dolfinx.mesh
@@ -104,30 +109,74 @@ def _key(row: dict) -> tuple:
     return row["cell"], row["degree"], row.get("multiplier_degree", 1), row["lbb"]
 
 
-def tetrahedra(sizes: list[int]) -> list[str]:
-    """P1-P1 on the unit cube's tetrahedra (6 n^3) cut by the sphere of radius 0.2 about
-    its centre, without LBB treatment and stabilised (the restriction is 2D only):
-    lines of a Markdown table of beta^2."""
+#: LBB treatments of the sphere in the unit cube (the 2D rows' others are 2D studies)
+SOLID_TREATMENTS = ("none", "restriction", "stabilized")
+#: Cell of each 3D element label's family: P on tetrahedra, Q on hexahedra
+SOLID_CELLS = {"tetrahedron": "P", "hexahedron": "Q"}
+
+
+def solids(
+    sizes: list[int], cells: list[str], elements: list[tuple[int, int]], treatments
+) -> tuple[list[str], list[dict]]:
+    """The unit cube's tetrahedra (6 n^3) or hexahedra (n^3) cut by the sphere of radius
+    0.2 about its centre, each element ``(degree, multiplier degree)`` and treatment:
+    lines of a Markdown table of beta (least eigenvalue beta^2 when negative; reduced
+    multiplier unknowns) with the slope of beta in log n over the last pair, and the
+    rows."""
     if not sizes:
-        return []
+        return [], []
     lines = [
         "",
-        "P1-P1 tetrahedra, sphere R = 0.2 in the unit cube (beta^2; multipliers):",
+        "Sphere R = 0.2 about the centre of the unit cube (beta; reduced multiplier unknowns):",
         "",
-        "| lbb | " + " | ".join(f"n={n}" for n in sizes) + " |",
-        "|---|" + "---|" * len(sizes),
+        "| cell | element | lbb | " + " | ".join(f"n={n}" for n in sizes) + " | slope |",
+        "|---|---|---|" + "---|" * len(sizes) + "---|",
     ]
-    for lbb in ("none", "stabilized"):
-        cells = []
-        for n in sizes:
-            mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, n, n, n)
-            sphere = lambda x: np.sqrt(((x.T - 0.5) ** 2).sum(axis=1)) - 0.2  # noqa: E731
-            cut = CutMesh(mesh, sphere, degree=2)
-            result = inf_sup_constant(Problem(cut, 1, Material(100e6, 0.3), Bonded(lbb=lbb)))
-            cells.append(f"{result.beta_squared:.3e} ({result.multipliers})")
-            note(f"tetrahedra P1-P1 {lbb:11s} n={n:3d}: beta^2 {result.beta_squared:.3e}")
-        lines.append(f"| {lbb} | " + " | ".join(cells) + " |")
-    return lines
+    rows = []
+    for cell in cells:
+        family = SOLID_CELLS[cell]
+        for degree, multiplier in elements:
+            name = f"{family}{degree}-{family}{multiplier}"
+            for lbb in treatments:
+                found = []
+                for n in sizes:
+                    start = time.perf_counter()
+                    mesh = dolfinx.mesh.create_unit_cube(
+                        MPI.COMM_WORLD, n, n, n, dolfinx.mesh.CellType[cell]
+                    )
+                    sphere = lambda x: np.sqrt(((x.T - 0.5) ** 2).sum(axis=1)) - 0.2  # noqa: E731
+                    cut = CutMesh(mesh, sphere, degree=2)
+                    law = Bonded(lbb=lbb, multiplier_degree=multiplier)
+                    result = inf_sup_constant(Problem(cut, degree, Material(100e6, 0.3), law))
+                    found.append(result)
+                    rows.append(
+                        {
+                            "cell": cell,
+                            "degree": degree,
+                            "multiplier_degree": multiplier,
+                            "lbb": lbb,
+                            "n": n,
+                            "beta": result.beta,
+                            "beta_squared": result.beta_squared,
+                            "multipliers": result.multipliers,
+                        }
+                    )
+                    note(
+                        f"{cell} {name} {lbb:11s} n={n:3d}: beta {result.beta:.3e} "
+                        f"({result.multipliers} multipliers, {time.perf_counter() - start:.1f} s)"
+                    )
+                slope = (
+                    math.log(found[-1].beta / found[-2].beta) / math.log(sizes[-1] / sizes[-2])
+                    if len(found) > 1 and min(r.beta for r in found[-2:]) > 0
+                    else float("nan")
+                )
+                values = " | ".join(
+                    (f"{r.beta:.3f}" if r.beta_squared > 0 else f"beta^2 {r.beta_squared:.2e}")
+                    + f" ({r.multipliers})"
+                    for r in found
+                )
+                lines.append(f"| {cell} | {name} | {lbb} | {values} | {slope:.2f} |")
+    return lines, rows
 
 
 def main() -> None:
@@ -135,7 +184,19 @@ def main() -> None:
     parser.add_argument("--circles", type=int, default=12, help="circles per mesh")
     parser.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32, 64], help="n")
     parser.add_argument(
-        "--tet-sizes", type=int, nargs="*", default=[4, 8, 12], help="n of the P1-P1 tetrahedra"
+        "--tet-sizes", type=int, nargs="*", default=[4, 8, 12], help="n of the sphere's cube"
+    )
+    parser.add_argument(
+        "--solid",
+        action="store_true",
+        help="the sphere only, for --elements and --cells (results in inf_sup_3d_<...>.*)",
+    )
+    parser.add_argument(
+        "--cells",
+        nargs="+",
+        choices=list(SOLID_CELLS),
+        default=["tetrahedron"],
+        help="cells of the sphere's cube (with --solid)",
     )
     parser.add_argument(
         "--elements",
@@ -152,6 +213,9 @@ def main() -> None:
         help="these LBB treatments (default all; fewer: results in inf_sup_<...>_<treatments>.*)",
     )
     args = parser.parse_args()
+    if args.solid:
+        solid_only(args)
+        return
     elements = [e for e in ELEMENTS if label(*e[1:]) in args.elements]
     treatments = {k: v for k, v in TREATMENTS.items() if k in args.treatments}
     default = sorted(args.elements) == sorted(DEFAULT_ELEMENTS) and len(treatments) == len(
@@ -223,9 +287,28 @@ def main() -> None:
         parts += [t.replace(", ", "_").replace(" ", "_") for t in treatments]
     name = "inf_sup" if default else "_".join(["inf_sup", *parts])
     if default:
-        lines += tetrahedra(args.tet_sizes)
+        lines += solids(args.tet_sizes, ["tetrahedron"], [(1, 1)], SOLID_TREATMENTS)[0]
     RESULTS.mkdir(exist_ok=True)
     plot(rows, elements, RESULTS / f"{name}.png")
+    (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
+    (RESULTS / f"{name}.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))
+    print("\n".join(lines))
+    print(f"wrote {RESULTS / name}.md and .json")
+
+
+def solid_only(args) -> None:
+    """The sphere's table alone (``--solid``), written with its command to
+    ``bench/results/inf_sup_3d_<cells>_<elements>.{md,json}``."""
+    elements = sorted({(d, m) for _, d, m in ELEMENTS if label(d, m) in args.elements})
+    treatments = [t for t in args.treatments if t in SOLID_TREATMENTS]
+    lines, rows = solids(args.tet_sizes, args.cells, elements, treatments)
+    command = "python bench/inf_sup.py " + " ".join(sys.argv[1:])
+    lines = [f"`{command}`", *lines]
+    parts = [*args.cells, *args.elements]
+    if len(treatments) < len(SOLID_TREATMENTS):
+        parts += [*treatments, *map(str, args.tet_sizes)]
+    name = "_".join(["inf_sup_3d", *parts])
+    RESULTS.mkdir(exist_ok=True)
     (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
     (RESULTS / f"{name}.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))
     print("\n".join(lines))

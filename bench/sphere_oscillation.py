@@ -1,12 +1,12 @@
 """The contact pressure's oscillation on a sphere with and without the LBB treatment:
 the concentric spheres in frictionless contact (uniform exact pressure) and the
-sticking sphere under triaxial compression, with the stabilised default and with
-``lbb="none"``.
+sticking sphere under triaxial compression, with the stabilised default, the vital-vertex
+restriction and ``lbb="none"``.
 
 Concentric spheres: ``R int |grad_Gamma lambda_n| dA / (|p| 4 pi R^2)`` (0 for the
 exact pressure) and the pressure error; sticking sphere: the surface total variation of
 ``lambda_n`` over the exact pressure's (1 for the exact one) and the pressure error.
-Run: ``python bench/sphere_oscillation.py [--sizes 4 8] [--degrees 1 2]``.
+Run: ``python bench/sphere_oscillation.py [--sizes 4 8] [--degrees 1 2] [--lbb none]``.
 """
 
 import argparse
@@ -33,18 +33,19 @@ from xfem_contact.cases.sphere_interface import (
     surface_total_variation,
 )
 
-TREATMENTS = ("stabilized", "none")
+TREATMENTS = ("stabilized", "restriction", "none")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[4, 8], help="cells per edge")
     parser.add_argument("--degrees", type=int, nargs="+", default=[1, 2])
+    parser.add_argument("--lbb", nargs="+", choices=TREATMENTS, default=list(TREATMENTS))
     args = parser.parse_args()
     rank = MPI.COMM_WORLD.rank
     for degree in args.degrees:
         for n in args.sizes:
-            for lbb in TREATMENTS:
+            for lbb in args.lbb:
                 start = time.perf_counter()
                 problem = composite_sphere_problem(n, degree, "frictionless", lbb=lbb)
                 report = problem.solve()

@@ -3,7 +3,8 @@ the contact pressure and tangential traction errors of the multiplier against th
 ``sigma n`` (uniform stress ``diag(-1, -2, -3)`` Pa, one material), with their rates.
 
 Run: ``python bench/sphere_triaxial.py [--sizes 4 8] [--degree 2] [--law sticking]
-[--cell tetrahedron] [--levelset distance|quadric] [--multiplier-degree 2]``; prints one
+[--cell tetrahedron] [--levelset distance|quadric] [--multiplier-degree 2]
+[--lbb restriction]``; prints one
 row per size (dofs, Newton iterations, time).
 """
 
@@ -17,6 +18,7 @@ import numpy as np
 from mpi4py import MPI
 
 from xfem_contact.cases.solid import sphere_errors, sphere_problem
+from xfem_contact.mechanics.laws.multiplier import LBB_OPTIONS
 
 
 def main() -> None:
@@ -37,9 +39,13 @@ def main() -> None:
     parser.add_argument(
         "--multiplier-degree", type=int, default=1, choices=[1, 2], help="of the multiplier"
     )
+    parser.add_argument(
+        "--lbb", default="stabilized", choices=LBB_OPTIONS, help="the LBB treatment"
+    )
     args = parser.parse_args()
     options = {} if args.friction is None else {"friction": args.friction}
     options["multiplier_degree"] = args.multiplier_degree
+    options["lbb"] = args.lbb
     comm = MPI.COMM_WORLD
     rows = []
     for n in args.sizes:
@@ -54,7 +60,8 @@ def main() -> None:
         rows.append((n, e_n, e_t))
         if comm.rank == 0:
             print(
-                f"{args.law} {args.cell} P{args.degree}-P{args.multiplier_degree} n={n}: "
+                f"{args.law} {args.cell} P{args.degree}-P{args.multiplier_degree} "
+                f"lbb={args.lbb} n={n}: "
                 f"pressure error {e_n:.3e}, "
                 f"tangential {e_t:.3e}, {dofs} dofs (with inactive), "
                 f"{getattr(report, 'iterations', 1)} Newton iterations, {elapsed:.1f} s",

@@ -190,3 +190,22 @@ def test_empty_and_errors():
         lbb.vital_vertices([[0, 1], [1, 2]], [[-1, 1], [-1, 1]])
     with pytest.raises(ValueError, match="not an end"):
         lbb.prolongation([[0, 1]], [2])
+
+
+def test_nearer_end():
+    """Given distances, each edge's vital vertex is its end nearer the interface (ties:
+    the smaller id), whatever the order of the rows or of the ends."""
+    edges = np.array([[0, 1], [2, 1], [2, 3], [4, 3]])
+    sides = np.array([[-1, 1], [-1, 1], [-1, 1], [-1, 1]])
+    distance = np.array([0.3, 0.1, 0.2, 0.2, 0.05])
+    vital = lbb.vital_vertices(edges, sides, distance[edges])
+    assert vital.tolist() == [1, 1, 2, 4]
+    flipped = edges[::-1, ::-1]
+    assert lbb.vital_vertices(flipped, sides[::-1, ::-1], distance[flipped]).tolist() == [
+        4,
+        2,
+        1,
+        1,
+    ]
+    with pytest.raises(ValueError, match="distances has shape"):
+        lbb.vital_vertices(edges, sides, distance[edges][:3])

@@ -73,14 +73,9 @@ def test_a_bad_degree_is_refused_in_one_line(bad):
 
 def test_p2_multipliers_on_tetrahedra_with_the_stabilisation():
     """3D: the stabilised P2 multiplier is built on tetrahedra (solved by
-    ``bench/sphere_triaxial.py --multiplier-degree 2``); the restriction is 2D only, for
-    every degree."""
+    ``bench/sphere_triaxial.py --multiplier-degree 2``; the restricted one:
+    tests/test_restriction_3d.py)."""
     mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, 3, 3, 3)
     cut = CutMesh(mesh, lambda x: np.sqrt(((x.T - 0.5) ** 2).sum(axis=1)) - 0.3, degree=2)
     problem = Problem(cut, 2, Material(100e6, 0.3), Bonded(multiplier_degree=2))
     assert problem.space.W.sub(2).ufl_element().embedded_superdegree == 2
-    with pytest.raises(ValueError, match="lbb='restriction' is not available on 3D"):
-        restricted = Problem(
-            cut, 2, Material(100e6, 0.3), Bonded(lbb="restriction", multiplier_degree=2)
-        )
-        restricted.prolongation()

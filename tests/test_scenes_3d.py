@@ -180,11 +180,6 @@ def with_load(data: dict, **load) -> dict:
 
 
 REFUSED = {
-    "restriction in 3D": (
-        box(law="sticking", lbb="restriction"),
-        "interfaces[0].lbb",
-        "not available on 3D meshes",
-    ),
     "large sliding in 3D": (
         box(law="frictionless", kinematics="large"),
         "interfaces[0].kinematics",

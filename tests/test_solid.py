@@ -352,11 +352,6 @@ def test_sphere_spins_under_frictionless_contact_are_a_warning():
         check_support(problem)
 
 
-def test_restriction_is_refused_in_3d():
-    with pytest.raises(ValueError, match="lbb='restriction' is not available on 3D meshes"):
-        sphere_problem(4, 1, "sticking", lbb="restriction").solve()
-
-
 def test_iterative_preset_in_3d_gives_the_direct_answer():
     """The iterative preset (GMRES, band multigrid with GAMG on six rigid modes per
     side) on the sticking sphere: the direct solver's fields. The Jacobian and the

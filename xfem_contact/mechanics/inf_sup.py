@@ -129,9 +129,10 @@ def _schur_and_norm(A, Bt, C, M, comm) -> tuple[np.ndarray, np.ndarray]:
     """``B A^-1 B^T - C_block`` and ``M`` as dense arrays on every process (``C_block``
     the multiplier block of the problem's matrix, minus the stabilisation). Collective."""
     ksp = PETSc.KSP().create(comm)
+    A.setOption(PETSc.Mat.Option.SPD, True)  # the displacement norm: LDL^T's half factor
     ksp.setOperators(A)
     ksp.setType("preonly")
-    ksp.getPC().setType("lu")
+    ksp.getPC().setType("cholesky")
     ksp.getPC().setFactorSolverType("mumps")
     e, column_M = M.createVecs()
     rhs, x = A.createVecs()

@@ -7,7 +7,9 @@ built on *cut edges* (mesh edges whose two end vertices lie on opposite sides
 of the interface, sides ``-1``/``+1`` per vertex):
 
 * every cut edge gets exactly one *vital vertex*, one of its two ends
-  (:func:`vital_vertices`);
+  (:func:`vital_vertices`): on triangle and quadrilateral edges by a greedy covering
+  (the vertex on most cut edges first), on tetrahedron and hexahedron edges the end
+  nearer the interface;
 * every vital vertex carries one independent multiplier unknown; the
   multiplier at the intersection point of a cut edge is that of its vital
   vertex;
@@ -60,18 +62,20 @@ def _check_sides(edges: npt.NDArray[np.int64], sides: npt.ArrayLike) -> None:
         raise ValueError("a vertex is given on both sides by different edges")
 
 
-def vital_vertices(edges: npt.ArrayLike, sides: npt.ArrayLike) -> npt.NDArray[np.int64]:
-    """The vital vertex of each cut edge, by deterministic greedy covering.
+def vital_vertices(
+    edges: npt.ArrayLike, sides: npt.ArrayLike, distances: npt.ArrayLike | None = None
+) -> npt.NDArray[np.int64]:
+    """The vital vertex of each cut edge: by deterministic greedy covering, or (given
+    ``distances``) the end nearer the interface.
 
-    Algorithm: duplicate edges (in either orientation) are merged. Each vertex
-    gets a count, the number of its cut edges not yet assigned. Repeatedly,
-    the vertex with the largest count (ties: smallest global vertex id) is
-    made vital and all its not-yet-assigned cut edges are assigned to it; the
-    counts of the other ends of those edges drop accordingly. The loop stops
-    when every cut edge is assigned. Only the set of (undirected) edges
-    matters, so the result does not depend on the order of the rows nor of the
-    two ends within a row: all MPI ranks holding the same gathered global
-    edge set agree.
+    Greedy covering (``distances`` None): duplicate edges (in either orientation) are
+    merged. Each vertex gets a count, the number of its cut edges not yet assigned.
+    Repeatedly, the vertex with the largest count (ties: smallest global vertex id)
+    is made vital and all its not-yet-assigned cut edges are assigned to it; the
+    counts of the other ends of those edges drop accordingly. The loop stops when
+    every cut edge is assigned. Only the set of (undirected) edges matters, so the
+    result does not depend on the order of the rows nor of the two ends within a
+    row: all MPI ranks holding the same gathered global edge set agree.
 
     Properties: each cut edge's vital vertex is one of its ends; a vital
     vertex is vital for at least one edge; a non-vital vertex has all of its
@@ -84,16 +88,26 @@ def vital_vertices(edges: npt.ArrayLike, sides: npt.ArrayLike) -> npt.NDArray[np
     algorithm and its stability proof for P1-P1 on triangles) are *not*
     applied here.
 
+    Nearer end (``distances`` given): each cut edge's vital vertex is its end of the
+    smaller distance to the interface (ties: the smaller global id), the end whose
+    shape function is at least 1/2 at the edge's crossing. Every vertex that is the
+    nearer end of one of its cut edges is vital; an edge may have both ends vital
+    (its farther end being nearer on another edge).
+
     Args:
         edges: ``(m, 2)`` global vertex ids of the two ends of each cut edge.
         sides: ``(m, 2)`` side (``-1`` or ``+1``) of those ends; checked for
             consistency (opposite sides on each edge, one side per vertex).
+        distances: ``(m, 2)`` distance (or absolute level set, any unit) of those ends
+            to the interface; the same value for a vertex in every row.
 
     Returns:
         ``(m,)`` int64: the global id of the vital vertex of each input edge.
     """
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     _check_sides(edges, sides)
+    if distances is not None:
+        return _nearer_ends(edges, distances)
     canon, inverse = _canonical_edges(edges)
     k = canon.shape[0]
     if k == 0:
@@ -124,6 +138,18 @@ def vital_vertices(edges: npt.ArrayLike, sides: npt.ArrayLike) -> npt.NDArray[np
         np.subtract.at(count, others, 1)
         count[v] = 0
     return verts[owner][inverse]
+
+
+def _nearer_ends(edges: npt.NDArray[np.int64], distances: npt.ArrayLike) -> npt.NDArray[np.int64]:
+    """The end of each edge ``(m, 2)`` of the smaller distance ``(m, 2)`` (ties: the
+    smaller id)."""
+    distances = np.asarray(distances, dtype=np.float64).reshape(-1, 2)
+    if distances.shape != edges.shape:
+        raise ValueError(f"distances has shape {distances.shape}, edges {edges.shape}")
+    first = (distances[:, 0] < distances[:, 1]) | (
+        (distances[:, 0] == distances[:, 1]) & (edges[:, 0] < edges[:, 1])
+    )
+    return np.where(first, edges[:, 0], edges[:, 1])
 
 
 def prolongation(

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import typing
 
+import basix
 import dolfinx.fem
 import dolfinx.mesh
 import numpy as np
@@ -15,24 +16,28 @@ from xfem_contact.fem.prolongation import MultiplierProlongation
 from xfem_contact.geometry.crack import NONE, TIP
 from xfem_contact.mechanics import lbb as lbb_module
 
-#: The edges of a degree-2 Lagrange cell as ``(end, end, edge node)`` (basix numbering)
-EDGE_NODES = {
-    dolfinx.mesh.CellType.triangle: ((1, 2, 3), (0, 2, 4), (0, 1, 5)),
-    dolfinx.mesh.CellType.quadrilateral: ((0, 1, 4), (0, 2, 5), (1, 3, 6), (2, 3, 7)),
-}
-#: Interior nodes of a degree-2 Lagrange cell as ``(node, its vertices)``
-INTERIOR_NODES = {
-    dolfinx.mesh.CellType.triangle: (),
-    dolfinx.mesh.CellType.quadrilateral: ((8, (0, 1, 2, 3)),),
-}
+#: Per topological dimension, whether each cut edge's vital vertex is its end nearer the
+#: interface (else the greedy covering of :func:`xfem_contact.mechanics.lbb.vital_vertices`):
+#: on tetrahedron edges the covering's few vital vertices lose the pressure's accuracy
+#: (docs' stability page)
+NEARER_END = {1: False, 2: False, 3: True}
 
 
 def _links(cell_type: dolfinx.mesh.CellType) -> np.ndarray:
-    """``(k, 2)`` cell-local node pairs of a degree-2 Lagrange cell: each edge node with
-    the ends of its edge, each interior node with the cell's vertices (the nodes whose
-    mean is a node's value in a linear, or bilinear, field)."""
-    pairs = [(m, end) for a, b, m in EDGE_NODES[cell_type] for end in (a, b)]
-    pairs += [(m, v) for m, vertices in INTERIOR_NODES[cell_type] for v in vertices]
+    """``(k, 2)`` cell-local node pairs of a degree-2 Lagrange cell: each node off the
+    vertices (one at the centre of each edge, and of each face and the interior of a
+    quadrilateral or hexahedron) with each vertex of its entity (basix numbering), the
+    nodes whose mean is that node's value in a linear (multilinear) field."""
+    cell = basix.CellType[cell_type.name]
+    element = basix.create_element(basix.ElementFamily.P, cell, 2, basix.LagrangeVariant.equispaced)
+    topology = basix.topology(cell)
+    pairs = [
+        (node, vertex)
+        for dim in range(1, len(topology))
+        for entity, nodes in enumerate(element.entity_dofs[dim])
+        for node in nodes
+        for vertex in topology[dim][entity]
+    ]
     return np.array(pairs, dtype=np.int64)
 
 
@@ -57,16 +62,18 @@ def vital_vertex_prolongation(
     the cut cells (a crack's: those it crosses and its tip cells, so that the tip
     cells' own vertices carry the multiplier too; not the cells cut ahead of its tips,
     where it would act on nothing) are gathered globally, vital vertices chosen
-    identically on every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`), and
+    identically on every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`: the
+    greedy covering on triangles and quadrilaterals, the end nearer the interface on
+    tetrahedra and hexahedra, :data:`NEARER_END`), and
     each multiplier dof of a vertex on a cut edge expressed by
     :func:`xfem_contact.mechanics.lbb.prolongation`; a vertex of a cut cell on no cut
     edge takes the mean of the rows of its cut cells' vertices on one.
 
-    For a P1 multiplier the nodes are the vertices. A P2 multiplier (triangles and
-    quadrilaterals: vertices, edge nodes, the quadrilateral's centre) has its vertices
-    restricted so, and every other node of a cut cell tied to the mean of its edge's
-    ends (the centre: of the cell's vertices): the P1 (Q1) restricted space, written in
-    the P2 (Q2) basis (richer relations measured: docs' stability page).
+    For a P1 multiplier the nodes are the vertices. A P2 multiplier (vertices, edge
+    nodes, and on quadrilaterals and hexahedra the face and cell centres) has its
+    vertices restricted so, and every other node of a cut cell tied to the mean of its
+    entity's vertices: the P1 (Q1) restricted space, written in the P2 (Q2) basis
+    (richer relations measured in 2D: docs' stability page).
 
     Args:
         cut: The cut mesh.
@@ -104,7 +111,9 @@ def vital_vertex_prolongation(
     degree = space.multiplier_degrees[field]
     if degree > 1:  # the vertices' nodes, and every other node tied to its vertices
         nodes, node_of_vertex = _lagrange_nodes(mesh, degree, cell_vertices, vertex_side)
-        return _prolongation_of_nodes(mesh, space, field, nodes, node_of_vertex[ends], cut_cells)
+        return _prolongation_of_nodes(
+            mesh, space, field, nodes, node_of_vertex[ends], cut_cells, vertex_phi[ends]
+        )
     gdim = mesh.geometry.dim
 
     def positions(vertices: np.ndarray) -> np.ndarray:
@@ -112,20 +121,14 @@ def vital_vertex_prolongation(
         return mesh.geometry.x[nodes.ravel(), :gdim]
 
     nodes = _Nodes(cell_vertices, vertex_side, vmap, positions)
-    return _prolongation_of_nodes(mesh, space, field, nodes, ends, cut_cells)
+    return _prolongation_of_nodes(mesh, space, field, nodes, ends, cut_cells, vertex_phi[ends])
 
 
 def _lagrange_nodes(mesh, degree: int, cell_vertices: np.ndarray, vertex_side: np.ndarray):
     """The nodes of the scalar Lagrange space of ``degree`` on ``mesh`` (the sides of the
     vertices' nodes ``vertex_side``, +1 elsewhere) and the node of each local vertex.
     Collective."""
-    cell_type = mesh.topology.cell_type
-    if cell_type not in EDGE_NODES:
-        valid = [c.name for c in EDGE_NODES]
-        raise ValueError(
-            f"lbb='restriction' with multiplier_degree {degree} is not available on "
-            f"{cell_type.name} cells; valid: {valid}"
-        )
+    assert degree == 2, "MultiplierLaw admits degrees 1 and 2"
     S = dolfinx.fem.functionspace(mesh, ("Lagrange", degree))
     cells = S.dofmap.list
     node_of_vertex = np.full(vertex_side.size, -1, dtype=np.int64)
@@ -133,7 +136,8 @@ def _lagrange_nodes(mesh, degree: int, cell_vertices: np.ndarray, vertex_side: n
     side = np.ones(S.dofmap.index_map.size_local + S.dofmap.index_map.num_ghosts, np.int8)
     side[node_of_vertex] = vertex_side
     x = S.tabulate_dof_coordinates()[:, : mesh.geometry.dim]
-    nodes = _Nodes(cells, side, S.dofmap.index_map, lambda k: x[k], _links(cell_type))
+    links = _links(mesh.topology.cell_type)
+    nodes = _Nodes(cells, side, S.dofmap.index_map, lambda k: x[k], links)
     return nodes, node_of_vertex
 
 
@@ -144,11 +148,13 @@ def _prolongation_of_nodes(
     nodes: _Nodes,
     ends: np.ndarray,
     cut_cells: np.ndarray,
+    phi_ends: np.ndarray,
 ) -> MultiplierProlongation:
     """The prolongation of ``field``'s dofs at ``nodes`` from the vital vertices of the
-    cut edges ``ends`` (local node pairs of vertices, ``(m, 2)``; duplicates allowed) of
-    ``cut_cells``; a vertex of a cut cell on no cut edge takes the mean of the rows of its
-    cut cells' vertices on one, a node off the vertices that of its linked vertices
+    cut edges ``ends`` (local node pairs of vertices, ``(m, 2)``; duplicates allowed, the
+    level set at them ``phi_ends``) of ``cut_cells``, chosen as :data:`NEARER_END`
+    says; a vertex of a cut cell on no cut edge takes the mean of the rows of its cut
+    cells' vertices on one, a node off the vertices that of its linked vertices
     (``nodes.links``). Collective."""
     comm, vmap = mesh.comm, nodes.index_map
     vertex_side = nodes.side
@@ -167,7 +173,10 @@ def _prolongation_of_nodes(
     label = np.empty_like(order)
     label[order] = np.arange(order.size)
     by_position = label[np.searchsorted(ids, all_ends)]
-    vital = ids[order][lbb_module.vital_vertices(by_position, all_sides)]
+    distances = None
+    if NEARER_END[mesh.topology.dim]:
+        distances = np.concatenate(comm.allgather(np.abs(phi_ends).reshape(-1, 2)))
+    vital = ids[order][lbb_module.vital_vertices(by_position, all_sides, distances)]
     rows, cols, vals, reduced = lbb_module.prolongation(all_ends, vital)
     # Vertices of cut cells on no cut edge (e.g. the far corner of a quadrilateral
     # cut near one vertex) take the mean of the prolongated rows of the cut-edge

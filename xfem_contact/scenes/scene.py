@@ -326,12 +326,6 @@ def _check_shape(table, where: str, gdim: int) -> None:
 
 def _check_in_3d(table, where: str) -> None:
     """Refuse the law options and kinematics of an interface that exist in 2D only."""
-    if table.get("lbb") == "restriction":
-        message = (
-            "'restriction' is not available on 3D meshes (its vital vertices are proven "
-            "stable on triangles only); valid there: ['stabilized', 'none']"
-        )
-        raise SceneError(f"{where}.lbb", message)
     if table.get("kinematics") == "large":
         message = "'large' (large sliding) is 2D only; valid on a 3D mesh: ['small']"
         raise SceneError(f"{where}.kinematics", message)

@@ -8,7 +8,7 @@ oscillates, so every multiplier law takes an ``lbb`` option:
 - ``"stabilized"`` (default): the consistent Barbosa-Hughes term
   ``- s int (lambda - t(u)).(mu - t(v))`` (:meth:`MultiplierLaw.stabilization_form`);
 - ``"restriction"``: the vital-vertex reduction of the multiplier space
-  (:func:`xfem_contact.mechanics.lbb.vital_vertex_prolongation`);
+  (:func:`xfem_contact.mechanics.lbb_space.vital_vertex_prolongation`; 2D and 3D);
 - ``"none"``: neither (for studies: it oscillates or diverges).
 
 Besides, a tiny normal-gradient term (:meth:`MultiplierLaw.extension_form`) fixes
@@ -99,13 +99,6 @@ class MultiplierLaw(InterfaceLaw):
     def prolongation(self, ctx: InterfaceContext, space):
         if self.lbb != "restriction":
             return None
-        if ctx.gdim != 2:
-            # its multiplier is wrong on the sphere (docs' mechanics page, "In 3D")
-            raise ValueError(
-                f"lbb='restriction' is not available on {ctx.gdim}D meshes (its vital vertices "
-                f"are not proven stable on tetrahedron or hexahedron edges); valid there: "
-                f"lbb='stabilized' or 'none'"
-            )
         return vital_vertex_prolongation(ctx.cut, space, ctx.field, ctx.name)
 
     # -- LBB terms ----------------------------------------------------------------------
