@@ -38,8 +38,9 @@ from xfem_contact.geometry.tensor_levelset import coefficients
 from xfem_contact.quadrature.rules import RuleSet
 from xfem_contact.quadrature.saye import MAX_DEPTH, CutRules, certified_sides, saye_points
 from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
+from xfem_contact.quadrature.tet_saye import truncated_saye_points
 
-__all__ = ["HEXAHEDRA", "classify_p2_tets", "hexahedron_map", "p2_tet_cut_rules"]
+__all__ = ["FRAMES", "HEXAHEDRA", "classify_p2_tets", "hexahedron_map", "p2_tet_cut_rules"]
 
 
 def _subdivision() -> np.ndarray:
@@ -157,12 +158,18 @@ def _to_simplex_bernstein() -> np.ndarray:
     return T
 
 
+FRAMES = ("tetrahedron", "hexahedra")
+"""Where :func:`p2_tet_cut_rules` runs Saye's algorithm: on boxes of the reference
+tetrahedron itself (:mod:`~xfem_contact.quadrature.tet_saye`), or on the four hexahedra."""
+
+
 def p2_tet_cut_rules(
     phi: npt.ArrayLike,
     order: int = 4,
     *,
     max_depth: int = MAX_DEPTH,
     min_depth: int = 0,
+    frame: str = "tetrahedron",
     jacobian: Jacobian | None = None,
 ) -> CutRules:
     """Rules of both sides and of the interface of tetrahedra with P2 level sets.
@@ -170,10 +177,13 @@ def p2_tet_cut_rules(
     Args:
         phi: P2 nodal values, shape ``(ncells, 10)`` (Basix ``gll_warped`` order).
         order: Gauss-Legendre points per interval of Saye's rules.
-        max_depth: Box subdivision levels on the cube.
+        max_depth: Box subdivision levels.
         min_depth: Levels of forced subdivisions of the boxes the interface may cross (0 ..
             ``max_depth``); each level lowers the rules' error on a cell and multiplies
             the points of the cut boxes by about four.
+        frame: ``"tetrahedron"``: Saye's rules on truncated boxes of the reference
+            tetrahedron (exact for planes), a cell left unresolved at ``max_depth`` going
+            to the hexahedra; ``"hexahedra"``: on the four hexahedra of every cell.
         jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule;
             ``None``: reference cells.
 
@@ -185,9 +195,10 @@ def p2_tet_cut_rules(
         ValueError: Bad shape or values, or a singular point of the zero set (naming
             the tetrahedron).
     """
-    C = _cube_coefficients(phi)
-    ncells = C.shape[0] // 4
-    C = C.reshape(ncells, 4, *C.shape[1:])
+    if frame not in FRAMES:
+        raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
+    phi = nodal_values(phi, 10, "P2 tetrahedron", "tetrahedron")
+    ncells = phi.shape[0]
     merged = {
         "minus": _Buffer([(3,), ()], [np.float64] * 2),
         "plus": _Buffer([(3,), ()], [np.float64] * 2),
@@ -196,34 +207,47 @@ def p2_tet_cut_rules(
     counts: dict[str, list[np.ndarray]] = {"minus": [], "plus": []}
     reduced = []
     for start in range(0, ncells, _CHUNK):
+        chunk = phi[start : start + _CHUNK]
         found: dict[str, list[tuple[np.ndarray, ...]]] = {side: [] for side in merged}
+        rest = np.arange(chunk.shape[0])
+        if frame == "tetrahedron":
+            points, rest = truncated_saye_points(
+                _tet_coefficients(chunk), order, max_depth=max_depth, min_depth=min_depth
+            )
+            for side in ("minus", "plus"):
+                rows, X, w = getattr(points, side)
+                found[side].append((rows + start, X.T, w))
+            rows, X, w, area = points.interface
+            found["interface"].append((rows + start, X.T, w, area.T))
+            reduced.append(points.reduced + start)
+        C = _cube_coefficients(chunk[rest])
+        C = C.reshape(rest.size, 4, *C.shape[1:])
         for k in range(4):  # hexahedron k of every cell: one map, no scatter
             points = saye_points(
-                np.ascontiguousarray(C[start : start + _CHUNK, k]),
+                np.ascontiguousarray(C[:, k]),
                 order,
                 max_depth=max_depth,
                 min_depth=min_depth,
                 kind="tetrahedron",
                 first=start,
+                names=rest,
             )
             for side in ("minus", "plus"):
                 rows, U, w = getattr(points, side)
                 X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
-                found[side].append((rows + start, X, w * (c0 * _cross(c1, c2)).sum(axis=0)))
+                found[side].append((rest[rows] + start, X, w * (c0 * _cross(c1, c2)).sum(axis=0)))
             rows, U, w, area = points.interface
             X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
             a0, a1, a2 = area.T
             area = _cross(c1, c2) * a0 + _cross(c2, c0) * a1 + _cross(c0, c1) * a2  # cof(dM) a
-            found["interface"].append((rows + start, X, w, area))
-            reduced.append(points.reduced + start)
+            found["interface"].append((rest[rows] + start, X, w, area))
+            reduced.append(rest[points.reduced] + start)
         for side, parts in found.items():
             rows, *columns = _merged(parts)
             if side == "interface":
                 columns = [rows, *columns]
             else:  # keep counts, not rows: offsets need no more
-                counts[side].append(
-                    np.bincount(rows - start, minlength=min(_CHUNK, ncells - start))
-                )
+                counts[side].append(np.bincount(rows - start, minlength=chunk.shape[0]))
             merged[side].append(columns, batches=-(-ncells // _CHUNK))
     sides = []
     for side in ("minus", "plus"):
@@ -233,6 +257,24 @@ def p2_tet_cut_rules(
     rows, X, w, area = merged["interface"].arrays()
     interface = surface_rules(X, area, w, rows, ncells, jacobian)
     return CutRules(*sides, interface, np.unique(np.concatenate([*reduced, rows[:0]])))
+
+
+@functools.cache
+def _to_tet_monomials() -> np.ndarray:
+    """Matrix ``(27, 10)``: P2 tetrahedron nodal values -> monomial coefficients ``(3, 3, 3)``
+    of the same polynomial in the reference coordinates (flattened)."""
+    q2 = basix.create_element(
+        basix.ElementFamily.P, basix.CellType.hexahedron, 2, basix.LagrangeVariant.gll_warped
+    )
+    p2 = basix.create_element(
+        basix.ElementFamily.P, basix.CellType.tetrahedron, 2, basix.LagrangeVariant.gll_warped
+    )
+    values = p2.tabulate(0, q2.points)[0, :, :, 0]  # (27, 10): the P2 basis at the Q2 nodes
+    return coefficients(values.T, 2).reshape(10, 27).T
+
+
+def _tet_coefficients(phi: np.ndarray) -> np.ndarray:
+    return (phi @ _to_tet_monomials().T).reshape(-1, 3, 3, 3)
 
 
 _CHUNK = 2048

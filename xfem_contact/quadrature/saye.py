@@ -188,6 +188,7 @@ def saye_points(
     min_depth: int = 0,
     kind: str = "hexahedron",
     first: int = 0,
+    names: npt.ArrayLike | None = None,
 ) -> SayePoints:
     """Saye's rules (see the module) of polynomials on the unit cube.
 
@@ -201,6 +202,8 @@ def saye_points(
             low degree in the cell's own coordinates).
         kind: The cells' name in error messages.
         first: The number of row 0 of ``C`` in error messages.
+        names: Per row of ``C``, its number in error messages (added to ``first``);
+            ``None``: the row itself.
 
     Returns:
         A :class:`SayePoints`.
@@ -242,8 +245,9 @@ def saye_points(
             bad = np.flatnonzero((pair < 0) & (height < 0))
             if bad.size:
                 b = bad[0]
+                name = cell[b] if names is None else np.asarray(names)[cell[b]]
                 raise ValueError(
-                    f"{kind} {first + cell[b]}: the level set has a singular point on its zero set "
+                    f"{kind} {first + name}: the level set has a singular point on its zero set "
                     f"in the box {lo[b].tolist()} .. {hi[b].tolist()} (unit-cube coordinates; "
                     f"no monotone axis after {max_depth} subdivisions); {bad.size} box(es)"
                 )
