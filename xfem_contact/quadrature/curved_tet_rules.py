@@ -209,17 +209,21 @@ def p2_tet_cut_rules(
     for start in range(0, ncells, _CHUNK):
         chunk = phi[start : start + _CHUNK]
         found: dict[str, list[tuple[np.ndarray, ...]]] = {side: [] for side in merged}
-        rest = np.arange(chunk.shape[0])
+        size = chunk.shape[0]
+        rest = np.arange(size)
         if frame == "tetrahedron":
             points, rest = truncated_saye_points(
                 _tet_coefficients(chunk), order, max_depth=max_depth, min_depth=min_depth
             )
-            for side in ("minus", "plus"):
-                rows, X, w = getattr(points, side)
-                found[side].append((rows + start, X.T, w))
-            rows, X, w, area = points.interface
-            found["interface"].append((rows + start, X.T, w, area.T))
             reduced.append(points.reduced + start)
+            if rest.size == 0:  # points sorted by row, vectors as (N, 3): nothing to merge
+                for side in merged:
+                    rows, *columns = getattr(points, side)
+                    _append(merged, counts, side, rows + start, columns, start, size, ncells)
+                continue
+            for side in merged:
+                rows, X, *columns = getattr(points, side)
+                found[side].append((rows + start, X.T, *(c.T for c in columns)))
         C = _cube_coefficients(chunk[rest])
         C = C.reshape(rest.size, 4, *C.shape[1:])
         for k in range(4):  # hexahedron k of every cell: one map, no scatter
@@ -244,11 +248,7 @@ def p2_tet_cut_rules(
             reduced.append(rest[points.reduced] + start)
         for side, parts in found.items():
             rows, *columns = _merged(parts)
-            if side == "interface":
-                columns = [rows, *columns]
-            else:  # keep counts, not rows: offsets need no more
-                counts[side].append(np.bincount(rows - start, minlength=chunk.shape[0]))
-            merged[side].append(columns, batches=-(-ncells // _CHUNK))
+            _append(merged, counts, side, rows, columns, start, size, ncells)
     sides = []
     for side in ("minus", "plus"):
         X, w = merged[side].arrays()
@@ -280,6 +280,16 @@ def _tet_coefficients(phi: np.ndarray) -> np.ndarray:
 _CHUNK = 2048
 """Cells per batch of :func:`p2_tet_cut_rules`: small batches keep the temporaries small
 enough for the allocator to reuse (fresh large arrays cost page faults)."""
+
+
+def _append(merged, counts, side, rows, columns, start, size, ncells) -> None:
+    """Append the points of ``side`` of the batch of ``size`` cells from row ``start``
+    (sorted by ``rows``, vectors ``(N, 3)``) to the buffers ``merged``."""
+    if side == "interface":
+        columns = [rows, *columns]
+    else:  # keep counts, not rows: offsets need no more
+        counts[side].append(np.bincount(rows - start, minlength=size))
+    merged[side].append(columns, batches=-(-ncells // _CHUNK))
 
 
 class _Buffer:

@@ -109,10 +109,11 @@ def truncated_saye_points(
         if depth < min_depth:
             pair = np.full(cell.size, -1)
         else:
-            pair, height = _truncated_axes(C[cell], lo, hi, B)
-            if depth < max_depth:
-                pair = np.where(_curved(C[cell], lo, hi, B, pair), -1, pair)
-            else:  # the best monotone height axis alone, as Saye's
+            DB = [bernstein(derivative(C[cell], k), lo, hi) for k in range(3)]
+            pair, height = _truncated_axes(C[cell], lo, hi, B, DB)
+            if depth < min(max_depth, CURVED_DEPTH):
+                pair = np.where(_curved(C[cell], lo, hi, B, DB, pair), -1, pair)
+            if depth == max_depth:  # the best monotone height axis alone, as Saye's
                 fallback = (pair < 0) & (height >= 0)
                 reduced.append(cell[fallback])
                 lone = [_PAIRS.index((k, (k + 1) % 3)) for k in range(3)]
@@ -132,26 +133,28 @@ def truncated_saye_points(
     gathered = []
     for side, widths in (("minus", (1, 3, 1)), ("plus", (1, 3, 1)), ("interface", (1, 3, 1, 3))):
         columns = _gather(parts[side], widths)
-        keep = ~np.isin(columns[0], bad)
-        gathered.append(tuple(c[keep] for c in columns))
+        if bad.size:
+            keep = ~np.isin(columns[0], bad)
+            columns = [c[keep] for c in columns]
+        gathered.append(tuple(columns))
     reduced = np.unique(np.concatenate([np.zeros(0, int), *reduced])).astype(np.int64)
     return SayePoints(*gathered, reduced[~np.isin(reduced, bad)]), bad
 
 
-def _truncated_axes(C, lo, hi, B):
+def _truncated_axes(C, lo, hi, B, DB):
     """Index into ``_PAIRS`` of the best valid ``(k3, k2)`` per box (-1: none) and the best
     monotone height axis alone (-1: none). The pair is Saye's for
     a box inside the half-space, else the same criteria on the faces the truncated box
     has (bottom ``x_k3 = lo``, top ``x_k3 = hi`` where it meets the half-space, the
-    slanted face along ``e_k2 - e_k3``) with the slanted face's margin in the score."""
+    slanted face along ``e_k2 - e_k3``) with the slanted face's margin in the score. ``B``,
+    ``DB``: Bernstein coefficients of ``psi`` and of its three derivatives on the boxes."""
     pair, height = _choose_axes(C, lo, hi, B)
     reaching = np.flatnonzero(hi.sum(axis=1) > 1.0)
     if reaching.size == 0:
         return pair, height
-    C, lo, hi, B = C[reaching], lo[reaching], hi[reaching], B[reaching]
+    lo, hi, B = lo[reaching], hi[reaching], B[reaching]
+    DB = [d[reaching] for d in DB]
     m = reaching.size
-    D = [derivative(C, k) for k in range(3)]
-    DB = [bernstein(d, lo, hi) for d in D]
     best, score = np.full(m, -1), np.full(m, -np.inf)
     for index, (k3, k2) in enumerate(_PAIRS):
         k1 = 3 - k3 - k2
@@ -164,8 +167,7 @@ def _truncated_axes(C, lo, hi, B):
             valid &= ~present | definite | _certain(slope[0])
             face_score = np.where(definite | ~present, np.inf, _margin(slope[0], slope))
             pair_score = np.minimum(pair_score, face_score)
-        along = bernstein(D[k2] - D[k3], lo, hi)
-        across = bernstein(D[k1] - D[k3], lo, hi)
+        along, across = DB[k2] - DB[k3], DB[k1] - DB[k3]  # Bernstein forms are linear
         valid &= _certain(along)
         pair_score = np.minimum(pair_score, _margin(along, [along, across]))
         better = valid & (pair_score > score)
@@ -181,10 +183,17 @@ CURVED = 1.0
 subdivided (the roots of its height lines have branch points too close for the rule)."""
 
 
-def _curved(C, lo, hi, B, pair):
+CURVED_DEPTH = 3
+"""Box levels subdivided by :data:`CURVED` (boxes of ``1 / 8`` of the cube at most: a
+slope that vanishes on the interface itself, such as a face function's where the
+interface touches the face, is not resolved by subdivision)."""
+
+
+def _curved(C, lo, hi, B, DB, pair):
     """Boxes with axes where a slope the roots depend on (of ``psi`` along ``k3``; along
-    ``k2`` on each face with zeros) is small against ``psi``'s second derivatives times
-    the box size (see :data:`CURVED`), ``(m,)`` bool."""
+    ``k2`` on each face with zeros and along the slanted face) is small against ``psi``'s
+    second derivatives times the box size (see :data:`CURVED`), ``(m,)`` bool; ``B``,
+    ``DB`` as in :func:`_truncated_axes`."""
     m = C.shape[0]
     second = np.zeros(m)
     for a in range(3):
@@ -195,17 +204,15 @@ def _curved(C, lo, hi, B, pair):
         group = np.flatnonzero(pair == index)
         if group.size == 0:
             continue
-        Cg, log, hig, Bg = C[group], lo[group], hi[group], B[group]
-        least = np.abs(bernstein(derivative(Cg, k3), log, hig)).reshape(group.size, -1).min(axis=1)
-        D2 = bernstein(derivative(Cg, k2), log, hig)
+        least = np.abs(DB[k3][group]).reshape(group.size, -1).min(axis=1)
         for end in (0, B.shape[1] - 1):
-            face = np.take(Bg, end, axis=k3 + 1).reshape(group.size, -1)
+            face = np.take(B[group], end, axis=k3 + 1).reshape(group.size, -1)
             crossed = ~((face > 0).all(axis=1) | (face < 0).all(axis=1))
-            face_slope = np.abs(np.take(D2, end, axis=k3 + 1)).reshape(group.size, -1).min(axis=1)
+            face_slope = np.abs(np.take(DB[k2][group], end, axis=k3 + 1))
+            face_slope = face_slope.reshape(group.size, -1).min(axis=1)
             least = np.where(crossed, np.minimum(least, face_slope), least)
-        reaching = hig.sum(axis=1) > 1.0
-        along = bernstein(derivative(Cg, k2) - derivative(Cg, k3), log, hig)
-        along = np.abs(along).reshape(group.size, -1).min(axis=1)
+        along = np.abs(DB[k2][group] - DB[k3][group]).reshape(group.size, -1).min(axis=1)
+        reaching = hi[group].sum(axis=1) > 1.0
         slope[group] = np.where(reaching, np.minimum(least, along), least)
     size = (hi - lo).max(axis=1)
     return (pair >= 0) & (second * size > CURVED * slope)
