@@ -228,3 +228,27 @@ def test_no_cell_left_open_and_no_cells():
     rules = p2_tet_cut_rules(np.zeros((0, 10)))
     assert rules.minus.offsets.tolist() == [0] and rules.interface.points.shape == (0, 3)
     assert rules.reduced.dtype == np.int64 and rules.reduced.size == 0
+
+
+def test_a_cells_rules_do_not_depend_on_the_batch():
+    """Each cell's points and weights are the same, bit for bit, alone or among others
+    (partition independence), in both frames."""
+    h = 0.25
+    origins = np.stack(np.meshgrid(*[np.arange(4) * h] * 3, indexing="ij"), -1).reshape(-1, 3)
+    vertices = (origins[:, None, None] + h * KUHN[None]).reshape(-1, 4, 3)
+    J = np.transpose(vertices[:, 1:] - vertices[:, :1], (0, 2, 1))
+    phi = np.linalg.norm(vertices[:, :1] + np.einsum("qk,ndk->nqd", nodes(), J) - 0.45, axis=-1)
+    phi = phi - 0.3
+    phi = phi[classify_p2_tets(phi) == 0]
+    for frame in ("tetrahedron", "hexahedra"):
+        together = p2_tet_cut_rules(phi, frame=frame)
+        for row in range(0, phi.shape[0], 7):
+            alone = p2_tet_cut_rules(phi[row : row + 1], frame=frame)
+            for a, b in zip(
+                (together.minus, together.plus, together.interface),
+                (alone.minus, alone.plus, alone.interface),
+                strict=True,
+            ):
+                part = slice(a.offsets[row], a.offsets[row + 1])
+                np.testing.assert_array_equal(a.points[part], b.points)
+                np.testing.assert_array_equal(a.weights[part], b.weights)

@@ -119,7 +119,8 @@ def _to_cubes() -> np.ndarray:
 
 def _cube_coefficients(phi: npt.ArrayLike) -> np.ndarray:
     phi = nodal_values(phi, 10, "P2 tetrahedron", "tetrahedron")
-    values = (phi @ _to_cubes().T).reshape(-1, 27)  # row 4 c + k: hexahedron k of cell c
+    # einsum, not BLAS: a cell's values must not depend on the batch it is in
+    values = np.einsum("nk,jk->nj", phi, _to_cubes()).reshape(-1, 27)  # row 4 c + k: hexahedron k
     return coefficients(values, 2)
 
 
@@ -274,7 +275,9 @@ def _to_tet_monomials() -> np.ndarray:
 
 
 def _tet_coefficients(phi: np.ndarray) -> np.ndarray:
-    return (phi @ _to_tet_monomials().T).reshape(-1, 3, 3, 3)
+    """Monomial coefficients ``(n, 3, 3, 3)`` of P2 nodal values ``phi`` ``(n, 10)`` (einsum,
+    not BLAS: a cell's coefficients must not depend on the batch it is in)."""
+    return np.einsum("nk,jk->nj", phi, _to_tet_monomials()).reshape(-1, 3, 3, 3)
 
 
 _CHUNK = 2048
