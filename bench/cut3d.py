@@ -20,8 +20,10 @@ nodal values):
 
 ``--order k`` sets the Gauss points per interval of Saye's rules (P2 tetrahedra and
 hexahedra; default 4, as ``quadrature_degree = 6`` in ``CutMesh``). ``--min-depth 1``
-splits every sub-box of the P2 tetrahedra's hexahedra that the interface
-may cross before Saye's rules (:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`).
+splits every box of the P2 tetrahedra that the interface may cross before Saye's rules,
+``--frame hexahedra`` runs them on the four hexahedra of each tetrahedron instead of on
+truncated boxes of the tetrahedron itself
+(:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`).
 
 The fuzz (``--fuzz N``) cuts ``N`` reference cells per kind by random spheres, ellipsoids,
 tori and planes (a third of them moved to pass exactly through a node) and counts the
@@ -139,6 +141,10 @@ ORDER = 4
 """Gauss points per interval of Saye's rules (``--order``)."""
 
 
+FRAME = "tetrahedron"
+"""Where the P2 tetrahedra's rules run Saye's algorithm (``--frame``)."""
+
+
 def sphere_tets(n: int, degree: int = 4, shape: str = "sphere") -> tuple[float, float, int, float]:
     """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P1 level set)."""
     vertices = kuhn_mesh(n, PERTURB)
@@ -174,7 +180,11 @@ def sphere_p2_tets(
     side = classify_p2_tets(phi)
     cut = np.flatnonzero(side == 0)
     rules = p2_tet_cut_rules(
-        phi[cut], order or ORDER, min_depth=MIN_DEPTH, jacobian=lambda rows, X: J[cut[rows]]
+        phi[cut],
+        order or ORDER,
+        min_depth=MIN_DEPTH,
+        frame=FRAME,
+        jacobian=lambda rows, X: J[cut[rows]],
     )
     elapsed = time.process_time() - start
     volume = detJ[side == -1].sum() / 6.0
@@ -336,9 +346,16 @@ def main() -> None:
         default=4,
         help="Gauss points per interval of Saye's rules (P2 tetrahedra, hexahedra)",
     )
+    parser.add_argument(
+        "--frame",
+        default="tetrahedron",
+        choices=["tetrahedron", "hexahedra"],
+        help="P2 tetrahedra: Saye's rules on truncated boxes of the tetrahedron or on its "
+        "four hexahedra (p2_tet_cut_rules frame)",
+    )
     args = parser.parse_args()
-    global PERTURB, MIN_DEPTH, ORDER
-    PERTURB, MIN_DEPTH, ORDER = args.perturb, args.min_depth, args.order
+    global PERTURB, MIN_DEPTH, ORDER, FRAME
+    PERTURB, MIN_DEPTH, ORDER, FRAME = args.perturb, args.min_depth, args.order, args.frame
     for kind in args.kinds if args.fuzz else []:
         start = time.perf_counter()
         counts = fuzz_cells(kind, args.fuzz)
