@@ -69,6 +69,7 @@ __all__ = [
     "CutRules",
     "SayePoints",
     "certified_sides",
+    "check_parameters",
     "classify_hexes",
     "hex_cut_rules",
     "rules_from_points",
@@ -211,14 +212,7 @@ def saye_points(
     Raises:
         ValueError: Bad ``order`` or ``max_depth``, or a singular point of a zero set.
     """
-    if not (isinstance(order, int) and order >= 1):
-        raise ValueError(f"order must be a positive int (Gauss points per interval), got {order!r}")
-    if not (isinstance(max_depth, int) and max_depth >= 0):
-        raise ValueError(f"max_depth must be a non-negative int, got {max_depth!r}")
-    if not (isinstance(min_depth, int) and 0 <= min_depth <= max_depth):
-        raise ValueError(
-            f"min_depth must be an int in 0 .. max_depth = {max_depth}, got {min_depth!r}"
-        )
+    check_parameters(order, max_depth, min_depth)
     ncells = C.shape[0]
     gx, gw = np.polynomial.legendre.leggauss(order)
     gauss = (0.5 * (gx + 1.0), 0.5 * gw)
@@ -266,6 +260,18 @@ def saye_points(
         tuple(_gather(parts["interface"], (1, 3, 1, 3))),
         np.unique(np.concatenate(reduced)).astype(np.int64) if reduced else np.zeros(0, np.int64),
     )
+
+
+def check_parameters(order: int, max_depth: int, min_depth: int) -> None:
+    """Raise a ``ValueError`` naming a bad ``order``, ``max_depth`` or ``min_depth``."""
+    if not (isinstance(order, int) and order >= 1):
+        raise ValueError(f"order must be a positive int (Gauss points per interval), got {order!r}")
+    if not (isinstance(max_depth, int) and max_depth >= 0):
+        raise ValueError(f"max_depth must be a non-negative int, got {max_depth!r}")
+    if not (isinstance(min_depth, int) and 0 <= min_depth <= max_depth):
+        raise ValueError(
+            f"min_depth must be an int in 0 .. max_depth = {max_depth}, got {min_depth!r}"
+        )
 
 
 def _certain(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

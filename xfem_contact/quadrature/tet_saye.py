@@ -59,6 +59,7 @@ from xfem_contact.quadrature.saye import (
     _pieces,
     _subdivide,
     _tensor_rule,
+    check_parameters,
 )
 
 __all__ = ["truncated_saye_points"]
@@ -81,7 +82,11 @@ def truncated_saye_points(
         ``reduced``: cells where a box at ``max_depth`` used the height axis alone) and
         the sorted rows of the unresolved cells (a box at ``max_depth`` with no monotone
         axis), which have no points.
+
+    Raises:
+        ValueError: Bad ``order``, ``max_depth`` or ``min_depth``.
     """
+    check_parameters(order, max_depth, min_depth)
     ncells = C.shape[0]
     gx, gw = np.polynomial.legendre.leggauss(order)
     gauss = (0.5 * (gx + 1.0), 0.5 * gw)
