@@ -183,7 +183,7 @@ def _truncated_axes(C, lo, hi, B, DB):
     return pair, height
 
 
-CURVED = 1.0
+CURVED = 4.0
 """Largest ``|d2 psi| size / min |d psi / d x_k3|`` of a box with axes: a box above it is
 subdivided (the roots of its height lines have branch points too close for the rule)."""
 
