@@ -28,8 +28,10 @@ gradient from the callable; cells, boxes and axes from the interpolant), as
 
 ``--order k`` sets the Gauss points per interval of Saye's rules (P2 tetrahedra and
 hexahedra; default 4, as ``quadrature_degree = 6`` in ``CutMesh``). ``--min-depth 1``
-splits every sub-box of the P2 tetrahedra's hexahedra that the interface
-may cross before Saye's rules (:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`).
+splits every box of the P2 tetrahedra that the interface may cross before Saye's rules,
+``--frame hexahedra`` runs them on the four hexahedra of each tetrahedron instead of on
+truncated boxes of the tetrahedron itself
+(:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`).
 
 The fuzz (``--fuzz N``) cuts ``N`` reference cells per kind by random spheres, ellipsoids,
 tori and planes (a third of them moved to pass exactly through a node) and counts the
@@ -149,6 +151,10 @@ ORDER = 4
 """Gauss points per interval of Saye's rules (``--order``)."""
 
 
+FRAME = "tetrahedron"
+"""Where the P2 tetrahedra's rules run Saye's algorithm (``--frame``)."""
+
+
 def sphere_tets(n: int, degree: int = 4, shape: str = "sphere") -> tuple[float, float, int, float]:
     """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P1 level set)."""
     vertices = kuhn_mesh(n, PERTURB)
@@ -192,6 +198,7 @@ def sphere_p2_tets(
         phi[cut],
         order or ORDER,
         min_depth=MIN_DEPTH,
+        frame=FRAME,
         jacobian=lambda rows, X: J[cut[rows]],
         exact=exact if callable_ else None,
     )
@@ -398,9 +405,16 @@ def main() -> None:
         default=4,
         help="Gauss points per interval of Saye's rules (P2 tetrahedra, hexahedra)",
     )
+    parser.add_argument(
+        "--frame",
+        default="tetrahedron",
+        choices=["tetrahedron", "hexahedra"],
+        help="P2 tetrahedra: Saye's rules on truncated boxes of the tetrahedron or on its "
+        "four hexahedra (p2_tet_cut_rules frame)",
+    )
     args = parser.parse_args()
-    global PERTURB, MIN_DEPTH, ORDER
-    PERTURB, MIN_DEPTH, ORDER = args.perturb, args.min_depth, args.order
+    global PERTURB, MIN_DEPTH, ORDER, FRAME
+    PERTURB, MIN_DEPTH, ORDER, FRAME = args.perturb, args.min_depth, args.order, args.frame
     for kind, levelset in itertools.product(args.kinds if args.fuzz else [], args.levelset):
         if levelset == "callable" and kind in ("tet-P1", "hex-Q1"):
             continue

@@ -1,6 +1,7 @@
-"""Tetrahedra cut by P2 level sets (Saye's rules on the four hexahedra of a tetrahedron):
-planes converge to the exact moments as the order grows, a sphere's volume and area at
-rate >= 3.8, refusals."""
+"""Tetrahedra cut by P2 level sets (Saye's rules on truncated boxes of the tetrahedron, or
+on its four hexahedra): planes exact in the tetrahedron's frame and converging in the
+hexahedra's, the rules' error on an exactly represented sphere, a sphere's volume and
+area at rate >= 3.8, refusals."""
 
 import basix
 import numpy as np
@@ -57,13 +58,14 @@ def test_the_four_hexahedra_fill_the_tetrahedron_with_positive_jacobians():
     "order, min_depth, tol", [(4, 0, 3e-6), (4, 1, 1e-7), (6, 1, 1e-10), (12, 0, 1e-13)]
 )
 def test_planes_converge_to_exact_moments(order, min_depth, tol):
-    """The composed level set is not planar: the rules converge in the order and in the
-    box size (min_depth), never exactly (the error does not shrink with the mesh size)."""
+    """On the hexahedra the composed level set is not planar: the rules converge in the
+    order and in the box size (min_depth), never exactly (the error does not shrink with
+    the mesh size)."""
     rng = np.random.default_rng(5)
     normals = rng.normal(size=(12, 3))
     offsets = np.einsum("ij,ij->i", normals, rng.dirichlet(np.ones(4), size=12)[:, 1:])
     phi = normals @ nodes().T - offsets[:, None]
-    rules = p2_tet_cut_rules(phi, order, min_depth=min_depth)
+    rules = p2_tet_cut_rules(phi, order, min_depth=min_depth, frame="hexahedra")
     for row, (n, c) in enumerate(zip(normals, offsets, strict=True)):
         minus, face = clip(tet_planes(REFERENCE), REFERENCE, TET_EDGES, (n, -c), -1)
         plus, _ = clip(tet_planes(REFERENCE), REFERENCE, TET_EDGES, (n, -c), +1)
@@ -81,6 +83,39 @@ def test_planes_converge_to_exact_moments(order, min_depth, tol):
         assert (rule.weights > 0).all()
 
 
+def planes(count: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Random planes ``n . x = c`` through the reference tetrahedron."""
+    rng = np.random.default_rng(seed)
+    normals = rng.normal(size=(count, 3))
+    offsets = np.einsum("ij,ij->i", normals, rng.dirichlet(np.ones(4), size=count)[:, 1:])
+    return normals, offsets
+
+
+@pytest.mark.parametrize("min_depth", [0, 1])
+def test_planes_are_exact_in_the_tetrahedron_frame(min_depth):
+    """Truncated boxes of the tetrahedron keep every breakpoint affine: four points per
+    interval integrate the moments of degree 4 exactly (nested, the outer integrand has
+    degree 6; the hexahedra's rules miss them by 1.8e-5 at this order)."""
+    normals, offsets = planes(40, 7)
+    phi = normals @ nodes().T - offsets[:, None]
+    rules = p2_tet_cut_rules(phi, 4, min_depth=min_depth)
+    worst = 0.0
+    for row, (n, c) in enumerate(zip(normals, offsets, strict=True)):
+        minus, face = clip(tet_planes(REFERENCE), REFERENCE, TET_EDGES, (n, -c), -1)
+        plus, _ = clip(tet_planes(REFERENCE), REFERENCE, TET_EDGES, (n, -c), +1)
+        for rule, cells in ((rules.minus, minus), (rules.plus, plus), (rules.interface, face)):
+            worst = max(worst, np.abs(moments(rule, row) - simplex_moments(cells, EXPS)).max())
+    print(f"planes, order 4, min_depth {min_depth}: largest moment error {worst:.1e}")
+    assert worst <= 1e-14
+    for rule in (rules.minus, rules.plus, rules.interface):
+        assert (rule.weights > 0).all()
+
+
+def test_frame_is_checked():
+    with pytest.raises(ValueError, match=r"frame must be one of \('tetrahedron', 'hexahedra'\)"):
+        p2_tet_cut_rules(nodes()[:, :1].T - 0.5, frame="cube")
+
+
 KUHN = np.array(
     [
         [(0, 0, 0), (1, 0, 0), (1, 1, 0), (1, 1, 1)],
@@ -94,7 +129,7 @@ KUHN = np.array(
 )
 
 
-def sphere(n: int, level_set=lambda x: np.linalg.norm(x - 0.5, axis=-1) - 0.3):
+def sphere(n: int, level_set=lambda x: np.linalg.norm(x - 0.5, axis=-1) - 0.3, frame="tetrahedron"):
     """Signed relative volume and area errors of the sphere R = 0.3 (P2 interpolant of
     ``level_set``, by default the distance) on the ``6 n^3`` tetrahedra of the unit cube."""
     h = 1.0 / n
@@ -106,7 +141,7 @@ def sphere(n: int, level_set=lambda x: np.linalg.norm(x - 0.5, axis=-1) - 0.3):
     phi = level_set(x)
     side = classify_p2_tets(phi)
     cut = np.flatnonzero(side == 0)
-    rules = p2_tet_cut_rules(phi[cut], 4, jacobian=lambda rows, X: J[cut[rows]])
+    rules = p2_tet_cut_rules(phi[cut], 4, frame=frame, jacobian=lambda rows, X: J[cut[rows]])
     volume = detJ[side == -1].sum() / 6 + rules.minus.weights @ detJ[cut[rules.minus.point_rows]]
     area = rules.interface.weights @ detJ[cut[rules.interface.point_rows]]
     exact_v, exact_a = 4 / 3 * np.pi * 0.3**3, 4 * np.pi * 0.3**2
@@ -120,6 +155,22 @@ def test_exact_quadric_sphere():
     assert abs(errors[0]) <= 1e-6 and abs(errors[1]) <= 3e-5
 
 
+def quadric(x):
+    return ((x - 0.5) ** 2).sum(axis=-1) - 0.09
+
+
+def test_rule_error_on_the_exact_quadric_sphere_stays_small():
+    """The P2 sphere at h = 1/8 and 1/16: only the rules err. In the tetrahedron's frame
+    their relative area error is 5.2e-9 and 1.5e-7; on the hexahedra (the same order)
+    5.6e-7 and 2.2e-7, and it rises to 3.2e-6 at h = 1/32. Both frames' errors depend on
+    which of two tied axis choices a symmetric box takes (:mod:`saye_axes` breaks ties
+    alike under round-off): at h = 1/16 the tetrahedron's frame gives 1.3e-8 with the
+    other choice."""
+    errors = np.abs(np.array([sphere(n, quadric) for n in (8, 16)]))
+    print(f"quadric sphere, order 4: volume {errors[:, 0]}, area {errors[:, 1]}")
+    assert errors[0].max() <= 1e-7 and errors[1].max() <= 2e-7
+
+
 def test_sphere_p2():
     errors = np.abs(np.array([sphere(n) for n in (8, 16)]))
     rates = np.log(errors[0] / errors[1]) / np.log(2)
@@ -129,7 +180,21 @@ def test_sphere_p2():
     assert rates[0] >= 3.8  # volume; the area's rate on this mesh is 3.0 (docs/cut3d.md)
 
 
-def test_round_off_does_not_change_the_rules():
+@pytest.mark.parametrize(
+    "frame",
+    [
+        "hexahedra",
+        pytest.param(
+            "tetrahedron",
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="the truncated boxes' own axis choice and breakpoints are not yet "
+                "stable under round-off",
+            ),
+        ),
+    ],
+)
+def test_round_off_does_not_change_the_rules(frame):
     """Spheres centred on the line x = y = z are symmetric in the tetrahedron's hexahedra:
     a few ulps of change in the nodal values (as a different cell numbering gives) keep
     the rules to round-off (the same points per cell, at the same places)."""
@@ -138,7 +203,8 @@ def test_round_off_does_not_change_the_rules():
     phi = np.linalg.norm(nodes()[None] - a[:, None, None], axis=2) - radii[:, None]
     phi = phi[classify_p2_tets(phi) == 0]
     ulps = rng.integers(-4, 5, size=phi.shape) * np.finfo(float).eps
-    rules, moved = p2_tet_cut_rules(phi, 3), p2_tet_cut_rules(phi * (1.0 + ulps), 3)
+    rules = p2_tet_cut_rules(phi, 3, frame=frame)
+    moved = p2_tet_cut_rules(phi * (1.0 + ulps), 3, frame=frame)
     for side in ("minus", "plus", "interface"):
         ours, theirs = getattr(rules, side), getattr(moved, side)
         assert np.array_equal(ours.offsets, theirs.offsets), side
@@ -197,3 +263,27 @@ def test_no_cell_left_open_and_no_cells():
     rules = p2_tet_cut_rules(np.zeros((0, 10)))
     assert rules.minus.offsets.tolist() == [0] and rules.interface.points.shape == (0, 3)
     assert rules.reduced.dtype == np.int64 and rules.reduced.size == 0
+
+
+def test_a_cells_rules_do_not_depend_on_the_batch():
+    """Each cell's points and weights are the same, bit for bit, alone or among others
+    (partition independence), in both frames."""
+    h = 0.25
+    origins = np.stack(np.meshgrid(*[np.arange(4) * h] * 3, indexing="ij"), -1).reshape(-1, 3)
+    vertices = (origins[:, None, None] + h * KUHN[None]).reshape(-1, 4, 3)
+    J = np.transpose(vertices[:, 1:] - vertices[:, :1], (0, 2, 1))
+    phi = np.linalg.norm(vertices[:, :1] + np.einsum("qk,ndk->nqd", nodes(), J) - 0.45, axis=-1)
+    phi = phi - 0.3
+    phi = phi[classify_p2_tets(phi) == 0]
+    for frame in ("tetrahedron", "hexahedra"):
+        together = p2_tet_cut_rules(phi, frame=frame)
+        for row in range(0, phi.shape[0], 7):
+            alone = p2_tet_cut_rules(phi[row : row + 1], frame=frame)
+            for a, b in zip(
+                (together.minus, together.plus, together.interface),
+                (alone.minus, alone.plus, alone.interface),
+                strict=True,
+            ):
+                part = slice(a.offsets[row], a.offsets[row + 1])
+                np.testing.assert_array_equal(a.points[part], b.points)
+                np.testing.assert_array_equal(a.weights[part], b.weights)

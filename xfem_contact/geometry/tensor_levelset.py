@@ -63,7 +63,9 @@ def coefficients(phi: npt.ArrayLike, degree: int) -> npt.NDArray[np.float64]:
         raise ValueError(f"degree must be 1 or 2 for a hexahedron level set, got {degree!r}")
     n = (degree + 1) ** 3
     phi = nodal_values(phi, n, f"Q{degree} hexahedron", "hexahedron")
-    return (phi @ _from_nodal(degree).T).reshape(-1, degree + 1, degree + 1, degree + 1)
+    # einsum, not BLAS: a cell's coefficients must not depend on the batch it is in
+    C = np.einsum("nk,jk->nj", phi, _from_nodal(degree))
+    return C.reshape(-1, degree + 1, degree + 1, degree + 1)
 
 
 def _powers(x: np.ndarray, p: int) -> np.ndarray:

@@ -39,8 +39,9 @@ from xfem_contact.geometry.tensor_levelset import coefficients
 from xfem_contact.quadrature.rules import RuleSet
 from xfem_contact.quadrature.saye import MAX_DEPTH, CutRules, certified_sides, saye_points
 from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
+from xfem_contact.quadrature.tet_saye import truncated_saye_points
 
-__all__ = ["HEXAHEDRA", "classify_p2_tets", "hexahedron_map", "p2_tet_cut_rules"]
+__all__ = ["FRAMES", "HEXAHEDRA", "classify_p2_tets", "hexahedron_map", "p2_tet_cut_rules"]
 
 
 def _subdivision() -> np.ndarray:
@@ -119,7 +120,8 @@ def _to_cubes() -> np.ndarray:
 
 def _cube_coefficients(phi: npt.ArrayLike) -> np.ndarray:
     phi = nodal_values(phi, 10, "P2 tetrahedron", "tetrahedron")
-    values = (phi @ _to_cubes().T).reshape(-1, 27)  # row 4 c + k: hexahedron k of cell c
+    # einsum, not BLAS: a cell's values must not depend on the batch it is in
+    values = np.einsum("nk,jk->nj", phi, _to_cubes()).reshape(-1, 27)  # row 4 c + k: hexahedron k
     return coefficients(values, 2)
 
 
@@ -158,12 +160,18 @@ def _to_simplex_bernstein() -> np.ndarray:
     return T
 
 
+FRAMES = ("tetrahedron", "hexahedra")
+"""Where :func:`p2_tet_cut_rules` runs Saye's algorithm: on boxes of the reference
+tetrahedron itself (:mod:`~xfem_contact.quadrature.tet_saye`), or on the four hexahedra."""
+
+
 def p2_tet_cut_rules(
     phi: npt.ArrayLike,
     order: int = 4,
     *,
     max_depth: int = MAX_DEPTH,
     min_depth: int = 0,
+    frame: str = "tetrahedron",
     jacobian: Jacobian | None = None,
     exact: ExactLevelSet | None = None,
 ) -> CutRules:
@@ -172,16 +180,20 @@ def p2_tet_cut_rules(
     Args:
         phi: P2 nodal values, shape ``(ncells, 10)`` (Basix ``gll_warped`` order).
         order: Gauss-Legendre points per interval of Saye's rules.
-        max_depth: Box subdivision levels on the cube.
+        max_depth: Box subdivision levels.
         min_depth: Levels of forced subdivisions of the boxes the interface may cross (0 ..
             ``max_depth``); each level lowers the rules' error on a cell and multiplies
             the points of the cut boxes by about four.
+        frame: ``"tetrahedron"``: Saye's rules on truncated boxes of the reference
+            tetrahedron (exact for planes), a cell left unresolved at ``max_depth`` going
+            to the hexahedra; ``"hexahedra"``: on the four hexahedra of every cell.
         jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule;
             ``None``: reference cells.
         exact: ``(rows, X) -> (m,)``: the level set that ``phi`` interpolates, at points
             ``X`` ``(m, 3)`` of the reference tetrahedron of cells ``rows``; the rules
             then follow its zero set (as
-            :func:`~xfem_contact.quadrature.saye.hex_cut_rules`'s); ``None``: ``phi``'s.
+            :func:`~xfem_contact.quadrature.saye.hex_cut_rules`'s), on the four hexahedra
+            whatever ``frame``; ``None``: ``phi``'s.
 
     Returns:
         A :class:`~xfem_contact.quadrature.saye.CutRules`: points in the reference
@@ -191,9 +203,10 @@ def p2_tet_cut_rules(
         ValueError: Bad shape or values, or a singular point of the zero set (naming
             the tetrahedron).
     """
-    C = _cube_coefficients(phi)
-    ncells = C.shape[0] // 4
-    C = C.reshape(ncells, 4, *C.shape[1:])
+    if frame not in FRAMES:
+        raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
+    phi = nodal_values(phi, 10, "P2 tetrahedron", "tetrahedron")
+    ncells = phi.shape[0]
     merged = {
         "minus": _Buffer([(3,), ()], [np.float64] * 2),
         "plus": _Buffer([(3,), ()], [np.float64] * 2),
@@ -202,36 +215,49 @@ def p2_tet_cut_rules(
     counts: dict[str, list[np.ndarray]] = {"minus": [], "plus": []}
     reduced = []
     for start in range(0, ncells, _CHUNK):
+        chunk = phi[start : start + _CHUNK]
         found: dict[str, list[tuple[np.ndarray, ...]]] = {side: [] for side in merged}
+        size = chunk.shape[0]
+        rest = np.arange(size)
+        if frame == "tetrahedron" and exact is None:
+            points, rest = truncated_saye_points(
+                _tet_coefficients(chunk), order, max_depth=max_depth, min_depth=min_depth
+            )
+            reduced.append(points.reduced + start)
+            if rest.size == 0:  # points sorted by row, vectors as (N, 3): nothing to merge
+                for side in merged:
+                    rows, *columns = getattr(points, side)
+                    _append(merged, counts, side, rows + start, columns, start, size, ncells)
+                continue
+            for side in merged:
+                rows, X, *columns = getattr(points, side)
+                found[side].append((rows + start, X.T, *(c.T for c in columns)))
+        C = _cube_coefficients(chunk[rest])
+        C = C.reshape(rest.size, 4, *C.shape[1:])
         for k in range(4):  # hexahedron k of every cell: one map, no scatter
             points = saye_points(
-                np.ascontiguousarray(C[start : start + _CHUNK, k]),
+                np.ascontiguousarray(C[:, k]),
                 order,
                 max_depth=max_depth,
                 min_depth=min_depth,
                 kind="tetrahedron",
                 first=start,
+                names=rest,
                 exact=None if exact is None else _on_cube(exact, k, start),
             )
             for side in ("minus", "plus"):
                 rows, U, w = getattr(points, side)
                 X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
-                found[side].append((rows + start, X, w * (c0 * _cross(c1, c2)).sum(axis=0)))
+                found[side].append((rest[rows] + start, X, w * (c0 * _cross(c1, c2)).sum(axis=0)))
             rows, U, w, area = points.interface
             X, c0, c1, c2 = _trilinear_map(U, _MONOMIALS[k])
             a0, a1, a2 = area.T
             area = _cross(c1, c2) * a0 + _cross(c2, c0) * a1 + _cross(c0, c1) * a2  # cof(dM) a
-            found["interface"].append((rows + start, X, w, area))
-            reduced.append(points.reduced + start)
+            found["interface"].append((rest[rows] + start, X, w, area))
+            reduced.append(rest[points.reduced] + start)
         for side, parts in found.items():
             rows, *columns = _merged(parts)
-            if side == "interface":
-                columns = [rows, *columns]
-            else:  # keep counts, not rows: offsets need no more
-                counts[side].append(
-                    np.bincount(rows - start, minlength=min(_CHUNK, ncells - start))
-                )
-            merged[side].append(columns, batches=-(-ncells // _CHUNK))
+            _append(merged, counts, side, rows, columns, start, size, ncells)
     sides = []
     for side in ("minus", "plus"):
         X, w = merged[side].arrays()
@@ -242,9 +268,39 @@ def p2_tet_cut_rules(
     return CutRules(*sides, interface, np.unique(np.concatenate([*reduced, rows[:0]])))
 
 
+@functools.cache
+def _to_tet_monomials() -> np.ndarray:
+    """Matrix ``(27, 10)``: P2 tetrahedron nodal values -> monomial coefficients ``(3, 3, 3)``
+    of the same polynomial in the reference coordinates (flattened)."""
+    q2 = basix.create_element(
+        basix.ElementFamily.P, basix.CellType.hexahedron, 2, basix.LagrangeVariant.gll_warped
+    )
+    p2 = basix.create_element(
+        basix.ElementFamily.P, basix.CellType.tetrahedron, 2, basix.LagrangeVariant.gll_warped
+    )
+    values = p2.tabulate(0, q2.points)[0, :, :, 0]  # (27, 10): the P2 basis at the Q2 nodes
+    return coefficients(values.T, 2).reshape(10, 27).T
+
+
+def _tet_coefficients(phi: np.ndarray) -> np.ndarray:
+    """Monomial coefficients ``(n, 3, 3, 3)`` of P2 nodal values ``phi`` ``(n, 10)`` (einsum,
+    not BLAS: a cell's coefficients must not depend on the batch it is in)."""
+    return np.einsum("nk,jk->nj", phi, _to_tet_monomials()).reshape(-1, 3, 3, 3)
+
+
 _CHUNK = 2048
 """Cells per batch of :func:`p2_tet_cut_rules`: small batches keep the temporaries small
 enough for the allocator to reuse (fresh large arrays cost page faults)."""
+
+
+def _append(merged, counts, side, rows, columns, start, size, ncells) -> None:
+    """Append the points of ``side`` of the batch of ``size`` cells from row ``start``
+    (sorted by ``rows``, vectors ``(N, 3)``) to the buffers ``merged``."""
+    if side == "interface":
+        columns = [rows, *columns]
+    else:  # keep counts, not rows: offsets need no more
+        counts[side].append(np.bincount(rows - start, minlength=size))
+    merged[side].append(columns, batches=-(-ncells // _CHUNK))
 
 
 class _Buffer:

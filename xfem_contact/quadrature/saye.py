@@ -79,6 +79,7 @@ __all__ = [
     "CutRules",
     "SayePoints",
     "certified_sides",
+    "check_parameters",
     "classify_hexes",
     "hex_cut_rules",
     "rules_from_points",
@@ -213,6 +214,7 @@ def saye_points(
     kind: str = "hexahedron",
     first: int = 0,
     exact: ExactLevelSet | None = None,
+    names: npt.ArrayLike | None = None,
 ) -> SayePoints:
     """Saye's rules (see the module) of polynomials on the unit cube.
 
@@ -230,6 +232,8 @@ def saye_points(
             ``(rows, U)`` (see :data:`ExactLevelSet`): the roots on every line, the sides
             of the height intervals and the interface's area vectors are then its own
             (see :func:`hex_cut_rules`); ``None``: the polynomials'.
+        names: Per row of ``C``, its number in error messages (added to ``first``);
+            ``None``: the row itself.
 
     Returns:
         A :class:`SayePoints`.
@@ -237,14 +241,7 @@ def saye_points(
     Raises:
         ValueError: Bad ``order`` or ``max_depth``, or a singular point of a zero set.
     """
-    if not (isinstance(order, int) and order >= 1):
-        raise ValueError(f"order must be a positive int (Gauss points per interval), got {order!r}")
-    if not (isinstance(max_depth, int) and max_depth >= 0):
-        raise ValueError(f"max_depth must be a non-negative int, got {max_depth!r}")
-    if not (isinstance(min_depth, int) and 0 <= min_depth <= max_depth):
-        raise ValueError(
-            f"min_depth must be an int in 0 .. max_depth = {max_depth}, got {min_depth!r}"
-        )
+    check_parameters(order, max_depth, min_depth)
     ncells = C.shape[0]
     gx, gw = np.polynomial.legendre.leggauss(order)
     gauss = (0.5 * (gx + 1.0), 0.5 * gw)
@@ -271,8 +268,9 @@ def saye_points(
             bad = np.flatnonzero((pair < 0) & (height < 0))
             if bad.size:
                 b = bad[0]
+                name = cell[b] if names is None else np.asarray(names)[cell[b]]
                 raise ValueError(
-                    f"{kind} {first + cell[b]}: the level set has a singular point on its zero set "
+                    f"{kind} {first + name}: the level set has a singular point on its zero set "
                     f"in the box {lo[b].tolist()} .. {hi[b].tolist()} (unit-cube coordinates; "
                     f"no monotone axis after {max_depth} subdivisions); {bad.size} box(es)"
                 )
@@ -291,6 +289,18 @@ def saye_points(
         tuple(_gather(parts["interface"], (1, 3, 1, 3))),
         np.unique(np.concatenate(reduced)).astype(np.int64) if reduced else np.zeros(0, np.int64),
     )
+
+
+def check_parameters(order: int, max_depth: int, min_depth: int) -> None:
+    """Raise a ``ValueError`` naming a bad ``order``, ``max_depth`` or ``min_depth``."""
+    if not (isinstance(order, int) and order >= 1):
+        raise ValueError(f"order must be a positive int (Gauss points per interval), got {order!r}")
+    if not (isinstance(max_depth, int) and max_depth >= 0):
+        raise ValueError(f"max_depth must be a non-negative int, got {max_depth!r}")
+    if not (isinstance(min_depth, int) and 0 <= min_depth <= max_depth):
+        raise ValueError(
+            f"min_depth must be an int in 0 .. max_depth = {max_depth}, got {min_depth!r}"
+        )
 
 
 def _subdivide(cell, lo, hi):

@@ -1,0 +1,337 @@
+"""Saye's rules on the reference tetrahedron itself: boxes of the unit cube truncated by
+the tetrahedron's slanted face, for P2 level sets (pure numpy).
+
+The reference tetrahedron is the unit cube cut by the half-space ``x + y + z <= 1``. Its
+P2 level set ``psi`` is a polynomial of total degree 2 in the reference coordinates, so
+the tensor machinery of :mod:`xfem_contact.geometry.tensor_levelset` applies unchanged
+(monomial coefficients, Bernstein sign certificates on boxes). A *truncated box* is a box
+``[lo, hi]`` of the cube intersected with that half-space; the algorithm is Saye's
+(:mod:`xfem_contact.quadrature.saye`) on truncated boxes:
+
+1. A box whose Bernstein coefficients have one sign lies on one side: a tensor rule if
+   ``hi`` lies in the half-space, else the nested rule of step 3 without roots.
+2. Otherwise the height axis ``k3`` and the axis ``k2`` are Saye's for the whole box; a
+   box that reaches the slanted face also needs ``psi`` monotone along the face in the
+   ``k2`` direction (``e_k2 - e_k3``), else the box is subdivided.
+3. Nested one-dimensional Gauss-Legendre rules: along ``k1`` between the roots of ``psi``
+   on the truncated box's edges (the box edges parallel to ``k1``, clipped, and the
+   slanted face's lines on the faces of constant ``k2`` or ``k3``) and the abscissae of
+   its vertices; at each point, along ``k2`` between the roots of ``psi`` on the bottom
+   face, the top face and the slanted face, and the kink where the top of the height line
+   leaves the box's top face for the slanted face; at each of those, along ``k3`` up to
+   ``min(hi_k3, 1 - x_k1 - x_k2)`` between the roots of ``psi``.
+
+Every breakpoint is a root of ``psi`` restricted to a straight line, every interval end
+an affine function of the outer coordinates: for a planar ``psi`` the rules integrate
+polynomials of degree ``2 order - 1`` per direction exactly, and for a curved one their
+error falls with the curvature of ``psi`` in the cell (the mesh size times the
+interface's curvature), not only with ``order``. All weights are positive. A box
+with axes is still subdivided while a slope its roots depend on is small against the
+second derivatives of ``psi`` times the box size (:data:`CURVED`). At ``max_depth`` a box
+without a valid pair uses the best monotone height axis alone (the cell is reported
+``reduced``); a cell with a box that has none is reported unresolved (the caller
+integrates it otherwise).
+
+Side -1 is ``psi < 0``, side +1 ``psi >= 0``; the interface bounding side -1, as in
+:mod:`xfem_contact.quadrature.saye` (a root at the end of a height line counts only
+when ``psi < 0`` inside next to it).
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from xfem_contact.geometry.tensor_levelset import (
+    bernstein,
+    derivative,
+    evaluate,
+    gradient,
+    line_coefficients,
+    line_roots,
+)
+from xfem_contact.quadrature.saye import (
+    SayePoints,
+    _gather,
+    _pieces,
+    _subdivide,
+    _tensor_rule,
+    check_parameters,
+)
+from xfem_contact.quadrature.saye_axes import PAIRS, choose_axes
+
+__all__ = ["truncated_saye_points"]
+
+
+def truncated_saye_points(
+    C: np.ndarray, order: int, *, max_depth: int, min_depth: int = 0
+) -> tuple[SayePoints, np.ndarray]:
+    """Saye's rules on the reference tetrahedron of P2 polynomials (see the module).
+
+    Args:
+        C: Monomial coefficients in the tetrahedron's reference coordinates, shape
+            ``(ncells, 3, 3, 3)``, of polynomials of total degree <= 2.
+        order: Gauss-Legendre points per interval.
+        max_depth: Box subdivision levels.
+        min_depth: Levels of boxes subdivided whenever the interface may cross them.
+
+    Returns:
+        The points of the resolved cells (a :class:`~xfem_contact.quadrature.saye.SayePoints`;
+        ``reduced``: cells where a box at ``max_depth`` used the height axis alone) and
+        the sorted rows of the unresolved cells (a box at ``max_depth`` with no monotone
+        axis), which have no points.
+
+    Raises:
+        ValueError: Bad ``order``, ``max_depth`` or ``min_depth``.
+    """
+    check_parameters(order, max_depth, min_depth)
+    ncells = C.shape[0]
+    gx, gw = np.polynomial.legendre.leggauss(order)
+    gauss = (0.5 * (gx + 1.0), 0.5 * gw)
+    parts: dict[str, list[tuple[np.ndarray, ...]]] = {"minus": [], "plus": [], "interface": []}
+    unresolved, reduced = [], []
+    cell = np.arange(ncells)
+    lo, hi = np.zeros((ncells, 3)), np.ones((ncells, 3))
+    for depth in range(max_depth + 1):
+        if cell.size == 0:
+            break
+        B = bernstein(C[cell], lo, hi)
+        flat = B.reshape(cell.size, -1)
+        truncated = hi.sum(axis=1) > 1.0
+        sides = {"minus": (flat < 0).all(axis=1), "plus": (flat >= 0).all(axis=1)}
+        for side, whole in sides.items():
+            plain = whole & ~truncated
+            parts[side].append(_tensor_rule(cell[plain], lo[plain], hi[plain], gauss))
+            clipped = whole & truncated
+            if clipped.any():
+                _clipped_rules(C, cell[clipped], lo[clipped], hi[clipped], 2, 1, gauss, parts, side)
+        rest = ~(sides["minus"] | sides["plus"])
+        cell, lo, hi, B = cell[rest], lo[rest], hi[rest], B[rest]
+        if cell.size == 0:
+            break
+        if depth < min_depth:
+            pair = np.full(cell.size, -1)
+        else:
+            DB = [bernstein(derivative(C[cell], k), lo, hi) for k in range(3)]
+            pair, height = _truncated_axes(C[cell], lo, hi, B, DB)
+            if depth < min(max_depth, CURVED_DEPTH):
+                pair = np.where(_curved(C[cell], lo, hi, B, DB, pair), -1, pair)
+            if depth == max_depth:  # the best monotone height axis alone, as Saye's
+                fallback = (pair < 0) & (height >= 0)
+                reduced.append(cell[fallback])
+                lone = [PAIRS.index((k, (k + 1) % 3)) for k in range(3)]
+                pair = np.where(fallback, np.take(lone, np.maximum(height, 0)), pair)
+        for index, (k3, k2) in enumerate(PAIRS):
+            group = pair == index
+            if group.any():
+                _clipped_rules(C, cell[group], lo[group], hi[group], k3, k2, gauss, parts, None)
+        subdivided = pair < 0
+        if depth == max_depth:
+            unresolved.append(cell[subdivided])
+            break
+        cell, lo, hi = _subdivide(cell[subdivided], lo[subdivided], hi[subdivided])
+        inside = lo.sum(axis=1) < 1.0  # children touching the half-space in a point at most go
+        cell, lo, hi = cell[inside], lo[inside], hi[inside]
+    bad = np.unique(np.concatenate(unresolved)).astype(np.int64) if unresolved else np.zeros(0, int)
+    gathered = []
+    for side, widths in (("minus", (1, 3, 1)), ("plus", (1, 3, 1)), ("interface", (1, 3, 1, 3))):
+        columns = _gather(parts[side], widths)
+        if bad.size:
+            keep = ~np.isin(columns[0], bad)
+            columns = [c[keep] for c in columns]
+        gathered.append(tuple(columns))
+    reduced = np.unique(np.concatenate([np.zeros(0, int), *reduced])).astype(np.int64)
+    return SayePoints(*gathered, reduced[~np.isin(reduced, bad)]), bad
+
+
+def _truncated_axes(C, lo, hi, B, DB):
+    """Index into ``PAIRS`` of the best valid ``(k3, k2)`` per box (-1: none) and the best
+    monotone height axis alone (-1: none). The pair is Saye's for
+    a box inside the half-space, else the same criteria on the faces the truncated box
+    has (bottom ``x_k3 = lo``, top ``x_k3 = hi`` where it meets the half-space, the
+    slanted face along ``e_k2 - e_k3``) with the slanted face's margin in the score. ``B``,
+    ``DB``: Bernstein coefficients of ``psi`` and of its three derivatives on the boxes."""
+    pair, height = choose_axes(C, lo, hi, B)
+    reaching = np.flatnonzero(hi.sum(axis=1) > 1.0)
+    if reaching.size == 0:
+        return pair, height
+    lo, hi, B = lo[reaching], hi[reaching], B[reaching]
+    DB = [d[reaching] for d in DB]
+    m = reaching.size
+    best, score = np.full(m, -1), np.full(m, -np.inf)
+    for index, (k3, k2) in enumerate(PAIRS):
+        k1 = 3 - k3 - k2
+        valid, pair_score = _certain(DB[k3]), _margin(DB[k3], DB)
+        top_inside = lo[:, k1] + lo[:, k2] + hi[:, k3] < 1.0
+        for end, present in ((0, np.ones(m, bool)), (B.shape[1] - 1, top_inside)):
+            face = np.take(B, end, axis=k3 + 1)
+            slope = [np.take(DB[k], end, axis=k3 + 1) for k in (k2, k1)]
+            definite = _certain(face) | (face.reshape(m, -1) == 0).all(axis=1)
+            valid &= ~present | definite | _certain(slope[0])
+            face_score = np.where(definite | ~present, np.inf, _margin(slope[0], slope))
+            pair_score = np.minimum(pair_score, face_score)
+        along, across = DB[k2] - DB[k3], DB[k1] - DB[k3]  # Bernstein forms are linear
+        valid &= _certain(along)
+        pair_score = np.minimum(pair_score, _margin(along, [along, across]))
+        better = valid & (pair_score > score)
+        best = np.where(better, index, best)
+        score = np.where(better, pair_score, score)
+    pair = pair.copy()
+    pair[reaching] = best
+    return pair, height
+
+
+CURVED = 4.0
+"""Largest ``|d2 psi| size / min |d psi / d x_k3|`` of a box with axes: a box above it is
+subdivided (the roots of its height lines have branch points too close for the rule)."""
+
+
+CURVED_DEPTH = 3
+"""Box levels subdivided by :data:`CURVED` (boxes of ``1 / 8`` of the cube at most: a
+slope that vanishes on the interface itself, such as a face function's where the
+interface touches the face, is not resolved by subdivision)."""
+
+
+def _curved(C, lo, hi, B, DB, pair):
+    """Boxes with axes where a slope the roots depend on (of ``psi`` along ``k3``; along
+    ``k2`` on each face with zeros and along the slanted face) is small against ``psi``'s
+    second derivatives times the box size (see :data:`CURVED`), ``(m,)`` bool; ``B``,
+    ``DB`` as in :func:`_truncated_axes`."""
+    m = C.shape[0]
+    second = np.zeros(m)
+    for a in range(3):
+        for b in range(a, 3):
+            second = np.maximum(second, np.abs(derivative(derivative(C, a), b)[:, 0, 0, 0]))
+    slope = np.full(m, np.inf)
+    for index, (k3, k2) in enumerate(PAIRS):
+        group = np.flatnonzero(pair == index)
+        if group.size == 0:
+            continue
+        least = np.abs(DB[k3][group]).reshape(group.size, -1).min(axis=1)
+        for end in (0, B.shape[1] - 1):
+            face = np.take(B[group], end, axis=k3 + 1).reshape(group.size, -1)
+            crossed = ~((face > 0).all(axis=1) | (face < 0).all(axis=1))
+            face_slope = np.abs(np.take(DB[k2][group], end, axis=k3 + 1))
+            face_slope = face_slope.reshape(group.size, -1).min(axis=1)
+            least = np.where(crossed, np.minimum(least, face_slope), least)
+        along = np.abs(DB[k2][group] - DB[k3][group]).reshape(group.size, -1).min(axis=1)
+        reaching = hi[group].sum(axis=1) > 1.0
+        slope[group] = np.where(reaching, np.minimum(least, along), least)
+    size = (hi - lo).max(axis=1)
+    return (pair >= 0) & (second * size > CURVED * slope)
+
+
+def _certain(B):
+    """Bernstein coefficients ``(m, ...)`` of one strict sign."""
+    flat = B.reshape(B.shape[0], -1)
+    return (flat > 0).all(axis=1) | (flat < 0).all(axis=1)
+
+
+def _margin(slope, slopes):
+    """Least ``|slope|`` relative to the largest of ``slopes`` (Bernstein bounds), ``(m,)``."""
+    m = slope.shape[0]
+    steepest = np.maximum.reduce([np.abs(s).reshape(m, -1).max(axis=1) for s in slopes])
+    return np.abs(slope).reshape(m, -1).min(axis=1) / np.where(steepest > 0, steepest, 1.0)
+
+
+def _slanted_line(C, P0, a, b):
+    """Coefficients ``(m, 3)`` in ``t`` of ``psi(P0 + t (e_a - e_b))`` (total degree 2)."""
+    Dd = derivative(C, a) - derivative(C, b)
+    Ddd = derivative(Dd, a) - derivative(Dd, b)
+    return np.stack([evaluate(C, P0), evaluate(Dd, P0), 0.5 * evaluate(Ddd, P0)], axis=1)
+
+
+def _roots_between(c, a, b):
+    """Roots ``(m, 2)`` of polynomials ``c`` in ``[a, b]`` (NaN: none or an empty range)."""
+    r = line_roots(c, a, np.maximum(a, b))
+    return np.where((b > a)[:, None], r, np.nan)
+
+
+def _inside(values, a, b):
+    """``values`` ``(m,)`` strictly inside ``(a, b)``, else NaN, as a column ``(m, 1)``."""
+    return np.where((values > a) & (values < b), values, np.nan)[:, None]
+
+
+def _clipped_rules(C, cell, lo, hi, k3, k2, gauss, parts, side):
+    """Nested Gauss rules of truncated boxes sharing the axes ``k3`` (height) and ``k2``;
+    ``side``: ``"minus"`` / ``"plus"`` for boxes certified on one side (no roots), else
+    ``None``."""
+    k1 = 3 - k3 - k2
+    m = cell.size
+    C1 = C[cell]
+    lo1, hi1, lo2, hi2, lo3, hi3 = lo[:, k1], hi[:, k1], lo[:, k2], hi[:, k2], lo[:, k3], hi[:, k3]
+    top1 = np.minimum(hi1, 1.0 - lo2 - lo3)
+    # level 1: along k1, breakpoints at the vertices and at the roots on the edges
+    breaks = [
+        _inside(1.0 - c2 - c3, lo1, top1) for c2, c3 in itertools.product((lo2, hi2), (lo3, hi3))
+    ]
+    if side is None:
+        for c2, c3 in itertools.product((lo2, hi2), (lo3, hi3)):  # box edges parallel to k1
+            X = np.zeros((m, 3))
+            X[:, k2], X[:, k3] = c2, c3
+            end = np.minimum(hi1, 1.0 - c2 - c3)
+            breaks.append(_roots_between(line_coefficients(C1, k1, X), lo1, end))
+        for fixed, free, (c_lo, c_hi) in ((k2, k3, (lo3, hi3)), (k3, k2, (lo2, hi2))):
+            for c in (lo[:, fixed], hi[:, fixed]):  # the slanted face on the face x_fixed = c
+                P0 = np.zeros((m, 3))
+                P0[:, fixed], P0[:, free] = c, 1.0 - c
+                a = np.maximum(lo1, 1.0 - c - c_hi)
+                b = np.minimum(hi1, 1.0 - c - c_lo)
+                breaks.append(_roots_between(_slanted_line(C1, P0, k1, free), a, b))
+    box1, u, w1, _, _ = _pieces(np.concatenate(breaks, axis=1), lo1, top1, gauss)
+    # level 2: along k2 at each u, breakpoints at the kink and the roots on the three faces
+    lo2, hi2, lo3, hi3 = lo2[box1], hi2[box1], lo3[box1], hi3[box1]
+    top2 = np.minimum(hi2, 1.0 - u - lo3)
+    kink = 1.0 - u - hi3
+    breaks = [_inside(kink, lo2, top2)]
+    if side is None:
+        C1 = C1[box1]
+        X = np.zeros((u.size, 3))
+        X[:, k1] = u
+        for c, end in ((lo3, top2), (hi3, np.minimum(top2, kink))):
+            X[:, k3] = c
+            breaks.append(_roots_between(line_coefficients(C1, k2, X), lo2, end))
+        P0 = np.zeros((u.size, 3))
+        P0[:, k1], P0[:, k3] = u, 1.0 - u
+        breaks.append(_roots_between(_slanted_line(C1, P0, k2, k3), np.maximum(lo2, kink), top2))
+    p1, v, w2, _, _ = _pieces(np.concatenate(breaks, axis=1), lo2, top2, gauss)
+    box2 = box1[p1]
+    W = w1[p1] * w2
+    X = np.zeros((v.size, 3))
+    X[:, k1], X[:, k2] = u[p1], v
+    lo3 = lo3[p1]
+    top3 = np.minimum(hi3[p1], 1.0 - X[:, k1] - v)
+    # level 3: along k3 at each (u, v), breakpoints at the roots of psi
+    if side is None:
+        C2 = C1[p1]
+        r = _roots_between(line_coefficients(C2, k3, X), lo3, top3)
+    else:
+        r = np.full((v.size, 0), np.nan)
+    p2, w, w3, piece, (pline, mid) = _pieces(r, lo3, top3, gauss)
+    Xq = X[p2].copy()
+    Xq[:, k3] = w
+    weights = W[p2] * w3
+    rows = cell[box2[p2]]
+    if side is not None:
+        parts[side].append((rows, Xq, weights))
+        return
+    Xmid = X[pline].copy()
+    Xmid[:, k3] = mid
+    negative = evaluate(C2[pline], Xmid) < 0
+    for name, keep in (("minus", negative[piece]), ("plus", ~negative[piece])):
+        parts[name].append((rows[keep], Xq[keep], weights[keep]))
+    # interface: each root of a height line bounding side -1
+    for j in range(r.shape[1]):
+        line = np.flatnonzero(~np.isnan(r[:, j]))
+        Xs = X[line].copy()
+        Xs[:, k3] = r[line, j]
+        grad = gradient(C2[line], Xs)
+        slope = grad[:, k3]
+        at_lo, at_hi = r[line, j] == lo3[line], r[line, j] == top3[line]
+        bounding = ~(at_lo | at_hi) | (at_hi & (slope > 0)) | (at_lo & (slope < 0))
+        bounding &= slope != 0
+        if j == 1:  # a double root (both columns equal) is one point
+            bounding &= ~(r[line, 1] == r[line, 0])
+        line, Xs, grad, slope = line[bounding], Xs[bounding], grad[bounding], slope[bounding]
+        parts["interface"].append((cell[box2[line]], Xs, W[line], grad / np.abs(slope)[:, None]))
