@@ -1,27 +1,51 @@
-"""The numerical inf-sup test of every 2D element: the discrete inf-sup constant
+"""The numerical inf-sup test of every element: the discrete inf-sup constant
 (:func:`xfem_contact.mechanics.inf_sup.inf_sup_constant`) of P1-P1, P2-P1 and P2-P2 on
-triangles and quadrilaterals, for each LBB treatment (none, restriction, stabilized; stabilized
-with the ghost penalty raised to the stabilisation's weight, 0.1, too), on n = 8, 16,
-32, 64 cells per side of the unit square, over circles at random centres and radii (a
-third of them passing within 1e-6 h of a mesh node: tiny cuts on purpose). Prints, per
-element, treatment and n, the least and median beta and the count of indefinite pairs
-(beta^2 < 0), and the slope of the least beta in log n over the last pair; then P1-P1
-on tetrahedra cut by a sphere (``--tet-sizes``). Writes
-``bench/results/inf_sup.{json,md,png}``.
+triangles and quadrilaterals and of P1-P1 and P2-P1 (Q1-Q1, Q2-Q1) on tetrahedra and
+hexahedra, for each LBB treatment, on interfaces cut at random (tiny cuts on purpose), on
+cracks and on a sphere.
 
-Run: ``python bench/inf_sup.py [--circles 50] [--sizes 8 16 32 64] [--elements P2-P2]``
-(``make bench``; default P1-P1 and P2-P1, with the tetrahedra; other ``--elements``
-write ``bench/results/inf_sup_<elements>.{json,md,png}``).
+The studies (``--study``):
+
+- ``circles`` (default): the unit square, n = 8, 16, 32, 64 cells a side, cut by circles
+  at random centres and radii (50 a mesh; a third of them passing within 1e-6 h of a
+  mesh node);
+- ``crack``: the unit square cut by straight cracks at random centres, directions and
+  half lengths (12 a mesh; a third of them along a line 1e-6 h from a node), the lips
+  bonded, with topological tip enrichment (the smallest displacement space: the least
+  ``beta``); a crack refuses the stabilisation;
+- ``3d``: the unit cube (tetrahedra or hexahedra, n cells a side) cut by the sphere of
+  radius 0.2 about its centre; the restriction is refused on 3D meshes.
+
+The treatments (``--treatments``): none, restriction, stabilized; stabilized with the
+ghost penalty raised to the stabilisation's weight (0.1) or with cell aggregation.
+Prints, per element, treatment and n, the least and median beta, the count of
+indefinite pairs (beta^2 < 0; without a treatment, round-off of a zero eigenvalue: a
+spurious multiplier) and the slope of the least beta in log n over the last pair.
+Writes ``bench/results/<name>.{json,md,png}`` after each element and treatment (``name``:
+``inf_sup``, ``inf_sup_crack``, ``inf_sup_3d``, with the elements and treatments that
+differ from the study's default, or ``--name``). BLAS runs on one thread (the dense
+eigenproblems are small; threads only contend).
+
+Run: ``python bench/inf_sup.py [--study circles|crack|3d] [--circles 50] [--sizes 8 16
+32 64] [--elements P2-P2] [--treatments ...]``.
 """
 
-import xfem_contact  # noqa: F401  (before dolfinx)
+import os
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")  # before numpy: one BLAS thread
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import xfem_contact  # noqa: E402, F401  (before dolfinx)
 
 # isort: split
 import argparse
 import json
 import math
 import pathlib
+import shlex
+import sys
 import time
+from collections.abc import Callable, Iterator
 
 import dolfinx.mesh
 import numpy as np
@@ -35,23 +59,27 @@ from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.problem import Problem
 
 RESULTS = pathlib.Path(__file__).resolve().parent / "results"
-#: (cell, displacement degree, multiplier degree)
-ELEMENTS = [
-    (cell, degree, multiplier)
-    for cell in ("triangle", "quadrilateral")
-    for degree, multiplier in ((1, 1), (2, 1), (2, 2))
-]
-
-
-#: The elements of ``bench/results/inf_sup.*``
-DEFAULT_ELEMENTS = ("P1-P1", "P2-P1")
-
-
-def label(degree: int, multiplier: int) -> str:
-    """``P2-P1``: the displacement and multiplier degrees."""
-    return f"P{degree}-P{multiplier}"
-
-
+MATERIAL = Material(100e6, 0.3)
+#: (cell, displacement degree, multiplier degree) of each study
+ELEMENTS = {
+    "circles": [
+        (cell, degree, multiplier)
+        for cell in ("triangle", "quadrilateral")
+        for degree, multiplier in ((1, 1), (2, 1), (2, 2))
+    ],
+    "crack": [
+        (cell, degree, multiplier)
+        for cell in ("triangle", "quadrilateral")
+        for degree, multiplier in ((1, 1), (2, 1), (2, 2))
+    ],
+    "3d": [(cell, degree, 1) for cell in ("tetrahedron", "hexahedron") for degree in (1, 2)],
+}
+#: The elements of each study's default result
+DEFAULT_ELEMENTS = {
+    "circles": ("P1-P1", "P2-P1"),
+    "crack": ("P1-P1", "P2-P1", "P2-P2"),
+    "3d": ("P1-P1", "P2-P1"),
+}
 #: label: (lbb, ghost penalty, cell aggregation; None: the default)
 TREATMENTS = {
     "none": ("none", None, None),
@@ -60,10 +88,24 @@ TREATMENTS = {
     "stabilized, ghost 0.1": ("stabilized", 0.1, None),
     "stabilized, aggregation 0.25": ("stabilized", None, 0.25),
 }
+#: The treatments of each study's default result (the others: ``--treatments``); a crack
+#: refuses the stabilisation (it squares the tip's singular traction on the lips)
+DEFAULT_TREATMENTS = {
+    "circles": ("none", "restriction", "stabilized"),
+    "crack": ("none", "restriction"),
+    "3d": ("none", "restriction", "stabilized"),
+}
+DEFAULT_SIZES = {"circles": (8, 16, 32, 64), "crack": (8, 16, 32, 64), "3d": (4, 8, 12)}
+
+
+def label(degree: int, multiplier: int) -> str:
+    """``P2-P1``: the displacement and multiplier degrees."""
+    return f"P{degree}-P{multiplier}"
 
 
 def circles(count: int, n: int, rng) -> list[tuple[float, float, float]]:
-    """Random circles inside the unit square; every third through a node to 1e-6 h."""
+    """Random circles ``(cx, cy, r)`` inside the unit square; every third through a node
+    to 1e-6 h."""
     out = []
     for k in range(count):
         cx, cy = rng.uniform(0.35, 0.65, 2)
@@ -75,23 +117,96 @@ def circles(count: int, n: int, rng) -> list[tuple[float, float, float]]:
     return out
 
 
-def plot(rows: list[dict], elements: list, path: pathlib.Path) -> None:
+def cracks(count: int, n: int, rng) -> list[tuple[float, float, float, float]]:
+    """Random straight cracks ``(cx, cy, angle, a)`` (centre, direction in rad, half
+    length) inside the unit square; every third along a line 1e-6 h from a node."""
+    out = []
+    for k in range(count):
+        cx, cy = rng.uniform(0.4, 0.6, 2)
+        angle, a = rng.uniform(0.0, math.pi), rng.uniform(0.15, 0.3)
+        if k % 3 == 2:
+            node = np.round(np.array([cx, cy]) * n) / n
+            normal = np.array([-math.sin(angle), math.cos(angle)])
+            cx, cy = node + 1e-6 / n * normal
+        out.append((float(cx), float(cy), float(angle), float(a)))
+    return out
+
+
+def circle_cuts(n: int, cell: str, degree: int, count: int) -> Iterator[CutMesh]:
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType[cell])
+    for cx, cy, r in circles(count, n, np.random.default_rng(n)):
+        circle = lambda x, c=(cx, cy), r=r: np.hypot(x[0] - c[0], x[1] - c[1]) - r  # noqa: E731
+        yield CutMesh(mesh, circle, degree=2)
+
+
+def crack_cuts(n: int, cell: str, degree: int, count: int) -> Iterator[CutMesh]:
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType[cell])
+    for cx, cy, angle, a in cracks(count, n, np.random.default_rng(n)):
+        d = np.array([math.cos(angle), math.sin(angle)])
+        yield CutMesh(
+            mesh,
+            lambda x, c=(cx, cy), d=d: (x[1] - c[1]) * d[0] - (x[0] - c[0]) * d[1],
+            degree=degree,
+            tangent=lambda x, c=(cx, cy), d=d, a=a: (
+                np.abs((x[0] - c[0]) * d[0] + (x[1] - c[1]) * d[1]) - a
+            ),
+        )
+
+
+def sphere_cuts(n: int, cell: str, degree: int, count: int) -> Iterator[CutMesh]:
+    mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, n, n, n, dolfinx.mesh.CellType[cell])
+    yield CutMesh(mesh, lambda x: np.sqrt(((x.T - 0.5) ** 2).sum(axis=1)) - 0.2, degree=2)
+
+
+#: study: the cuts of one mesh ``(n, cell, displacement degree, count)``
+CUTS: dict[str, Callable[..., Iterator[CutMesh]]] = {
+    "circles": circle_cuts,
+    "crack": crack_cuts,
+    "3d": sphere_cuts,
+}
+
+
+def sample(study: str, cell: str, degree: int, multiplier: int, lbb: str, n: int, count: int):
+    """beta^2 of each cut of one mesh (None: the treatment is refused, with the reason)."""
+    treatment, ghost_penalty, aggregation = TREATMENTS[lbb]
+    law = Bonded(lbb=treatment, multiplier_degree=multiplier)
+    out = []
+    for cut in CUTS[study](n, cell, degree, count):
+        try:
+            problem = Problem(
+                cut,
+                degree,
+                MATERIAL,
+                law,
+                ghost_penalty=ghost_penalty,
+                aggregation=aggregation,
+                tip_radius=None,
+            )
+            out.append(inf_sup_constant(problem))
+        except ValueError as refused:  # a treatment the problem refuses, e.g. on a crack
+            return None, str(refused)
+    return out, ""
+
+
+def plot(rows: list[dict], path: pathlib.Path) -> None:
     """Least beta against n, one panel per element, one line per treatment."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    elements = list(dict.fromkeys((r["cell"], r["element"]) for r in rows))
     fig, axes = plt.subplots(
         1, len(elements), figsize=(4 * len(elements), 3.6), sharey=True, squeeze=False
     )
-    for ax, element in zip(axes[0], elements, strict=True):
-        cell, degree, multiplier = element
+    for ax, (cell, element) in zip(axes[0], elements, strict=True):
         for lbb in dict.fromkeys(r["lbb"] for r in rows):
-            sel = [r for r in rows if _key(r) == (*element, lbb)]
-            ns = [r["n"] for r in sel]
-            ax.loglog(ns, [max(r["beta_min"], 1e-8) for r in sel], "o-", label=f"{lbb} (least)")
-        ax.set_title(f"{cell}, {label(degree, multiplier)}")
+            sel = [r for r in rows if (r["cell"], r["element"], r["lbb"]) == (cell, element, lbb)]
+            sel = [r for r in sel if r["beta_squared"]]
+            if sel:
+                ns, least = [r["n"] for r in sel], [max(r["beta_min"], 1e-8) for r in sel]
+                ax.loglog(ns, least, "o-", label=f"{lbb} (least)")
+        ax.set_title(f"{cell}, {element}")
         ax.set_xlabel("cells per side n")
     axes[0][0].set_ylabel("discrete inf-sup constant beta")
     axes[0][0].legend(fontsize=8)
@@ -100,136 +215,123 @@ def plot(rows: list[dict], elements: list, path: pathlib.Path) -> None:
     plt.close(fig)
 
 
-def _key(row: dict) -> tuple:
-    return row["cell"], row["degree"], row.get("multiplier_degree", 1), row["lbb"]
-
-
-def tetrahedra(sizes: list[int]) -> list[str]:
-    """P1-P1 on the unit cube's tetrahedra (6 n^3) cut by the sphere of radius 0.2 about
-    its centre, without LBB treatment and stabilised (the restriction is 2D only):
-    lines of a Markdown table of beta^2."""
-    if not sizes:
-        return []
+def table(rows: list[dict], sizes: list[int]) -> list[str]:
+    """Markdown lines: per element and treatment, least / median beta of each n, the
+    slope of the least beta over the last pair and the count of indefinite pairs."""
     lines = [
-        "",
-        "P1-P1 tetrahedra, sphere R = 0.2 in the unit cube (beta^2; multipliers):",
-        "",
-        "| lbb | " + " | ".join(f"n={n}" for n in sizes) + " |",
-        "|---|" + "---|" * len(sizes),
+        "| cell | element | lbb | "
+        + " | ".join(f"n={n}: min / median beta" for n in sizes)
+        + " | slope of min (last pair) | indefinite | multipliers (largest n) |",
+        "|---|---|---|" + "---|" * len(sizes) + "---|---|---|",
     ]
-    for lbb in ("none", "stabilized"):
-        cells = []
-        for n in sizes:
-            mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, n, n, n)
-            sphere = lambda x: np.sqrt(((x.T - 0.5) ** 2).sum(axis=1)) - 0.2  # noqa: E731
-            cut = CutMesh(mesh, sphere, degree=2)
-            result = inf_sup_constant(Problem(cut, 1, Material(100e6, 0.3), Bonded(lbb=lbb)))
-            cells.append(f"{result.beta_squared:.3e} ({result.multipliers})")
-            note(f"tetrahedra P1-P1 {lbb:11s} n={n:3d}: beta^2 {result.beta_squared:.3e}")
-        lines.append(f"| {lbb} | " + " | ".join(cells) + " |")
+    for cell, element, lbb in dict.fromkeys((r["cell"], r["element"], r["lbb"]) for r in rows):
+        sel = [r for r in rows if (r["cell"], r["element"], r["lbb"]) == (cell, element, lbb)]
+        if sel[0]["refused"]:
+            lines.append(
+                f"| {cell} | {element} | {lbb} | refused: {sel[0]['refused']} |"
+                + " |" * (len(sizes) + 2)
+            )
+            continue
+        mins = [r["beta_min"] for r in sel]
+        slope = (
+            math.log(mins[-1] / mins[-2]) / math.log(sel[-1]["n"] / sel[-2]["n"])
+            if len(mins) > 1 and min(mins[-2:]) > 0
+            else float("nan")
+        )
+        cells = " | ".join(f"{r['beta_min']:.2e} / {r['beta_median']:.2e}" for r in sel)
+        indefinite = sum(r["indefinite"] for r in sel)
+        total = sum(len(r["beta_squared"]) for r in sel)
+        lines.append(
+            f"| {cell} | {element} | {lbb} | {cells} | {slope:.2f} | {indefinite}/{total} | "
+            f"{max(sel[-1]['multipliers'])} |"
+        )
     return lines
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--circles", type=int, default=12, help="circles per mesh")
-    parser.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32, 64], help="n")
-    parser.add_argument(
-        "--tet-sizes", type=int, nargs="*", default=[4, 8, 12], help="n of the P1-P1 tetrahedra"
-    )
+    parser.add_argument("--study", choices=list(CUTS), default="circles", help="the cuts")
+    parser.add_argument("--circles", type=int, default=50, help="circles per mesh")
+    parser.add_argument("--cracks", type=int, default=12, help="cracks per mesh")
+    parser.add_argument("--sizes", type=int, nargs="+", help="n (default per study)")
     parser.add_argument(
         "--elements",
         nargs="+",
-        choices=sorted({label(d, m) for _, d, m in ELEMENTS}),
-        default=list(DEFAULT_ELEMENTS),
-        help="these elements (default P1-P1 P2-P1; others: results in inf_sup_<elements>.*)",
+        choices=sorted({label(d, m) for elements in ELEMENTS.values() for _, d, m in elements}),
+        help="these elements (default per study)",
     )
     parser.add_argument(
-        "--treatments",
-        nargs="+",
-        choices=list(TREATMENTS),
-        default=list(TREATMENTS),
-        help="these LBB treatments (default all; fewer: results in inf_sup_<...>_<treatments>.*)",
+        "--cells", nargs="+", help="these cells only (default: both of the study's)"
     )
+    parser.add_argument("--treatments", nargs="+", choices=list(TREATMENTS), help="LBB treatments")
+    parser.add_argument("--name", help="results bench/results/NAME.* (default: see above)")
     args = parser.parse_args()
-    elements = [e for e in ELEMENTS if label(*e[1:]) in args.elements]
-    treatments = {k: v for k, v in TREATMENTS.items() if k in args.treatments}
-    default = sorted(args.elements) == sorted(DEFAULT_ELEMENTS) and len(treatments) == len(
-        TREATMENTS
-    )
+    study = args.study
+    sizes = args.sizes or list(DEFAULT_SIZES[study])
+    chosen = args.elements or list(DEFAULT_ELEMENTS[study])
+    treatments = args.treatments or list(DEFAULT_TREATMENTS[study])
+    elements = [e for e in ELEMENTS[study] if label(*e[1:]) in chosen]
+    cells = {cell for cell, _, _ in ELEMENTS[study]}
+    if args.cells is not None:
+        if not set(args.cells) <= cells:
+            raise ValueError(f"--cells of the {study} study must be among {sorted(cells)}")
+        elements = [e for e in elements if e[0] in args.cells]
+    if not elements:
+        raise ValueError(f"--elements {chosen} has none in the {study} study: {ELEMENTS[study]}")
+    count = {"circles": args.circles, "crack": args.cracks, "3d": 1}[study]
+    parts = [] if study == "circles" else [study]
+    if sorted(chosen) != sorted(DEFAULT_ELEMENTS[study]):
+        parts += chosen
+    if list(treatments) != list(DEFAULT_TREATMENTS[study]):
+        parts += [t.replace(", ", "_").replace(" ", "_") for t in treatments]
+    name = args.name or "_".join(["inf_sup", *parts, *(args.cells or [])])
+    command = shlex.join(["python", "bench/inf_sup.py", *sys.argv[1:]])
     rows = []
     for cell, degree, multiplier in elements:
-        for lbb, (treatment, ghost_penalty, aggregation) in treatments.items():
-            for n in args.sizes:
-                mesh = dolfinx.mesh.create_unit_square(
-                    MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType[cell]
-                )
-                start, b2 = time.perf_counter(), []
-                for cx, cy, r in circles(args.circles, n, np.random.default_rng(n)):
-                    circle = lambda x, c=(cx, cy), r=r: np.hypot(x[0] - c[0], x[1] - c[1]) - r  # noqa: E731
-                    cut = CutMesh(mesh, circle, degree=2)
-                    law = Bonded(lbb=treatment, multiplier_degree=multiplier)
-                    material = Material(100e6, 0.3)
-                    problem = Problem(
-                        cut,
-                        degree,
-                        material,
-                        law,
-                        ghost_penalty=ghost_penalty,
-                        aggregation=aggregation,
-                    )
-                    b2.append(inf_sup_constant(problem).beta_squared)
-                b = np.sqrt(np.maximum(b2, 0.0))
+        for lbb in treatments:
+            for n in sizes:
+                start = time.perf_counter()
+                results, refused = sample(study, cell, degree, multiplier, lbb, n, count)
+                b2 = [r.beta_squared for r in results or []]
+                b = np.sqrt(np.maximum(b2, 0.0)) if b2 else np.zeros(1)
                 rows.append(
                     {
                         "cell": cell,
-                        "degree": degree,
-                        "multiplier_degree": multiplier,
+                        "element": label(degree, multiplier),
                         "lbb": lbb,
                         "n": n,
                         "beta_min": float(b.min()),
                         "beta_median": float(np.median(b)),
                         "indefinite": int((np.array(b2) < 0).sum()),
                         "beta_squared": b2,
+                        "multipliers": [r.multipliers for r in results or []],
+                        "refused": refused,
                     }
                 )
                 note(
-                    f"{cell:13s} {label(degree, multiplier)} {lbb:21s} n={n:3d}: beta min "
-                    f"{b.min():.3e} median {np.median(b):.3e}, indefinite {rows[-1]['indefinite']}/"
-                    f"{len(b2)} ({time.perf_counter() - start:.1f} s)"
+                    f"{cell:13s} {label(degree, multiplier)} {lbb:21s} n={n:3d}: "
+                    + (
+                        f"refused ({refused})"
+                        if refused
+                        else f"beta min {b.min():.3e} median {np.median(b):.3e}, indefinite "
+                        f"{rows[-1]['indefinite']}/{len(b2)}"
+                    )
+                    + f" ({time.perf_counter() - start:.1f} s)"
                 )
-    lines = [
-        "| cell | element | lbb | "
-        + " | ".join(f"n={n}: min / median beta" for n in args.sizes)
-        + " | slope of min (last pair) | indefinite |",
-        "|---|---|---|" + "---|" * len(args.sizes) + "---|---|",
-    ]
-    for cell, degree, multiplier in elements:
-        for lbb in treatments:
-            sel = [r for r in rows if _key(r) == (cell, degree, multiplier, lbb)]
-            mins = [r["beta_min"] for r in sel]
-            slope = (
-                math.log(mins[-1] / mins[-2]) / math.log(args.sizes[-1] / args.sizes[-2])
-                if len(mins) > 1 and min(mins[-2:]) > 0
-                else float("nan")
-            )
-            cells = " | ".join(f"{r['beta_min']:.2e} / {r['beta_median']:.2e}" for r in sel)
-            lines.append(
-                f"| {cell} | {label(degree, multiplier)} | {lbb} | {cells} | {slope:.2f} | "
-                f"{sum(r['indefinite'] for r in sel)}/{args.circles * len(sel)} |"
-            )
-    parts = list(args.elements)
-    if len(treatments) < len(TREATMENTS):
-        parts += [t.replace(", ", "_").replace(" ", "_") for t in treatments]
-    name = "inf_sup" if default else "_".join(["inf_sup", *parts])
-    if default:
-        lines += tetrahedra(args.tet_sizes)
-    RESULTS.mkdir(exist_ok=True)
-    plot(rows, elements, RESULTS / f"{name}.png")
-    (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
-    (RESULTS / f"{name}.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))
-    print("\n".join(lines))
+                if refused:
+                    break
+            write(rows, sizes, name, command, vars(args))  # each block: a long run's partial table
+    print((RESULTS / f"{name}.md").read_text())
     print(f"wrote {RESULTS / name}.md and .json")
+
+
+def write(rows: list[dict], sizes: list[int], name: str, command: str, args: dict) -> None:
+    """``bench/results/<name>.{md,json,png}`` of ``rows``."""
+    lines = [f"Command: `{command}`", "", *table(rows, sizes)]
+    RESULTS.mkdir(exist_ok=True)
+    plot(rows, RESULTS / f"{name}.png")
+    (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
+    (RESULTS / f"{name}.json").write_text(json.dumps({"rows": rows, "args": args}))
 
 
 if __name__ == "__main__":

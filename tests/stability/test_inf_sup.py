@@ -100,6 +100,86 @@ def test_without_lbb_treatment_the_constant_falls():
     assert min(values) < FLOOR and slope(values) < SLOPE, values
 
 
+#: A straight crack through the unit square (centre, direction in rad, half length):
+#: both tips inside cells, off every mesh line
+CRACK = (0.5123, 0.5271, 0.3, 0.3)
+
+
+def crack_cut(n: int) -> CutMesh:
+    """:data:`CRACK` on the unit square's triangles, ``n`` cells a side."""
+    cx, cy, angle, a = CRACK
+    d = (math.cos(angle), math.sin(angle))
+    return CutMesh(
+        dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n),
+        lambda x: (x[1] - cy) * d[0] - (x[0] - cx) * d[1],
+        degree=1,
+        tangent=lambda x: np.abs((x[0] - cx) * d[0] + (x[1] - cy) * d[1]) - a,
+    )
+
+
+def crack_betas(lbb: str) -> list[float]:
+    """beta of the bonded lips of :data:`CRACK` (P1-P1 triangles, topological tip
+    enrichment: the smallest displacement space, so the least beta) on n = ``SIZES``."""
+    out = []
+    for n in SIZES:
+        problem = Problem(crack_cut(n), 1, Material(100e6, 0.3), Bonded(lbb=lbb), tip_radius=None)
+        out.append(inf_sup_constant(problem).beta)
+    return out
+
+
+def test_the_restriction_keeps_the_crack_constant_bounded():
+    """The lips' multiplier of a crack with the vital-vertex restriction (a crack's
+    default): beta 0.451, 0.465, 0.458 on n = 8, 16, 32 (0.440 at n = 64)."""
+    values = crack_betas("restriction")
+    assert min(values) > FLOOR, values
+    assert slope(values) >= SLOPE, values
+
+
+def test_without_lbb_treatment_the_crack_constant_falls():
+    """The guard's failure for a crack: beta 0.091, 0.030, 0.020 (0.0069 at n = 64)."""
+    values = crack_betas("none")
+    assert min(values) < FLOOR and slope(values) < SLOPE, values
+
+
+def test_a_crack_refuses_the_stabilisation():
+    """The Barbosa-Hughes term squares the tip's singular traction on the lips: a crack
+    has only the restriction to claim stability."""
+    with pytest.raises(ValueError, match="lbb='stabilized' squares"):
+        Problem(crack_cut(4), 1, Material(100e6, 0.3), Bonded(lbb="stabilized"))
+
+
+#: 3D: P1-P1 tetrahedra of the unit cube (6 n^3) cut by the sphere of radius 0.2 about
+#: its centre, on n = 4, 8
+SIZES_3D = (4, 8)
+
+
+def sphere_betas(lbb: str, degree: int = 1) -> list[float]:
+    out = []
+    for n in SIZES_3D:
+        mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, n, n, n)
+        cut = CutMesh(mesh, lambda x: np.sqrt(((x.T - 0.5) ** 2).sum(axis=1)) - 0.2, degree=2)
+        problem = Problem(cut, degree, Material(100e6, 0.3), Bonded(lbb=lbb))
+        out.append(inf_sup_constant(problem).beta)
+    return out
+
+
+def slope_3d(values: list[float]) -> float:
+    return math.log(values[-1] / values[-2]) / math.log(SIZES_3D[-1] / SIZES_3D[-2])
+
+
+def test_the_stabilisation_keeps_the_3d_constant_bounded():
+    """Tetrahedra, P1-P1, stabilised: beta 0.365, 0.361 on n = 4, 8."""
+    values = sphere_betas("stabilized")
+    assert min(values) > FLOOR, values
+    assert slope_3d(values) >= SLOPE, values
+
+
+def test_without_lbb_treatment_the_3d_constant_falls():
+    """The guard's failure in 3D: beta 0.082, 0.015 on n = 4, 8."""
+    values = sphere_betas("none")
+    assert min(values) < FLOOR and slope_3d(values) < SLOPE, values
+
+
 #: A circle on which the Barbosa-Hughes stabilisation (weight 0.1) with the default ghost
 #: penalty (0.01) gives an indefinite pair: P2 triangles, n = 16, beta^2 = -16.8
 INDEFINITE = (0.5897298894274488, 0.4623662904020971, 0.21349896734588636)
