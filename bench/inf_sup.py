@@ -14,7 +14,8 @@ The studies (``--study``):
   bonded, with topological tip enrichment (the smallest displacement space: the least
   ``beta``); a crack refuses the stabilisation;
 - ``3d``: the unit cube (tetrahedra or hexahedra, n cells a side) cut by the sphere of
-  radius 0.2 about its centre; the restriction is refused on 3D meshes.
+  radius 0.2 about its centre (``--spheres K``: and K - 1 random ones, every third
+  through a node to 1e-6 h); the restriction is refused on 3D meshes.
 
 The treatments (``--treatments``): none, restriction, stabilized; stabilized with the
 ghost penalty raised to the stabilisation's weight (0.1) or with cell aggregation.
@@ -52,6 +53,7 @@ import numpy as np
 from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.io.meshes import ghosted_partitioner
 from xfem_contact.io.progress import note
 from xfem_contact.mechanics.inf_sup import inf_sup_constant
 from xfem_contact.mechanics.laws import Bonded
@@ -140,7 +142,9 @@ def circle_cuts(n: int, cell: str, degree: int, count: int) -> Iterator[CutMesh]
 
 
 def crack_cuts(n: int, cell: str, degree: int, count: int) -> Iterator[CutMesh]:
-    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType[cell])
+    mesh = dolfinx.mesh.create_unit_square(
+        MPI.COMM_WORLD, n, n, dolfinx.mesh.CellType[cell], partitioner=ghosted_partitioner()
+    )
     for cx, cy, angle, a in cracks(count, n, np.random.default_rng(n)):
         d = np.array([math.cos(angle), math.sin(angle)])
         yield CutMesh(
@@ -153,9 +157,24 @@ def crack_cuts(n: int, cell: str, degree: int, count: int) -> Iterator[CutMesh]:
         )
 
 
+def spheres(count: int, n: int, rng) -> list[tuple[float, float, float, float]]:
+    """``(cx, cy, cz, r)``: the sphere of radius 0.2 about the unit cube's centre, then
+    random ones inside it, every third through a node to 1e-6 h."""
+    out = [(0.5, 0.5, 0.5, 0.2)]
+    for k in range(1, count):
+        centre, r = rng.uniform(0.35, 0.65, 3), rng.uniform(0.12, 0.3)
+        if k % 3 == 2:
+            node = np.round((centre + (r, 0.0, 0.0)) * n) / n
+            r = float(np.linalg.norm(node - centre)) + 1e-6 / n
+        out.append((*map(float, centre), float(r)))
+    return out
+
+
 def sphere_cuts(n: int, cell: str, degree: int, count: int) -> Iterator[CutMesh]:
     mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, n, n, n, dolfinx.mesh.CellType[cell])
-    yield CutMesh(mesh, lambda x: np.sqrt(((x.T - 0.5) ** 2).sum(axis=1)) - 0.2, degree=2)
+    for *c, r in spheres(count, n, np.random.default_rng(n)):
+        sphere = lambda x, c=tuple(c), r=r: np.sqrt(((x.T - c) ** 2).sum(axis=1)) - r  # noqa: E731
+        yield CutMesh(mesh, sphere, degree=2)
 
 
 #: study: the cuts of one mesh ``(n, cell, displacement degree, count)``
@@ -253,6 +272,7 @@ def main() -> None:
     parser.add_argument("--study", choices=list(CUTS), default="circles", help="the cuts")
     parser.add_argument("--circles", type=int, default=50, help="circles per mesh")
     parser.add_argument("--cracks", type=int, default=12, help="cracks per mesh")
+    parser.add_argument("--spheres", type=int, default=1, help="spheres per mesh (3d)")
     parser.add_argument("--sizes", type=int, nargs="+", help="n (default per study)")
     parser.add_argument(
         "--elements",
@@ -278,7 +298,7 @@ def main() -> None:
         elements = [e for e in elements if e[0] in args.cells]
     if not elements:
         raise ValueError(f"--elements {chosen} has none in the {study} study: {ELEMENTS[study]}")
-    count = {"circles": args.circles, "crack": args.cracks, "3d": 1}[study]
+    count = {"circles": args.circles, "crack": args.cracks, "3d": args.spheres}[study]
     parts = [] if study == "circles" else [study]
     if sorted(chosen) != sorted(DEFAULT_ELEMENTS[study]):
         parts += chosen
