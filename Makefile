@@ -72,7 +72,8 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/inf_sup.py --elements P1-P1
 	$(PY) bench/inf_sup.py --elements P2-P1
 	$(PY) bench/inf_sup.py --elements P2-P2 --sizes 8 16 32 --circles 12 --treatments none restriction stabilized "stabilized, ghost 0.1" --name inf_sup_P2-P2
-	$(PY) bench/inf_sup.py --circles 12 --treatments "stabilized, ghost 0.1" "stabilized, aggregation 0.25"
+	$(PY) bench/inf_sup.py --circles 12 --treatments "stabilized, ghost 0.1" --name inf_sup_P1-P1_P2-P1_stabilized_ghost_0.1
+	$(PY) bench/inf_sup.py --circles 12 --treatments "stabilized, aggregation 0.25" --name inf_sup_P1-P1_P2-P1_stabilized_aggregation_0.25
 	$(PY) bench/inf_sup.py --study crack
 	$(PY) bench/inf_sup.py --study 3d --sizes 4 8 12
 	$(PY) bench/multiplier_degree.py

@@ -55,7 +55,7 @@ from mpi4py import MPI
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.io.meshes import ghosted_partitioner
 from xfem_contact.io.progress import note
-from xfem_contact.mechanics.inf_sup import inf_sup_constant
+from xfem_contact.mechanics.inf_sup import InfSup, inf_sup_constant
 from xfem_contact.mechanics.laws import Bonded
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.mechanics.problem import Problem
@@ -185,8 +185,11 @@ CUTS: dict[str, Callable[..., Iterator[CutMesh]]] = {
 }
 
 
-def sample(study: str, cell: str, degree: int, multiplier: int, lbb: str, n: int, count: int):
-    """beta^2 of each cut of one mesh (None: the treatment is refused, with the reason)."""
+def sample(
+    study: str, cell: str, degree: int, multiplier: int, lbb: str, n: int, count: int
+) -> tuple[list[InfSup] | None, str]:
+    """The :class:`InfSup` of each cut of one mesh and ``""``; or None and the reason the
+    problem refuses the treatment."""
     treatment, ghost_penalty, aggregation = TREATMENTS[lbb]
     law = Bonded(lbb=treatment, multiplier_degree=multiplier)
     out = []
@@ -262,7 +265,7 @@ def table(rows: list[dict], sizes: list[int]) -> list[str]:
         total = sum(len(r["beta_squared"]) for r in sel)
         lines.append(
             f"| {cell} | {element} | {lbb} | {cells} | {slope:.2f} | {indefinite}/{total} | "
-            f"{max(sel[-1]['multipliers'])} |"
+            f"{max(sel[-1]['multipliers'], default='')} |"
         )
     return lines
 
