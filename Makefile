@@ -69,8 +69,16 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/moving_interface.py --no-progress
 	$(PY) bench/parameter_sweep.py --no-progress
 	$(PY) bench/crack_convergence.py --no-progress
-	$(PY) bench/inf_sup.py
-	$(PY) bench/inf_sup.py --elements P2-P2 --sizes 8 16 32
+	$(PY) bench/inf_sup.py --elements P1-P1
+	$(PY) bench/inf_sup.py --elements P2-P1
+	$(PY) bench/inf_sup.py --elements P2-P2 --sizes 8 16 32 --circles 12 --treatments none restriction stabilized "stabilized, ghost 0.1" --name inf_sup_P2-P2
+	$(PY) bench/inf_sup.py --circles 12 --treatments "stabilized, ghost 0.1" --name inf_sup_P1-P1_P2-P1_stabilized_ghost_0.1
+	$(PY) bench/inf_sup.py --circles 12 --treatments "stabilized, aggregation 0.25" --name inf_sup_P1-P1_P2-P1_stabilized_aggregation_0.25
+	$(PY) bench/inf_sup.py --study crack
+	$(PY) bench/inf_sup.py --study 3d --sizes 4 8 12
+	$(PY) bench/inf_sup.py --study 3d --sizes 4 8 --spheres 12 --cells tetrahedron --treatments stabilized --name inf_sup_3d_spheres
+	$(PY) bench/inf_sup.py --study 3d --sizes 4 8 --spheres 12 --cells tetrahedron --elements P1-P1 --treatments "stabilized, ghost 0.1" "stabilized, aggregation 0.25" --name inf_sup_3d_spheres_P1-P1_ghost_aggregation
+	$(PY) bench/inf_sup.py --study crack --cells quadrilateral --elements P1-P1 P2-P1 --cracks 6 --name inf_sup_crack_quadrilateral
 	$(PY) bench/multiplier_degree.py
 	$(PY) bench/aggregation.py
 	$(PY) bench/cut3d.py --sizes 4 8 16 32

@@ -1,9 +1,9 @@
 """Each stability test fails with the guard it checks switched off.
 
 Guards: the ghost penalty (cut fractions), cell aggregation (cut fractions without the
-ghost penalty), the harmonic-mean augmentation (stiffness
-contrast), the Coulomb clamp (friction cone), the objective bulk (a large rotation in
-one step or ten). The LBB check carries its own counter-test (``lbb="none"``).
+ghost penalty; the stabilised pair's inf-sup constant), the harmonic-mean augmentation
+(stiffness contrast), the Coulomb clamp (friction cone), the objective bulk (a large
+rotation in one step or ten). The LBB check carries its own counter-test (``lbb="none"``).
 Marked ``guards``: ``pytest -m guards`` runs these alone.
 """
 
@@ -11,6 +11,7 @@ import pytest
 import test_aggregation
 import test_cuts
 import test_friction
+import test_inf_sup
 import test_materials
 import test_rotation
 
@@ -34,15 +35,23 @@ def without_aggregation(monkeypatch):
     return test_aggregation.test_aggregation_bounds_the_condition_without_ghost_penalty
 
 
+def without_aggregation_in_the_inf_sup_test(monkeypatch):
+    betas = test_inf_sup.betas
+    monkeypatch.setattr(
+        test_inf_sup,
+        "betas",
+        lambda *args, **options: betas(*args, **options | {"aggregation": None}),
+    )
+    return test_inf_sup.test_aggregation_keeps_the_stabilised_constant_bounded
+
+
 def with_arithmetic_mean_augmentation(monkeypatch):
     monkeypatch.setattr(
         contact.ContactLaw,
         "augmentation_coefficient",
         lambda self, m, h: self.augmentation * 0.5 * (m[-1].E + m[1].E) / h,
     )
-    return lambda: test_materials.test_stiffness_contrast_keeps_the_interface_closed_and_smooth(
-        1e6
-    )
+    return lambda: test_materials.test_stiffness_contrast_keeps_the_interface_closed_and_smooth(1e6)
 
 
 def without_coulomb_clamp(monkeypatch):
@@ -60,6 +69,7 @@ def with_small_strain_bulk(monkeypatch):
 GUARDS = {
     "ghost penalty": without_ghost_penalty,
     "cell aggregation": without_aggregation,
+    "cell aggregation (inf-sup)": without_aggregation_in_the_inf_sup_test,
     "harmonic-mean augmentation": with_arithmetic_mean_augmentation,
     "Coulomb clamp": without_coulomb_clamp,
     "objective bulk": with_small_strain_bulk,

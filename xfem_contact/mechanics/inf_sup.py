@@ -40,6 +40,8 @@ if typing.TYPE_CHECKING:
 #: Share of the largest eigenvalue of the multiplier norm below which a direction of the
 #: multiplier space counts as without trace on the interface (left out of the test)
 TRACE_TOLERANCE = 1e-12
+#: Multiplier columns solved for at once (a dense block of the bulk's size times this)
+BLOCK = 128
 
 
 class InfSup(typing.NamedTuple):
@@ -127,36 +129,43 @@ def _columns_of(R: PETSc.Mat, W, field: int) -> np.ndarray:
 
 def _schur_and_norm(A, Bt, C, M, comm) -> tuple[np.ndarray, np.ndarray]:
     """``B A^-1 B^T - C_block`` and ``M`` as dense arrays on every process (``C_block``
-    the multiplier block of the problem's matrix, minus the stabilisation). Collective."""
+    the multiplier block of the problem's matrix, minus the stabilisation). One LU of
+    ``A``, solved for :data:`BLOCK` multiplier columns at a time. Collective."""
     ksp = PETSc.KSP().create(comm)
     A.setOption(PETSc.Mat.Option.SPD, True)  # the displacement norm: LDL^T's half factor
     ksp.setOperators(A)
     ksp.setType("preonly")
     ksp.getPC().setType("cholesky")
     ksp.getPC().setFactorSolverType("mumps")
-    e, column_M = M.createVecs()
-    rhs, x = A.createVecs()
-    s, column_C = Bt.createVecRight(), Bt.createVecRight()
-    n = e.getSize()
-    lo, hi = e.getOwnershipRange()
+    ksp.setUp()
+    factor = ksp.getPC().getFactorMatrix()
+    n = M.getSize()[0]
     S, Md = np.empty((n, n)), np.empty((n, n))
     try:
-        for j in range(n):
-            e.set(0.0)
-            if lo <= j < hi:
-                e.array[j - lo] = 1.0
-            Bt.mult(e, rhs)
-            ksp.solve(rhs, x)
-            if ksp.getConvergedReason() < 0:
-                raise RuntimeError(
-                    f"inf-sup test: the bulk solve failed ({ksp.getConvergedReason()})"
-                )
-            Bt.multTranspose(x, s)
-            C.mult(e, column_C)
-            M.mult(e, column_M)
-            S[:, j] = np.concatenate(comm.allgather(s.array - column_C.array))
-            Md[:, j] = np.concatenate(comm.allgather(column_M.array))
+        for start in range(0, n, BLOCK):
+            stop = min(start + BLOCK, n)
+            E = _unit_columns(M, start, stop)
+            rhs = Bt.matMult(E)
+            x = rhs.duplicate()
+            factor.matSolve(rhs, x)
+            blocks = (Bt.transposeMatMult(x), C.matMult(E), M.matMult(E))
+            s, c, m = (np.concatenate(comm.allgather(b.getDenseArray().copy())) for b in blocks)
+            S[:, start:stop], Md[:, start:stop] = s - c, m
+            for obj in (E, rhs, x, *blocks):
+                obj.destroy()
     finally:
-        for obj in (ksp, e, column_M, rhs, x, s, column_C):
-            obj.destroy()
+        ksp.destroy()
     return 0.5 * (S + S.T), 0.5 * (Md + Md.T)
+
+
+def _unit_columns(M: PETSc.Mat, start: int, stop: int) -> PETSc.Mat:
+    """The dense matrix of the unit vectors ``e_start .. e_(stop-1)`` in ``M``'s row
+    layout (collective)."""
+    lo, hi = M.getOwnershipRange()
+    E = PETSc.Mat().createDense(((hi - lo, M.getSize()[0]), (None, stop - start)), comm=M.getComm())
+    E.setUp()
+    E.zeroEntries()
+    for j in range(max(start, lo), min(stop, hi)):
+        E.setValue(j, j - start, 1.0)
+    E.assemble()
+    return E
