@@ -29,3 +29,16 @@ def test_short_sweep_of_random_inclusions():
             assert r["error"] < (1e-3 if r["shape"] == "sphere" else 5e-2), r
     assert all(np.isfinite(t["median error"]) for t in table.values())
     assert table["slipping"]["histogram"], table
+
+
+def test_stalled_coulomb_solve_restarts_with_another_augmentation():
+    """The one inclusion of the bench's slipping sweep (n = 4, seed 0) on which Newton
+    cycles with period 4 at the default augmentation (its residual stays near 1e-3, on the
+    multiplier of a vertex whose shape function barely reaches the interface; line
+    searches stall there too): it stalls after 8 iterations and converges in 5 more with
+    the augmentation doubled, with a warning saying so."""
+    placement = robustness3d.placements(92, seed=0)[91]
+    row = robustness3d.run(placement, "slipping", n=4, degree=2)
+    assert row["raised"] is None and row["converged"], row
+    assert row["iterations"] <= robustness3d.MAX_ITERATIONS, row
+    assert any(w.startswith("AugmentationWarning") for w in row["warnings"]), row
