@@ -45,7 +45,7 @@ logger = logging.getLogger(__name__)
 #: when none of the last ``STALL_WINDOW`` iterates has a residual norm below
 #: ``STALL_FACTOR`` times the least of those before them (Newton cycling among a few
 #: active sets or stuck where the residual has no root nearby, not converging slowly)
-STALL_WINDOW, STALL_FACTOR = 4, 0.5
+STALL_WINDOW, STALL_FACTOR = 4, 0.9
 #: The reason of a stalled solve: PETSc's ``SNES_DIVERGED_LOCAL_MIN``
 STALLED = int(PETSc.SNES.ConvergedReason.DIVERGED_LOCAL_MIN)
 
