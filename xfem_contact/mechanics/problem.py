@@ -20,6 +20,7 @@ from xfem_contact.fem.cut_state import CutState
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.prolongation import prolongation_matrix
+from xfem_contact.mechanics.augmentation_restarts import solve_restarting
 from xfem_contact.mechanics.bulk import BULK_MODELS, KINEMATICS, cell_size, check_ghosts
 from xfem_contact.mechanics.composition import Materials, interface_laws, side_and_law_materials
 from xfem_contact.mechanics.contexts import interface_context, samples, status_counts
@@ -328,7 +329,8 @@ class Problem:
 
         Linear problems: one KSP solve. With a contact law: generalized Newton
         (SNES) from ``self.w``, a log record per iterate (INFO, logger
-        ``xfem_contact.solvers.newton``). Either way returns a
+        ``xfem_contact.solvers.newton``), restarted with another augmentation when it
+        stalls (:mod:`~xfem_contact.mechanics.augmentation_restarts`). Either way returns a
         :class:`~xfem_contact.solvers.report.SolveReport` (the solution ``w``, its
         fields, iterations, residual history, reason). The Newton solver is kept between
         solves and rebuilt when the loads, the Dirichlet conditions or
@@ -402,7 +404,7 @@ class Problem:
         if self.kinematics == "large":  # turn rotated bodies rigidly first (predictor)
             self.loads.rotate_bodies(self.w, self._rotated_at, t)
         try:
-            report = self._newton.solve()
+            report = solve_restarting(self._newton, self.laws)
             self._rotated_at = t
             report.w, report.space = self.w, self.space
             self._last_report = report

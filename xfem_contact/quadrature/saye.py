@@ -26,8 +26,9 @@ On a box ``U = [lo, hi]`` of the reference cube, with ``psi`` the cell's level s
    ``grad psi / |d psi / d x_k3|`` (reference coordinates) and the weight of its line.
    Every integrand is smooth between the breakpoints, so the rules converge at the rate
    of Gauss-Legendre rules; all weights are positive.
-4. When no pair is valid (or above ``min_depth``, for every box the interface may
-   cross) the box is subdivided into eight, down to ``max_depth`` levels; a box
+4. When no pair is valid, or the best pair's certified slopes (its score in step 2) are
+   below :data:`MIN_SLOPE`, or above ``min_depth`` for every box the interface may cross,
+   the box is subdivided into eight, down to ``max_depth`` levels; a box
    at that depth that still has none uses the best monotone height axis alone (a
    lower-order rule on a box of size ``2^-max_depth``; the cell is reported in
    :attr:`CutRules.reduced`), and one with no monotone axis at all (a singular
@@ -76,6 +77,7 @@ from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
 
 __all__ = [
     "MAX_DEPTH",
+    "MIN_SLOPE",
     "CutRules",
     "SayePoints",
     "certified_sides",
@@ -93,6 +95,12 @@ BREAK_TOLERANCE = 1e-12
 """Breakpoints of the outer lines (levels 1 and 2) closer than this, relative to the line's
 length, are one: the same crossing found on two edges of a symmetric box gives one
 breakpoint, not an interval of a few ulps whose presence round-off decides."""
+
+MIN_SLOPE = 0.2
+"""Boxes whose best pair of axes has certified slopes below this score (the lower bound of a
+slope relative to the gradient's bound, step 2 of the module) are subdivided, down to
+``max_depth``: on such boxes the roots are steep functions of the outer coordinates and
+the Gauss rules converge slowly (the docs' 3D cut page gives the errors measured)."""
 
 
 @dataclass(frozen=True)
@@ -263,7 +271,9 @@ def saye_points(
         if depth < min_depth:  # subdivide every box that the interface may cross
             pair, height = np.full(cell.size, -1), np.full(cell.size, -1)
         else:
-            pair, height = choose_axes(C[cell], lo, hi, B)
+            pair, height, score = choose_axes(C[cell], lo, hi, B)
+            if depth < max_depth:  # shallow slopes: steep roots, slow rules; subdivide
+                pair = np.where(score < MIN_SLOPE, -1, pair)
         if depth == max_depth:
             bad = np.flatnonzero((pair < 0) & (height < 0))
             if bad.size:

@@ -38,11 +38,12 @@ def _certain(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def choose_axes(
     C: np.ndarray, lo: np.ndarray, hi: np.ndarray, B: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The axes of Saye's rules on boxes ``[lo, hi]`` (each ``(m, 3)``) of polynomials ``C``
     ``(m, p+1, p+1, p+1)`` whose Bernstein coefficients there are ``B``: the index into
-    :data:`PAIRS` of the best valid ``(k3, k2)`` per box (-1: none) and the best monotone
-    height axis alone (-1: none), each ``(m,)`` (see the module)."""
+    :data:`PAIRS` of the best valid ``(k3, k2)`` per box (-1: none), the best monotone
+    height axis alone (-1: none) and the chosen pair's score (its least slope relative to
+    the gradient's bound; ``-inf``: none), each ``(m,)`` (see the module)."""
     m = C.shape[0]
     D = [bernstein(derivative(C, k), lo, hi) for k in range(3)]
     size = [np.abs(d).reshape(m, -1) for d in D]
@@ -71,7 +72,9 @@ def choose_axes(
         scores[index] = np.where(valid, pair_score, -np.inf)
     height_scores = np.where(monotone, margin, -np.inf)
     second = np.array([mean[k3] for k3, _ in PAIRS])
-    return _first_best(scores, second), _first_best(height_scores, np.array(mean))
+    pair = _first_best(scores, second)
+    score = np.where(pair >= 0, scores[np.maximum(pair, 0), np.arange(m)], -np.inf)
+    return pair, _first_best(height_scores, np.array(mean)), score
 
 
 def _first_best(scores: np.ndarray, second: np.ndarray) -> np.ndarray:

@@ -52,6 +52,7 @@ from xfem_contact.geometry.tensor_levelset import (
     line_roots,
 )
 from xfem_contact.quadrature.saye import (
+    MIN_SLOPE,
     SayePoints,
     _gather,
     _pieces,
@@ -114,7 +115,10 @@ def truncated_saye_points(
             pair = np.full(cell.size, -1)
         else:
             DB = [bernstein(derivative(C[cell], k), lo, hi) for k in range(3)]
-            pair, height = _truncated_axes(C[cell], lo, hi, B, DB)
+            pair, height, score = _truncated_axes(C[cell], lo, hi, B, DB)
+            if depth < max_depth:  # shallow slopes: steep roots, slow rules; subdivide
+                shallow = (score < MIN_SLOPE) & (hi.sum(axis=1) <= 1.0)  # boxes of Saye's own
+                pair = np.where(shallow, -1, pair)
             if depth < min(max_depth, CURVED_DEPTH):
                 pair = np.where(_curved(C[cell], lo, hi, B, DB, pair), -1, pair)
             if depth == max_depth:  # the best monotone height axis alone, as Saye's
@@ -147,15 +151,15 @@ def truncated_saye_points(
 
 def _truncated_axes(C, lo, hi, B, DB):
     """Index into ``PAIRS`` of the best valid ``(k3, k2)`` per box (-1: none) and the best
-    monotone height axis alone (-1: none). The pair is Saye's for
-    a box inside the half-space, else the same criteria on the faces the truncated box
+    monotone height axis alone (-1: none), and the pair's score (``-inf``: none). The pair
+    is Saye's for a box inside the half-space, else the same criteria on the faces the truncated box
     has (bottom ``x_k3 = lo``, top ``x_k3 = hi`` where it meets the half-space, the
     slanted face along ``e_k2 - e_k3``) with the slanted face's margin in the score. ``B``,
     ``DB``: Bernstein coefficients of ``psi`` and of its three derivatives on the boxes."""
-    pair, height = choose_axes(C, lo, hi, B)
+    pair, height, chosen = choose_axes(C, lo, hi, B)
     reaching = np.flatnonzero(hi.sum(axis=1) > 1.0)
     if reaching.size == 0:
-        return pair, height
+        return pair, height, chosen
     lo, hi, B = lo[reaching], hi[reaching], B[reaching]
     DB = [d[reaching] for d in DB]
     m = reaching.size
@@ -177,9 +181,9 @@ def _truncated_axes(C, lo, hi, B, DB):
         better = valid & (pair_score > score)
         best = np.where(better, index, best)
         score = np.where(better, pair_score, score)
-    pair = pair.copy()
-    pair[reaching] = best
-    return pair, height
+    pair, chosen = pair.copy(), chosen.copy()
+    pair[reaching], chosen[reaching] = best, score
+    return pair, height, chosen
 
 
 CURVED = 4.0

@@ -41,6 +41,14 @@ from xfem_contact.solvers.symmetry import mark_symmetric
 
 logger = logging.getLogger(__name__)
 
+#: Stagnation test of :class:`ReducedNewton`: a solve stops (``reason`` :data:`STALLED`)
+#: when none of the last ``STALL_WINDOW`` iterates has a residual norm below
+#: ``STALL_FACTOR`` times the least of those before them (Newton cycling among a few
+#: active sets or stuck where the residual has no root nearby, not converging slowly)
+STALL_WINDOW, STALL_FACTOR = 4, 0.9
+#: The reason of a stalled solve: PETSc's ``SNES_DIVERGED_LOCAL_MIN``
+STALLED = int(PETSc.SNES.ConvergedReason.DIVERGED_LOCAL_MIN)
+
 
 class ReducedNewton:
     """Solve ``F(w; v) = 0`` for ``w = R y`` on the reduced space of ``R``.
@@ -52,16 +60,17 @@ class ReducedNewton:
     under its options prefix, removing its options from the PETSc database
     afterwards). SNES iterates on the scaled unknowns ``y`` with ``w = R D y``, so the
     residual norms it reports are those of ``D R^T F``. Each :meth:`solve` starts from
-    the current ``w`` (projected on the range of ``R D``) and checks the final residual
-    against the tolerances. With ``pc_type = "cholesky"`` every Jacobian is checked to
-    be symmetric first (:func:`~xfem_contact.solvers.symmetry.mark_symmetric`). A
-    Krylov method over a factorisation (``pc_type`` lu or cholesky, e.g. the preset
-    ``reused_lu`` of :data:`~xfem_contact.solvers.options.PRESETS`) keeps the
-    factorisation of an earlier iterate of the same solve: it refactors at the first
-    iterate, when the pattern grows, and after a linear solve that failed or took more than
-    :data:`~xfem_contact.solvers.options.REFACTOR_AFTER` iterations; such a failed
-    linear solve does not end the Newton solve (its step is taken as it is, the final
-    residual check stands).
+    the current ``w`` (projected on the range of ``R D``), stops early when the residual
+    norms stall (:func:`stalled`) and checks the final residual against the tolerances.
+    With ``pc_type = "cholesky"`` every Jacobian is checked to be symmetric first
+    (:func:`~xfem_contact.solvers.symmetry.mark_symmetric`). A Krylov method over a
+    factorisation (``pc_type`` lu or cholesky, e.g. the preset ``reused_lu`` of
+    :data:`~xfem_contact.solvers.options.PRESETS`) keeps the factorisation of an earlier
+    iterate of the same solve: it refactors at the first iterate, when the pattern grows,
+    and after a linear solve that failed or took more than
+    :data:`~xfem_contact.solvers.options.REFACTOR_AFTER` iterations; such a failed linear
+    solve does not end the Newton solve (its step is taken as it is, the final residual
+    check stands).
 
     Args:
         residual: UFL residual form, linear in the test function, on the full
@@ -292,6 +301,12 @@ class ReducedNewton:
         status = self.status(self.w) if self.status else {}
         self.report.status.append(status)
         self.report.status_time += seconds(timer)
+        self._log(snes, it, norm, status)
+        # SNES monitors after its convergence test and stops on the reason it then holds
+        if snes.getConvergedReason() == 0 and stalled(self.report.residuals):
+            snes.setConvergedReason(STALLED)
+
+    def _log(self, snes, it: int, norm: float, status: dict) -> None:
         if logger.isEnabledFor(logging.INFO):
             krylov = ""
             if it > 0 and snes.getKSP().getType() != PETSc.KSP.Type.PREONLY:
@@ -331,7 +346,8 @@ class ReducedNewton:
             The history of this solve; ``w`` holds the solution ``R y``.
 
         Raises:
-            NewtonFailure: SNES did not converge (reason <= 0); it holds the history.
+            NewtonFailure: SNES did not converge (reason <= 0), or stalled (reason
+                :data:`STALLED`, see :func:`stalled`); it holds the history.
         """
         self.report = NewtonReport()
         timer = phase("Newton solve")
@@ -349,6 +365,12 @@ class ReducedNewton:
         self.report.total_time = seconds(timer)
         self._update(self.y)
         self.report.reason = self.snes.getConvergedReason()
+        if self.report.reason == STALLED:
+            raise NewtonFailure(
+                f"Newton stalled (reason {STALLED}): no residual of the last {STALL_WINDOW} "
+                f"iterates below {STALL_FACTOR:g} times the least before them",
+                self.report,
+            )
         if self.report.reason <= 0:
             raise NewtonFailure(
                 f"Newton failed to converge (SNES reason {self.report.reason})", self.report
@@ -389,6 +411,16 @@ _DIFFERENT = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
 
 #: SNES types that evaluate the residual at the iterate they stop at (and monitor it)
 _EVALUATES_LAST = ("newtonls", "newtontr")
+
+
+def stalled(residuals: list[float]) -> bool:
+    """Whether a Newton history of residual norms (the initial one first) stalls: none of
+    its last :data:`STALL_WINDOW` norms is below :data:`STALL_FACTOR` times the least
+    norm before them, and at least ``STALL_WINDOW`` iterates came after the initial one
+    before those. Not collective (the norms are global)."""
+    if len(residuals) < 2 * STALL_WINDOW + 1:
+        return False
+    return min(residuals[-STALL_WINDOW:]) >= STALL_FACTOR * min(residuals[:-STALL_WINDOW])
 
 
 def _same_state(x: np.ndarray, x0: np.ndarray, comm: MPI.Comm) -> bool:

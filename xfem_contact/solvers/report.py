@@ -41,6 +41,9 @@ class SolveReport:
     w: typing.Any = None
     #: The problem's enriched space (for :meth:`field`)
     space: typing.Any = dataclasses.field(default=None, repr=False)
+    #: The reports of the stalled solves this one restarted from
+    #: (:mod:`xfem_contact.mechanics.augmentation_restarts`), first first
+    earlier: list = dataclasses.field(default_factory=list, repr=False)
 
     @property
     def converged(self) -> bool:
@@ -70,6 +73,11 @@ class SolveReport:
     def iterations(self) -> int:
         """Number of Newton steps taken."""
         return max(len(self.residuals) - 1, 0)
+
+    @property
+    def total_iterations(self) -> int:
+        """Newton steps taken, those of the :attr:`earlier` solves included."""
+        return self.iterations + sum(r.iterations for r in self.earlier)
 
     def table(self) -> str:
         """The history, one line per iterate. Not collective."""
