@@ -91,7 +91,6 @@ class Aggregation(typing.NamedTuple):
             self.vals[entries],
         )
 
-
     def without_sources(self, fixed: npt.NDArray[np.int64]) -> Aggregation:
         """The same with the dofs whose extension reads a dof of ``fixed`` (global dofs
         of ``W``, e.g. all processes' Dirichlet ones) left as unknowns: a prescribed
@@ -113,8 +112,7 @@ def check_threshold(threshold: float | None) -> None:
     """Refuse an aggregation threshold outside ``(0, 1)`` (None: off)."""
     if threshold is not None and not (isinstance(threshold, float | int) and 0 < threshold < 1):
         raise ValueError(
-            f"aggregation must be None (off) or a side volume fraction in (0, 1), "
-            f"got {threshold!r}"
+            f"aggregation must be None (off) or a side volume fraction in (0, 1), got {threshold!r}"
         )
 
 
@@ -142,9 +140,7 @@ def side_areas(cut: CutMesh, side: int, areas: npt.NDArray[np.float64]) -> np.nd
     return side_area
 
 
-def aggregate(
-    space: EnrichedSpace, threshold: float, active: npt.NDArray[np.bool_]
-) -> Aggregation:
+def aggregate(space: EnrichedSpace, threshold: float, active: npt.NDArray[np.bool_]) -> Aggregation:
     """The constrained dofs of both displacement fields and of the multiplier fields of
     ``space`` (module docstring). Collective.
 

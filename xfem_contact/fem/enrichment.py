@@ -425,4 +425,3 @@ class EnrichedSpace:
         ties = comm.allreduce(len(self._ties), op=MPI.SUM)
         branch = 0 if self.branch_field is None else counts[self.branch_field]
         return DofCounts(standard, counts[0] + counts[1] - standard - ties + branch, multiplier)
-

@@ -138,8 +138,6 @@ def rotation_holds(problem, body: Body, U: np.ndarray) -> list[tuple[list[float]
     return picks
 
 
-
-
 def null_space(A: np.ndarray) -> np.ndarray:
     _, s, Vt = np.linalg.svd(A)
     rank = int(np.sum(s > 0.1))

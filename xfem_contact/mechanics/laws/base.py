@@ -278,6 +278,7 @@ def project_on_disc(trial, bound, ops: Ops):
     with np.errstate(divide="ignore", invalid="ignore"):  # trial / 0: only where not taken
         return ops.below(norm, bound, trial, ops.scale(bound, ops.divide(trial, norm)))
 
+
 #: What a closed interface transmits (:attr:`InterfaceLaw.transmits`)
 TRANSMITS = ("none", "normal", "full")
 #: Codes of :meth:`InterfaceLaw.point_status`: open, sticking, slipping
