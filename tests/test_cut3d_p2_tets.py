@@ -197,20 +197,7 @@ def test_sphere_p2():
     assert rates[0] >= 3.8  # volume; the area's rate on this mesh is 3.0 (docs/cut3d.md)
 
 
-@pytest.mark.parametrize(
-    "frame",
-    [
-        "hexahedra",
-        pytest.param(
-            "tetrahedron",
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="the truncated boxes' own axis choice and breakpoints are not yet "
-                "stable under round-off",
-            ),
-        ),
-    ],
-)
+@pytest.mark.parametrize("frame", ["hexahedra", "tetrahedron"])
 def test_round_off_does_not_change_the_rules(frame):
     """Spheres centred on the line x = y = z are symmetric in the tetrahedron's hexahedra:
     a few ulps of change in the nodal values (as a different cell numbering gives) keep

@@ -19,7 +19,7 @@ import numpy as np
 
 from xfem_contact.geometry.tensor_levelset import bernstein, derivative
 
-__all__ = ["PAIRS", "SCORE_TOLERANCE", "choose_axes"]
+__all__ = ["PAIRS", "SCORE_TOLERANCE", "choose_axes", "first_best", "mean_slopes"]
 
 PAIRS = [(k3, k2) for k3 in range(3) for k2 in range(3) if k2 != k3]
 """The candidate ``(k3, k2)`` pairs, in the order that breaks ties."""
@@ -49,7 +49,7 @@ def choose_axes(
     size = [np.abs(d).reshape(m, -1) for d in D]
     steepest = np.maximum.reduce([a.max(axis=1) for a in size])
     margin = [a.min(axis=1) / np.where(steepest > 0, steepest, 1.0) for a in size]
-    mean = [a.mean(axis=1) / np.where(steepest > 0, steepest, 1.0) for a in size]
+    mean = mean_slopes(D)
     monotone = [_certain(d)[0] for d in D]
     scores = np.full((len(PAIRS), m), -np.inf)  # -inf: not valid
     for index, (k3, k2) in enumerate(PAIRS):
@@ -72,12 +72,21 @@ def choose_axes(
         scores[index] = np.where(valid, pair_score, -np.inf)
     height_scores = np.where(monotone, margin, -np.inf)
     second = np.array([mean[k3] for k3, _ in PAIRS])
-    pair = _first_best(scores, second)
+    pair = first_best(scores, second)
     score = np.where(pair >= 0, scores[np.maximum(pair, 0), np.arange(m)], -np.inf)
-    return pair, _first_best(height_scores, np.array(mean)), score
+    return pair, first_best(height_scores, np.array(mean)), score
 
 
-def _first_best(scores: np.ndarray, second: np.ndarray) -> np.ndarray:
+def mean_slopes(D: list[np.ndarray]) -> list[np.ndarray]:
+    """The tie-breaking slopes: per axis ``k``, the mean of ``|d psi / d x_k|``'s Bernstein
+    coefficients ``D[k]`` ``(m, ...)`` relative to the largest of the three, each ``(m,)``."""
+    m = D[0].shape[0]
+    size = [np.abs(d).reshape(m, -1) for d in D]
+    steepest = np.maximum.reduce([a.max(axis=1) for a in size])
+    return [a.mean(axis=1) / np.where(steepest > 0, steepest, 1.0) for a in size]
+
+
+def first_best(scores: np.ndarray, second: np.ndarray) -> np.ndarray:
     """Per column of ``scores`` ``(candidates, m)`` (``-inf``: not valid): of the candidates
     whose score is within :data:`SCORE_TOLERANCE` of the column's best, those whose
     ``second`` score (same shape) is within it of theirs, the first; -1 where none is

@@ -60,7 +60,13 @@ from xfem_contact.quadrature.saye import (
     _tensor_rule,
     check_parameters,
 )
-from xfem_contact.quadrature.saye_axes import PAIRS, choose_axes
+from xfem_contact.quadrature.saye_axes import (
+    PAIRS,
+    SCORE_TOLERANCE,
+    choose_axes,
+    first_best,
+    mean_slopes,
+)
 
 __all__ = ["truncated_saye_points"]
 
@@ -154,7 +160,8 @@ def _truncated_axes(C, lo, hi, B, DB):
     monotone height axis alone (-1: none), and the pair's score (``-inf``: none). The pair
     is Saye's for a box inside the half-space, else the same criteria on the faces the truncated box
     has (bottom ``x_k3 = lo``, top ``x_k3 = hi`` where it meets the half-space, the
-    slanted face along ``e_k2 - e_k3``) with the slanted face's margin in the score. ``B``,
+    slanted face along ``e_k2 - e_k3``) with the slanted face's margin in the score, and
+    near-ties broken as Saye's (:func:`~xfem_contact.quadrature.saye_axes.first_best`). ``B``,
     ``DB``: Bernstein coefficients of ``psi`` and of its three derivatives on the boxes."""
     pair, height, chosen = choose_axes(C, lo, hi, B)
     reaching = np.flatnonzero(hi.sum(axis=1) > 1.0)
@@ -163,7 +170,7 @@ def _truncated_axes(C, lo, hi, B, DB):
     lo, hi, B = lo[reaching], hi[reaching], B[reaching]
     DB = [d[reaching] for d in DB]
     m = reaching.size
-    best, score = np.full(m, -1), np.full(m, -np.inf)
+    scores = np.full((len(PAIRS), m), -np.inf)  # -inf: not valid
     for index, (k3, k2) in enumerate(PAIRS):
         k1 = 3 - k3 - k2
         valid, pair_score = _certain(DB[k3]), _margin(DB[k3], DB)
@@ -178,11 +185,13 @@ def _truncated_axes(C, lo, hi, B, DB):
         along, across = DB[k2] - DB[k3], DB[k1] - DB[k3]  # Bernstein forms are linear
         valid &= _certain(along)
         pair_score = np.minimum(pair_score, _margin(along, [along, across]))
-        better = valid & (pair_score > score)
-        best = np.where(better, index, best)
-        score = np.where(better, pair_score, score)
+        # a score within SCORE_TOLERANCE of 0 is a certificate by round-off only: not valid
+        scores[index] = np.where(valid & (pair_score > SCORE_TOLERANCE), pair_score, -np.inf)
+    mean = mean_slopes(DB)
+    best = first_best(scores, np.array([mean[k3] for k3, _ in PAIRS]))
     pair, chosen = pair.copy(), chosen.copy()
-    pair[reaching], chosen[reaching] = best, score
+    pair[reaching] = best
+    chosen[reaching] = np.where(best >= 0, scores[np.maximum(best, 0), np.arange(m)], -np.inf)
     return pair, height, chosen
 
 
@@ -283,7 +292,7 @@ def _clipped_rules(C, cell, lo, hi, k3, k2, gauss, parts, side):
                 a = np.maximum(lo1, 1.0 - c - c_hi)
                 b = np.minimum(hi1, 1.0 - c - c_lo)
                 breaks.append(_roots_between(_slanted_line(C1, P0, k1, free), a, b))
-    box1, u, w1, _, _ = _pieces(np.concatenate(breaks, axis=1), lo1, top1, gauss)
+    box1, u, w1, _, _ = _pieces(np.concatenate(breaks, axis=1), lo1, top1, gauss, merge=True)
     # level 2: along k2 at each u, breakpoints at the kink and the roots on the three faces
     lo2, hi2, lo3, hi3 = lo2[box1], hi2[box1], lo3[box1], hi3[box1]
     top2 = np.minimum(hi2, 1.0 - u - lo3)
@@ -299,7 +308,7 @@ def _clipped_rules(C, cell, lo, hi, k3, k2, gauss, parts, side):
         P0 = np.zeros((u.size, 3))
         P0[:, k1], P0[:, k3] = u, 1.0 - u
         breaks.append(_roots_between(_slanted_line(C1, P0, k2, k3), np.maximum(lo2, kink), top2))
-    p1, v, w2, _, _ = _pieces(np.concatenate(breaks, axis=1), lo2, top2, gauss)
+    p1, v, w2, _, _ = _pieces(np.concatenate(breaks, axis=1), lo2, top2, gauss, merge=True)
     box2 = box1[p1]
     W = w1[p1] * w2
     X = np.zeros((v.size, 3))
