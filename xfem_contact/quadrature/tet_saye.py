@@ -12,14 +12,20 @@ the tensor machinery of :mod:`xfem_contact.geometry.tensor_levelset` applies unc
    ``hi`` lies in the half-space, else the nested rule of step 3 without roots.
 2. Otherwise the height axis ``k3`` and the axis ``k2`` are Saye's for the whole box; a
    box that reaches the slanted face also needs ``psi`` monotone along the face in the
-   ``k2`` direction (``e_k2 - e_k3``), else the box is subdivided.
+   ``k2`` direction (``e_k2 - e_k3``), else the box is subdivided. Near-ties between pairs
+   are broken as Saye's (:mod:`xfem_contact.quadrature.saye_axes`), and a pair whose
+   score is within :data:`~xfem_contact.quadrature.saye_axes.SCORE_TOLERANCE` of zero (a
+   slope certified by round-off only) is not valid.
 3. Nested one-dimensional Gauss-Legendre rules: along ``k1`` between the roots of ``psi``
    on the truncated box's edges (the box edges parallel to ``k1``, clipped, and the
    slanted face's lines on the faces of constant ``k2`` or ``k3``) and the abscissae of
    its vertices; at each point, along ``k2`` between the roots of ``psi`` on the bottom
    face, the top face and the slanted face, and the kink where the top of the height line
    leaves the box's top face for the slanted face; at each of those, along ``k3`` up to
-   ``min(hi_k3, 1 - x_k1 - x_k2)`` between the roots of ``psi``.
+   ``min(hi_k3, 1 - x_k1 - x_k2)`` between the roots of ``psi``. Breakpoints along ``k1``
+   and ``k2`` within :data:`~xfem_contact.quadrature.saye.BREAK_TOLERANCE` of each other
+   are one (the same crossing found on two edges or faces), so that a few ulps in ``psi``
+   do not change a rule.
 
 Every breakpoint is a root of ``psi`` restricted to a straight line, every interval end
 an affine function of the outer coordinates: for a planar ``psi`` the rules integrate
