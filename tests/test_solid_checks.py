@@ -5,6 +5,8 @@ without the LBB treatment on the sphere, and the friction limits. The rates and 
 finer meshes are in ``bench/composite_sphere.py``, ``bench/sphere_oscillation.py`` and
 ``bench/sphere_friction.py``."""
 
+import math
+
 import numpy as np
 import pytest
 from mpi4py import MPI
@@ -24,6 +26,7 @@ from xfem_contact.cases.solid import (
     sphere_problem,
 )
 from xfem_contact.cases.sphere_interface import pressure_oscillation
+from xfem_contact.solvers.report import NewtonFailure
 
 
 def test_composite_sphere_exact_field_is_continuous_and_balanced():
@@ -74,15 +77,24 @@ def test_composite_sphere_contact_needs_an_even_n():
 
 def test_lbb_treatment_keeps_the_contact_pressure_smooth():
     """The concentric spheres (uniform exact pressure), P1, n = 4: the pressure's
-    oscillation index 0.39 with the stabilised default, 3.7 with ``lbb="none"`` (its
-    pressure 55 % off; 17 Newton iterations against 1)."""
-    index = {}
-    for lbb in ("stabilized", "none"):
-        problem = composite_sphere_problem(4, 1, "frictionless", lbb=lbb)
-        assert problem.solve().converged
-        index[lbb] = pressure_oscillation(problem, composite_sphere_pressure(), COMPOSITE_RADIUS)
-    print(f"\npressure oscillation P1 n=4: {index}")
-    assert index["stabilized"] < 1.0 < index["none"]
+    oscillation index 0.39 with the stabilised default, one Newton iteration. With
+    ``lbb="none"`` the multiplier's spurious modes either oscillate (index 3.7, pressure
+    55 % off, 17 Newton iterations, on the tetrahedra's hexahedra frame of Saye's rules)
+    or make Newton cycle between active sets (the tetrahedron frame: a jump at iterate 10
+    and again at 17, stalled, and so after the restarts with other augmentations)."""
+    problem = composite_sphere_problem(4, 1, "frictionless", lbb="stabilized")
+    assert problem.solve().converged
+    index = pressure_oscillation(problem, composite_sphere_pressure(), COMPOSITE_RADIUS)
+    unstable = composite_sphere_problem(4, 1, "frictionless", lbb="none")
+    try:
+        unstable.solve()
+        unstable_index = pressure_oscillation(
+            unstable, composite_sphere_pressure(), COMPOSITE_RADIUS
+        )
+    except NewtonFailure:
+        unstable_index = math.inf
+    print(f"\npressure oscillation P1 n=4: stabilized {index}, none {unstable_index}")
+    assert index < 1.0 < unstable_index
 
 
 def held_sphere(n, law, **options):

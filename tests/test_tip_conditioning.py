@@ -21,7 +21,7 @@ import pytest
 import ufl
 from mpi4py import MPI
 
-import xfem_contact.mechanics.problem as problem_module
+import xfem_contact.mechanics.solving as solving_module
 from xfem_contact.cases.cracks import frictional_crack_case, williams_case
 from xfem_contact.fem.forms import form
 from xfem_contact.solvers.block_scaling import scaled, tip_transform
@@ -92,7 +92,7 @@ def test_tip_scaling_keeps_the_newton_solution(monkeypatch):
     w = []
     for on in (True, False):
         if not on:
-            monkeypatch.setattr(problem_module, "tip_transform", lambda space, off=False: None)
+            monkeypatch.setattr(solving_module, "tip_transform", lambda space, off=False: None)
         case = frictional_crack_case(4, 2, friction=0.3, tip_radius=0.5)
         case.problem.solve()
         assert (case.problem.newton.tip is not None) == on

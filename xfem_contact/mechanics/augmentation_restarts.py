@@ -47,7 +47,7 @@ def solve_restarting(newton: ReducedNewton, laws: Mapping[str, InterfaceLaw]) ->
         NewtonFailure: A failure other than a stall, or the last stall; the laws then keep
             the augmentation they started with.
     """
-    adaptable = {name: law for name, law in laws.items() if hasattr(law, "augmentation")}
+    adaptable = {name: law for name, law in laws.items() if "augmentation" in law.options()}
     given = {name: law.augmentation for name, law in adaptable.items()}
     earlier: list[SolveReport] = []
     start = newton.w.x.array.copy()

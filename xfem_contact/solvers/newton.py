@@ -44,7 +44,8 @@ logger = logging.getLogger(__name__)
 #: Stagnation test of :class:`ReducedNewton`: a solve stops (``reason`` :data:`STALLED`)
 #: when none of the last ``STALL_WINDOW`` iterates has a residual norm below
 #: ``STALL_FACTOR`` times the least of those before them (Newton cycling among a few
-#: active sets or stuck where the residual has no root nearby, not converging slowly)
+#: active sets or stuck where the residual has no root nearby, not converging slowly or
+#: descending again, see :func:`stalled`)
 STALL_WINDOW, STALL_FACTOR = 4, 0.9
 #: The reason of a stalled solve: PETSc's ``SNES_DIVERGED_LOCAL_MIN``
 STALLED = int(PETSc.SNES.ConvergedReason.DIVERGED_LOCAL_MIN)
@@ -417,8 +418,13 @@ def stalled(residuals: list[float]) -> bool:
     """Whether a Newton history of residual norms (the initial one first) stalls: none of
     its last :data:`STALL_WINDOW` norms is below :data:`STALL_FACTOR` times the least
     norm before them, and at least ``STALL_WINDOW`` iterates came after the initial one
-    before those. Not collective (the norms are global)."""
+    before those, unless each of the last norms is below the one before it (Newton
+    descending again after a jump of its active set is not cycling). Not collective (the
+    norms are global)."""
     if len(residuals) < 2 * STALL_WINDOW + 1:
+        return False
+    last = residuals[-STALL_WINDOW:]
+    if all(b < a for a, b in zip(last[:-1], last[1:], strict=True)):
         return False
     return min(residuals[-STALL_WINDOW:]) >= STALL_FACTOR * min(residuals[:-STALL_WINDOW])
 
