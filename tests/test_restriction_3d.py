@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 from parallel import gathered_fields, max_relative_difference
+from test_multiplier_degree import assert_p2_restriction_is_p1s
 from test_scenes_3d import solved, sphere_scene
 
 from xfem_contact.cases.solid import TRIAXIAL, sphere_errors, sphere_problem
@@ -65,20 +66,11 @@ def test_the_restricted_p2_space_is_the_restricted_p1_space(cell):
     """P2 multipliers with the restriction: every node off the vertices tied to the mean
     of its entity's vertices (edges; a hexahedron's faces and centre too), so the same
     unknowns and the same multiplier as P1 to round-off."""
-    results, unknowns = [], []
-    for degree in (1, 2):
-        problem = sphere_problem(
+    assert_p2_restriction_is_p1s(
+        lambda degree: sphere_problem(
             4, 1, "sticking", cell, levelset="quadric", lbb="restriction", multiplier_degree=degree
         )
-        problem.solve()
-        ctx = problem.contexts["interface"]
-        results.append(ctx.values_at(problem.w, ctx.field))
-        R = problem.prolongation()
-        unknowns.append(R.getSize()[1])
-        R.destroy()
-    assert unknowns[0] == unknowns[1]
-    scale = np.abs(results[0]).max()
-    assert np.abs(results[1] - results[0]).max() < 1e-9 * scale
+    )
 
 
 def test_the_scene_option_in_3d():
