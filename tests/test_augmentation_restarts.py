@@ -1,5 +1,6 @@
 """The stagnation test of the Newton solver and the restarts of a stalled contact solve
-with another augmentation (tests/test_robustness3d.py runs the inclusion that needs it)."""
+with another augmentation (the slipping sweep of bench/robustness3d.py meets the inclusion
+that needs it: ``--laws slipping``)."""
 
 import xfem_contact  # noqa: F401  (before dolfinx)
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import typing
 
+import basix
 import numpy as np
 import numpy.typing as npt
 import ufl
@@ -86,8 +87,7 @@ def runtime_integral(expression_ir, domain) -> RuntimeIntegral | None:
         element, avg, derivatives, component = get_modified_terminal_element(mt)
         if avg is not None:
             raise NotImplementedError("Cell/facet averages inside runtime integrals")
-        cell = ufl.domain.extract_unique_domain(mt.terminal).ufl_cell()
-        codim = cell.topological_dimension - element.cell.topological_dimension
+        codim = _tdim(ufl.domain.extract_unique_domain(mt.terminal)) - _tdim(element)
         spec = TableSpec(
             tr.name, element, avg, tuple(derivatives), component, codim, tr.values.shape[-1]
         )
@@ -102,6 +102,15 @@ def runtime_integral(expression_ir, domain) -> RuntimeIntegral | None:
     tables = tuple(spec for _, spec in chosen)
     key = kernel_key(tuple(descriptor for descriptor, _ in chosen))
     return RuntimeIntegral(key, tables, markers.pop())
+
+
+def _tdim(owner) -> int:
+    """Topological dimension of the cell of a UFL domain or a Basix element, from its
+    Basix cell type (``ufl_cell()`` and ``cell`` build a new ``ufl.Cell`` and all its
+    sub-entities at each call: seconds over a large form)."""
+    if isinstance(owner, ufl.AbstractDomain):
+        owner = owner.ufl_coordinate_element()
+    return len(basix.topology(owner.cell_type)) - 1
 
 
 def _descriptor(spec: TableSpec) -> str:

@@ -232,7 +232,7 @@ class CellMaps:
     def push_forward(self, cells, X) -> npt.NDArray[np.float64]:
         """Physical points ``x = F_cell(X)``, shape ``(m, gdim)``."""
         basis = self._cmap.tabulate(0, X)[0, :, :, 0]
-        return np.einsum("pi,pid->pd", basis, self._geom[cells])
+        return np.matmul(basis[:, None, :], self._geom[cells])[:, 0]  # BLAS, not einsum
 
     def push_forward_lattice(self, cells, X) -> npt.NDArray[np.float64]:
         """``x = F_cell(X_k)`` for the same reference points ``X`` (k, tdim) in every
@@ -250,7 +250,7 @@ class CellMaps:
     def jacobian(self, cells, X) -> npt.NDArray[np.float64]:
         """Jacobians ``dx/dX`` of the cell maps, shape ``(m, gdim, tdim)``."""
         tab = self._cmap.tabulate(1, X)[1:, :, :, 0]  # (tdim, m, ndofs)
-        return np.einsum("kpi,pid->pdk", tab, self._geom[cells])
+        return np.matmul(self._geom[cells].transpose(0, 2, 1), tab.transpose(1, 2, 0))
 
     def values(self, cells, X) -> npt.NDArray[np.float64]:
         """The interpolated level set at the points, shape ``(m,)``."""

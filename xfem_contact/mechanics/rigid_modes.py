@@ -280,10 +280,12 @@ def _bodies(problem) -> tuple[list[Body], dict[int, np.ndarray]]:
 
 
 def _volume_ratio(J: np.ndarray) -> np.ndarray:
-    """``|det J|`` of Jacobians ``J``, shape ``(m, d, d)`` -> ``(m,)`` (2 x 2 written out:
-    LAPACK's per-matrix call is ten times slower on many small matrices)."""
+    """``|det J|`` of Jacobians ``J``, shape ``(m, d, d)`` -> ``(m,)`` (2 x 2 and 3 x 3
+    written out: LAPACK's per-matrix call is ten times slower on many small matrices)."""
     if J.shape[1:] == (2, 2):
         return np.abs(J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0])
+    if J.shape[1:] == (3, 3):
+        return np.abs(np.einsum("pi,pi->p", J[:, 0], np.cross(J[:, 1], J[:, 2])))
     return np.abs(np.linalg.det(J))
 
 
