@@ -32,9 +32,9 @@ import numpy as np
 from mpi4py import MPI
 
 from xfem_contact.cases.paper import INCLUSION_CENTRE, inclusion_errors, inclusion_problem
-from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
+from xfem_contact.io.output import write_cut_geometry, write_json, write_lips, write_solution
 from xfem_contact.io.plots import Series, line_plot
-from xfem_contact.io.progress import add_output_arguments, printer
+from xfem_contact.io.progress import add_law_arguments, add_output_arguments, printer
 from xfem_contact.solvers.log_lines import lines_to
 from xfem_contact.solvers.options import LINEAR_PRESETS, preset
 
@@ -52,31 +52,12 @@ def main():
     parser.add_argument(
         "--n", type=int, default=40, help="cells per side, even (default %(default)s)"
     )
-    parser.add_argument(
-        "--degree",
-        type=int,
-        default=2,
-        choices=[1, 2],
-        help="polynomial degree of the displacement; the multipliers are linear "
-        "(default %(default)s)",
-    )
+    add_law_arguments(parser, friction=1.0)
     parser.add_argument(
         "--cell",
         default="quadrilateral",
         choices=["quadrilateral", "triangle"],
         help="cell shape of the mesh (default %(default)s)",
-    )
-    parser.add_argument(
-        "--law",
-        default="sticking",
-        choices=["sticking", "coulomb", "frictionless"],
-        help="contact law of the interface (default %(default)s)",
-    )
-    parser.add_argument(
-        "--friction",
-        type=float,
-        default=1.0,
-        help="Coulomb friction coefficient, with --law coulomb (default %(default)s)",
     )
     parser.add_argument(
         "--lbb",
@@ -131,10 +112,7 @@ def main():
     )
 
     t0 = time.perf_counter()
-    names = ("u_minus", "u_plus", "multiplier")
-    fields = [problem.space.field(problem.w, i, name) for i, name in enumerate(names)]
-    write_fields(out, "displacement", fields[:2])
-    write_fields(out, "multiplier", fields[2:])
+    fields = write_solution(out, problem)
     write_lips(out / "result.vtu", cut, fields[0], fields[1])
     write_cut_geometry(out, cut)
     if comm.rank == 0:

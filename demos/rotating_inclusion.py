@@ -40,7 +40,7 @@ from xfem_contact.cases.rotation import (
     rotating_annulus_problem,
     svk_annulus_pressure,
 )
-from xfem_contact.io.output import write_fields, write_json, write_lips
+from xfem_contact.io.output import write_json, write_lips, write_solution
 from xfem_contact.io.plots import Series, line_plot
 from xfem_contact.io.progress import add_output_arguments, printer, progress
 from xfem_contact.mechanics.laws import SLIDING_LAWS
@@ -168,10 +168,7 @@ def solve(args, degree: int, say, comm) -> tuple[dict, dict]:
     )
     out = pathlib.Path(args.out) / f"degree{degree}"
     t0 = time.perf_counter()
-    names = ("u_minus", "u_plus", "multiplier")
-    fields = [problem.space.field(problem.w, i, name) for i, name in enumerate(names)]
-    write_fields(out, "displacement", fields[:2])
-    write_fields(out, "multiplier", fields[2:])
+    fields = write_solution(out, problem)
     write_lips(out / "result.vtu", problem.cut, fields[0], fields[1])
     timings["output"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - start

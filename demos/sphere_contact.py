@@ -33,9 +33,9 @@ from mpi4py import MPI
 
 from xfem_contact.cases.solid import sphere_errors, sphere_problem
 from xfem_contact.io.interface_data import interface_point_data
-from xfem_contact.io.output import write_cut_geometry, write_fields, write_json, write_lips
+from xfem_contact.io.output import write_cut_geometry, write_json, write_lips, write_solution
 from xfem_contact.io.pictures import render_folder
-from xfem_contact.io.progress import add_output_arguments, printer
+from xfem_contact.io.progress import add_law_arguments, add_output_arguments, printer
 from xfem_contact.mechanics.stress import StressFields
 from xfem_contact.solvers.log_lines import lines_to
 
@@ -55,31 +55,12 @@ def main():
     parser.add_argument(
         "--n", type=int, default=8, help="cells per edge of the cube, even (default %(default)s)"
     )
-    parser.add_argument(
-        "--degree",
-        type=int,
-        default=2,
-        choices=[1, 2],
-        help="polynomial degree of the displacement; the multipliers are linear "
-        "(default %(default)s)",
-    )
+    add_law_arguments(parser, friction=0.3)
     parser.add_argument(
         "--cell",
         default="tet",
         choices=sorted(CELLS),
         help="cells of the mesh: tetrahedra or hexahedra (default %(default)s)",
-    )
-    parser.add_argument(
-        "--law",
-        default="sticking",
-        choices=["sticking", "coulomb", "frictionless"],
-        help="contact law of the interface (default %(default)s)",
-    )
-    parser.add_argument(
-        "--friction",
-        type=float,
-        default=0.3,
-        help="Coulomb friction coefficient, with --law coulomb (default %(default)s)",
     )
     add_output_arguments(parser, "results/sphere_contact", "VTX, .vtu, PNG, summary.json")
     parser.add_argument("--no-png", action="store_true", help="write no pictures")
@@ -118,10 +99,7 @@ def main():
     )
 
     t0 = time.perf_counter()
-    names = ("u_minus", "u_plus", "multiplier")
-    fields = [problem.space.field(problem.w, i, name) for i, name in enumerate(names)]
-    write_fields(out, "displacement", fields[:2])
-    write_fields(out, "multiplier", fields[2:])
+    fields = write_solution(out, problem)
     material = problem.bulk.materials[1]
     stress = StressFields([("u_minus", material, fields[0]), ("u_plus", material, fields[1])])
     stress.update()

@@ -44,6 +44,17 @@ def write_fields(directory: str | pathlib.Path, name: str, functions: list) -> l
     return [path]
 
 
+def write_solution(directory: str | pathlib.Path, problem) -> list:
+    """Write a contact problem's solution ``problem.w`` as VTX: each side's displacement
+    (m) to ``directory/displacement.bp``, the multipliers (Pa) to ``multiplier.bp``.
+    Returns the three fields ``u_minus``, ``u_plus`` and ``multiplier``. Collective."""
+    names = ("u_minus", "u_plus", "multiplier")
+    fields = [problem.space.field(problem.w, i, name) for i, name in enumerate(names)]
+    write_fields(directory, "displacement", fields[:2])
+    write_fields(directory, "multiplier", fields[2:])
+    return fields
+
+
 def write_sides(directory: str | pathlib.Path, cut: CutMesh) -> pathlib.Path:
     """Write the cell side indicator (DG0: -1, 0 for cut, +1) to ``sides.xdmf``. Collective."""
     directory = pathlib.Path(directory)

@@ -82,3 +82,29 @@ def add_output_arguments(parser: argparse.ArgumentParser, out: str, contents: st
         "--json", default=None, help="path of the JSON summary (default OUT/summary.json)"
     )
     parser.add_argument("--quiet", action="store_true", help="print no progress lines")
+
+
+def add_law_arguments(parser: argparse.ArgumentParser, friction: float) -> None:
+    """Add a contact script's flags to ``parser``: ``--degree`` (of the displacement, 1 or
+    2; the multipliers are linear), ``--law`` (sticking, coulomb or frictionless) and
+    ``--friction`` (Coulomb's coefficient, default ``friction``)."""
+    parser.add_argument(
+        "--degree",
+        type=int,
+        default=2,
+        choices=[1, 2],
+        help="polynomial degree of the displacement; the multipliers are linear "
+        "(default %(default)s)",
+    )
+    parser.add_argument(
+        "--law",
+        default="sticking",
+        choices=["sticking", "coulomb", "frictionless"],
+        help="contact law of the interface (default %(default)s)",
+    )
+    parser.add_argument(
+        "--friction",
+        type=float,
+        default=friction,
+        help="Coulomb friction coefficient, with --law coulomb (default %(default)s)",
+    )
