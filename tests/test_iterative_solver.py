@@ -12,6 +12,7 @@ from test_scenes import base
 
 from xfem_contact.cases.paper import inclusion_errors, inclusion_problem
 from xfem_contact.scenes.scene import SceneError, load_scene
+from xfem_contact.solvers.assembly import aij
 from xfem_contact.solvers.options import LINEAR_PRESETS, preset
 
 
@@ -69,12 +70,22 @@ def test_band_and_interpolation():
     # P_full; no interpolation arrays once the prolongations are built
     assert newton.jacobian.R is None
     assert context.P.getType() == "submatrix" and context._interpolation is None
+    # the blocks and the factorisation released after the Krylov solve, the modes once
+    # restricted to the coarse unknowns; the Jacobian stored by node blocks (BAIJ)
+    assert not context._built and context._modes == [] and len(context._coarse_modes) == 6
+    assert newton.J_r.getType() == "seqbaij" and newton.J_r.getBlockSize() == 2
+    pc = newton.snes.getKSP().getPC()
+    context.setUp(pc)  # extracted again, as the next Newton step's set-up does
+    assert context.B is None  # the multipliers' rows serve the set-up only
     # the band's rows stored once: on the band, and outside it (no band columns there)
-    band_rows = newton.J_r.createSubMatrix(context.band, context.all_columns)
+    J, copied = aij(newton.J_r)
+    band_rows = J.createSubMatrix(context.band, context.all_columns)
     stored = [m.getInfo()["nz_used"] for m in (band_rows, context.J_bb, context.J_bo)]
     assert stored[0] == stored[1] + stored[2] and stored[2] > 0
     assert not np.any(np.isin(context.band.getIndices(), context.outside.getIndices()))
     band_rows.destroy()
+    assert copied
+    J.destroy()
     # the start of a solve from w keeps no R^T R nor its solver, and recovers y from w
     assert not hasattr(newton, "_projection")
     y = newton.y.copy()

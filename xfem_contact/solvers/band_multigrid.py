@@ -38,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 from petsc4py import PETSc
 
+from xfem_contact.solvers.assembly import aij
 from xfem_contact.solvers.options import PRESETS
 from xfem_contact.solvers.scaling import gather
 from xfem_contact.solvers.symmetry import mark_symmetric
@@ -56,7 +57,8 @@ class BandMultigrid:
         self.u = self.band = None
         self._interpolation, self._degree2 = None, False
         self._prolongations: tuple | None = None  # (P, P in J's rows, coarse positions)
-        self._modes: list[PETSc.Vec] = []
+        self._modes: list[PETSc.Vec] = []  # owned: destroyed once restricted (degree 2)
+        self._coarse_modes: list[PETSc.Vec] = []
         self._objects: list = []
         self._built = False
 
@@ -66,21 +68,31 @@ class BandMultigrid:
         Args:
             u: The displacement unknowns (owned, global indices of the operator).
             band: The band's unknowns (owned, global indices).
-            modes: Near null space of ``A_uu`` (vectors laid out as ``u``).
+            modes: Near null space of ``A_uu`` (vectors laid out as ``u``); this object
+                takes them over (and destroys them).
             interpolation: ``None`` (degree 1), or ``(rows, cols, weights)``: global
                 unknowns of the operator, rows owned, each a displacement unknown, cols
                 the vertex unknowns it interpolates from (the coarse unknowns).
         """
+        self._forget_prolongations()
+        self._forget_modes()
         self.u, self.band, self._modes = u, band, list(modes)
         self._degree2 = interpolation is not None
         self._interpolation = interpolation  # released once the prolongations are built
-        self._forget_prolongations()
 
     def _forget_prolongations(self) -> None:
         if self._prolongations is not None:
             for mat in self._prolongations[:2]:
                 mat.destroy()
         self._prolongations = None
+        for vector in self._coarse_modes:
+            vector.destroy()
+        self._coarse_modes = []
+
+    def _forget_modes(self) -> None:
+        for vector in self._modes:
+            vector.destroy()
+        self._modes = []
 
     # -- PETSc's callbacks ---------------------------------------------------------
     def setUp(self, pc: PETSc.PC) -> None:
@@ -97,7 +109,15 @@ class BandMultigrid:
                     mark_symmetric(ksp.getOperators()[0])  # checked, then flagged
                 ksp.setUp()
 
+    def postSolve(self, pc: PETSc.PC, ksp: PETSc.KSP, b: PETSc.Vec, x: PETSc.Vec) -> None:
+        """Release the blocks and the factorisation after each Krylov solve: the next
+        Newton step's set-up extracts them afresh anyway, and the residual assembled
+        meanwhile does not add its memory to theirs."""
+        self.reset(pc)
+
     def apply(self, pc: PETSc.PC, r: PETSc.Vec, x: PETSc.Vec) -> None:
+        if not self._built:  # a solve with operators unchanged since the last one
+            self.setUp(pc)
         x.set(0.0)
         r_u, x_u = r.getSubVector(self.u), x.getSubVector(self.u)
         self.ksp_u.solve(r_u, x_u)
@@ -117,8 +137,8 @@ class BandMultigrid:
         x.restoreSubVector(self.band, x_b)
 
     def view(self, pc: PETSc.PC, viewer: PETSc.Viewer | None = None) -> None:
-        if viewer is not None and self._built:
-            levels = "degree 2 on degree 1, coarse GAMG" if self.P is not None else "GAMG"
+        if viewer is not None and self.u is not None:
+            levels = "degree 2 on degree 1, coarse GAMG" if self._degree2 else "GAMG"
             viewer.printfASCII(
                 f"  band multigrid: {self.band.getSize()} band unknowns (LU), "
                 f"{self.u.getSize()} displacements ({levels})\n"
@@ -136,9 +156,19 @@ class BandMultigrid:
     def destroy(self, pc: PETSc.PC | None = None) -> None:
         self.reset(pc)
         self._forget_prolongations()
+        self._forget_modes()
 
     # -- construction --------------------------------------------------------------
-    def _build(self, J: PETSc.Mat, prefix: str) -> None:
+    def _build(self, J_given: PETSc.Mat, prefix: str) -> None:
+        J, copied = aij(J_given)  # the blocks are taken from AIJ storage
+        try:
+            self._build_from(J, J_given, prefix)
+        finally:
+            if copied:
+                J.destroy()
+
+    def _build_from(self, J: PETSc.Mat, J_given: PETSc.Mat, prefix: str) -> None:
+        """The blocks from ``J`` (AIJ), the fine level reading ``J_given`` in place."""
         comm = J.getComm()
         first, last = J.getOwnershipRange()
         self.all_columns = PETSc.IS().createStride(last - first, first, 1, comm=comm)
@@ -160,32 +190,40 @@ class BandMultigrid:
         self.ksp_u.setOptionsPrefix(prefix + PRESETS["band_u"].prefix)
         space = PETSc.NullSpace().create(vectors=self._modes, comm=comm)
         self.P = self.A_c = None
-        self._objects = [self.all_columns, multipliers, self.B, self.outside, self.J_bb]
-        self._objects.append(self.J_bo)
-        self._objects += [self.r_b, self.x_b, self.ksp_band, self.ksp_u, space]
+        self._objects = [self.all_columns, multipliers, self.outside, self.J_bb, self.J_bo]
+        self._objects += [self.r_b, self.x_b, self.ksp_band, self.ksp_u]
         if not self._degree2:  # degree 1: GAMG on the augmented block
             self.u_preset = PRESETS["band_u_degree1"]
             self.A = J.createSubMatrix(self.u, self.u)
-            self.A.axpy(1.0, _gram(self.B), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            BtB = _gram(self.B)
+            self.A.axpy(1.0, BtB, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             self.A.setBlockSize(self.u.getBlockSize())
+            space = PETSc.NullSpace().create(vectors=self._modes, comm=comm)
             self.A.setNearNullSpace(space)
             self.ksp_u.setOperators(self.A)
-            self._objects.append(self.A)
+            self._objects += [self.A, space]
+            BtB.destroy()
         else:  # degree 2: J's block itself (no copy) smoothed, the coarse level augmented
             self.u_preset = PRESETS["band_u"]
             if self._prolongations is None:  # the pattern of J does not change them
                 self._prolongations = _prolongation(J, self.u, *self._interpolation)
                 self._interpolation = None
+                # the near null space on the coarse unknowns only, the modes released
+                coarse = self._prolongations[2]
+                self._coarse_modes = _orthonormal([_restricted(m, coarse) for m in self._modes])
+                self._forget_modes()
             self.P, self.P_full, coarse = self._prolongations  # P: P_full's rows u (a view)
             #: Local positions in ``u`` of the owned coarse (vertex) unknowns
             self.coarse_positions = coarse
-            self.A = PETSc.Mat().createSubMatrixVirtual(J, self.u, self.u)
-            self.A_c = J.PtAP(self.P_full)
+            self.A = PETSc.Mat().createSubMatrixVirtual(J_given, self.u, self.u)
+            product = J.PtAP(self.P_full)  # which keeps J (maybe a copy) alive: copied
+            self.A_c = product.duplicate(copy=True)
+            product.destroy()
             BP = self.B.matMult(self.P_full)
-            self.A_c.axpy(1.0, _gram(BP), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            BtB = _gram(BP)
+            self.A_c.axpy(1.0, BtB, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             self.A_c.setBlockSize(self.u.getBlockSize())
-            coarse_modes = _orthonormal([_restricted(m, coarse) for m in self._modes])
-            coarse_space = PETSc.NullSpace().create(vectors=coarse_modes, comm=comm)
+            coarse_space = PETSc.NullSpace().create(vectors=self._coarse_modes, comm=comm)
             self.A_c.setNearNullSpace(coarse_space)
             self.ksp_u.setOperators(self.A)
             mg = self.ksp_u.getPC()
@@ -194,7 +232,11 @@ class BandMultigrid:
             mg.setMGInterpolation(1, self.P)
             mg.getMGCoarseSolve().setOperators(self.A_c, self.A_c)
             mg.getMGSmoother(1).setOperators(self.A, self.A)
-            self._objects += [self.A, self.A_c, BP, coarse_space, *coarse_modes]
+            self._objects += [self.A, self.A_c, coarse_space]
+            for obj in (BP, BtB):
+                obj.destroy()
+        self.B.destroy()  # the multipliers' rows serve the set-up only
+        self.B = None
         self._built = True
 
 
