@@ -22,9 +22,12 @@ fieldsplit) does not suffice: the ghost-penalty rows make the degree-2 operator 
 aggregate, and the multipliers couple only through the band. With the band solved
 exactly and the bulk by the p-multigrid, the Krylov iteration count does not grow with
 the mesh size nor with tiny cuts (measured by ``bench/iterative.py``). The band has
-O(N) unknowns and the coarse level a quarter of the displacements'; the copies made
-are the band's rows (once: their band columns ``J_bb``, factored and multiplied, and
-the others ``J_bo``), the multipliers' rows ``B`` and the coarse level.
+O(N) unknowns and the coarse level a quarter of the displacements'. The copies made
+are the band's block ``J_bb`` (released once an LDL^T factorisation, which keeps its
+own upper triangle, is made; ``(J x)_b`` is read from ``J`` itself), the multipliers'
+rows ``B`` (during the set-up only) and the coarse level; everything but the
+prolongations is released after each Krylov solve (the next set-up extracts it afresh).
+A Jacobian stored by node blocks (BAIJ) gives its blocks through a transient AIJ copy.
 
 Sub-solver options live under the PC's prefix plus ``bmg_u_`` (the PCMG, or GAMG for
 degree 1) and ``bmg_band_`` (the band's LU); the rows ``band_u``, ``band_u_degree1`` and
@@ -54,7 +57,7 @@ class BandMultigrid:
     """
 
     def __init__(self):
-        self.u = self.band = None
+        self.u = self.band = self.J = None
         self._interpolation, self._degree2 = None, False
         self._prolongations: tuple | None = None  # (P, P in J's rows, coarse positions)
         self._modes: list[PETSc.Vec] = []  # owned: destroyed once restricted (degree 2)
@@ -108,6 +111,21 @@ class BandMultigrid:
                 if ksp.getPC().getType() == PETSc.PC.Type.CHOLESKY:
                     mark_symmetric(ksp.getOperators()[0])  # checked, then flagged
                 ksp.setUp()
+            if ksp is self.ksp_band:
+                self._release_band_block()
+
+    def _release_band_block(self) -> None:
+        """With an LDL^T factorisation (which keeps the band's upper triangle itself),
+        solve the band by the factors and release ``J_bb`` and its solver."""
+        self._solve_band = self.ksp_band.solve
+        if self.ksp_band.getPC().getType() != PETSc.PC.Type.CHOLESKY:
+            return
+        factor = self.ksp_band.getPC().getFactorMatrix()
+        self._solve_band = factor.solve
+        self._objects.append(factor)
+        for obj in (self.ksp_band, self.J_bb):
+            obj.destroy()
+        self.ksp_band = self.J_bb = None
 
     def postSolve(self, pc: PETSc.PC, ksp: PETSc.KSP, b: PETSc.Vec, x: PETSc.Vec) -> None:
         """Release the blocks and the factorisation after each Krylov solve: the next
@@ -123,16 +141,12 @@ class BandMultigrid:
         self.ksp_u.solve(r_u, x_u)
         r.restoreSubVector(self.u, r_u)
         x.restoreSubVector(self.u, x_u)
-        # (J x)_b: the band rows only, J_bb x_b + J_bo x_o (o: the unknowns outside)
-        x_o = x.getSubVector(self.outside)
-        self.J_bo.mult(x_o, self.r_b)
-        x.restoreSubVector(self.outside, x_o)
+        self.J.mult(x, self.Jx)  # (r - J x)_b from J itself: no copy of the band's rows
+        self.Jx.aypx(-1.0, r)
+        self.Jx.getSubVector(self.band, self.r_b)
+        self._solve_band(self.r_b, self.x_b)
+        self.Jx.restoreSubVector(self.band, self.r_b)
         x_b = x.getSubVector(self.band)
-        self.J_bb.multAdd(x_b, self.r_b, self.r_b)
-        r_b = r.getSubVector(self.band)
-        self.r_b.aypx(-1.0, r_b)
-        r.restoreSubVector(self.band, r_b)
-        self.ksp_band.solve(self.r_b, self.x_b)
         x_b.axpy(1.0, self.x_b)
         x.restoreSubVector(self.band, x_b)
 
@@ -151,6 +165,7 @@ class BandMultigrid:
         for obj in self._objects:
             obj.destroy()
         self._objects = []
+        self.J = None
         self._built = False
 
     def destroy(self, pc: PETSc.PC | None = None) -> None:
@@ -177,12 +192,10 @@ class BandMultigrid:
         # the multipliers' rows: on u for degree 1, on all columns for degree 2 (``B P``
         # as ``B_all P_full``: P_full's rows outside u are zero)
         self.B = J.createSubMatrix(multipliers, self.all_columns if self._degree2 else self.u)
-        # the band's rows once: on the band (factored, and multiplied) and outside it
-        outside = np.setdiff1d(np.arange(first, last), self.band.getIndices())
-        self.outside = PETSc.IS().createGeneral(outside.astype(PETSc.IntType), comm=comm)
-        self.J_bb = J.createSubMatrix(self.band, self.band)
-        self.J_bo = J.createSubMatrix(self.band, self.outside)
-        self.r_b, self.x_b = self.J_bb.createVecLeft(), self.J_bb.createVecRight()
+        self.J = J_given  # multiplied by in place (the residual on the band)
+        self.J_bb = J.createSubMatrix(self.band, self.band)  # to factor
+        self.Jx, self.x_b = J_given.createVecLeft(), self.J_bb.createVecRight()
+        self.r_b = PETSc.Vec()  # a view of Jx's band part during each application
         self.ksp_band = PETSc.KSP().create(comm)
         self.ksp_band.setOptionsPrefix(prefix + PRESETS["band"].prefix)
         self.ksp_band.setOperators(self.J_bb)
@@ -190,8 +203,8 @@ class BandMultigrid:
         self.ksp_u.setOptionsPrefix(prefix + PRESETS["band_u"].prefix)
         space = PETSc.NullSpace().create(vectors=self._modes, comm=comm)
         self.P = self.A_c = None
-        self._objects = [self.all_columns, multipliers, self.outside, self.J_bb, self.J_bo]
-        self._objects += [self.r_b, self.x_b, self.ksp_band, self.ksp_u]
+        self._objects = [self.all_columns, multipliers, self.J_bb, self.Jx, self.x_b]
+        self._objects += [self.ksp_band, self.ksp_u]
         if not self._degree2:  # degree 1: GAMG on the augmented block
             self.u_preset = PRESETS["band_u_degree1"]
             self.A = J.createSubMatrix(self.u, self.u)
