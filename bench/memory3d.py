@@ -34,6 +34,7 @@ from petsc4py import PETSc
 from xfem_contact import _timers
 from xfem_contact.cases import solid
 from xfem_contact.mechanics import problem as problem_module
+from xfem_contact.mechanics import solving
 from xfem_contact.solvers import band_multigrid, newton
 from xfem_contact.solvers.options import preset
 
@@ -144,9 +145,9 @@ def main():
     for module, name in (
         (problem_module, "EnrichedSpace"),
         (problem_module, "prolongation_matrix"),
-        (problem_module, "rigid_modes"),
-        (problem_module, "vertex_interpolation"),
-        (problem_module, "fieldsplit_dofs"),
+        (solving, "rigid_modes"),
+        (solving, "vertex_interpolation"),
+        (solving, "fieldsplit_dofs"),
         (newton, "fieldsplit_sets"),
         (newton, "saddle_point_scaling"),
     ):

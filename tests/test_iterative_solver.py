@@ -12,7 +12,8 @@ from test_scenes import base
 
 from xfem_contact.cases.paper import inclusion_errors, inclusion_problem
 from xfem_contact.scenes.scene import SceneError, load_scene
-from xfem_contact.solvers.options import LINEAR_PRESETS, preset
+from xfem_contact.solvers.assembly import aij
+from xfem_contact.solvers.options import LINEAR_PRESETS, applied_options, preset
 
 
 @pytest.mark.mpi
@@ -69,12 +70,30 @@ def test_band_and_interpolation():
     # P_full; no interpolation arrays once the prolongations are built
     assert newton.jacobian.R is None
     assert context.P.getType() == "submatrix" and context._interpolation is None
-    # the band's rows stored once: on the band, and outside it (no band columns there)
-    band_rows = newton.J_r.createSubMatrix(context.band, context.all_columns)
-    stored = [m.getInfo()["nz_used"] for m in (band_rows, context.J_bb, context.J_bo)]
-    assert stored[0] == stored[1] + stored[2] and stored[2] > 0
-    assert not np.any(np.isin(context.band.getIndices(), context.outside.getIndices()))
-    band_rows.destroy()
+    # the blocks and the factorisation released after the Krylov solve, the modes once
+    # restricted to the coarse unknowns; the Jacobian stored by node blocks (BAIJ)
+    assert not context._built and context._modes == [] and len(context._coarse_modes) == 6
+    assert newton.J_r.getType() == "seqbaij" and newton.J_r.getBlockSize() == 2
+    pc = newton.snes.getKSP().getPC()
+    with applied_options(newton._prefix, newton.options):  # as in a Newton step's set-up
+        context.setUp(pc)  # extracted again
+    assert context.B is None  # the multipliers' rows serve the set-up only
+    # the band's block released once factored LDL^T (the factor keeps its own copy),
+    # (J x)_b taken from J itself: no copy of the band's rows
+    assert context.J_bb is None and context.ksp_band is None
+    assert not hasattr(context, "J_bo")
+    J, copied = aij(newton.J_r)  # BAIJ extracts whole blocks only
+    J_bb = J.createSubMatrix(context.band, context.band)
+    b = J_bb.createVecLeft()
+    b.setRandom()
+    x = J_bb.createVecRight()
+    context._solve_band(b, x)
+    check = J_bb.createVecLeft()
+    J_bb.mult(x, check)
+    assert np.allclose(check.getArray(), b.getArray(), rtol=0.0, atol=1e-8 * b.norm())
+    assert copied
+    for obj in (J, J_bb, b, x, check):
+        obj.destroy()
     # the start of a solve from w keeps no R^T R nor its solver, and recovers y from w
     assert not hasattr(newton, "_projection")
     y = newton.y.copy()

@@ -37,7 +37,7 @@ from xfem_contact.mechanics.rigid_modes import (
 )
 from xfem_contact.mechanics.rigid_motions import rigid_motions
 from xfem_contact.mechanics.stress import StressFields
-from xfem_contact.solvers.options import preset
+from xfem_contact.solvers.options import applied_options, preset
 
 
 def cube(n=2, cell="tetrahedron"):
@@ -356,7 +356,7 @@ def test_iterative_preset_in_3d_gives_the_direct_answer():
     """The iterative preset (GMRES, band multigrid with GAMG on six rigid modes per
     side) on the sticking sphere: the direct solver's fields. The Jacobian and the
     coarse level are stored in 3 x 3 node blocks (GAMG aggregates nodes), the band
-    factored LDL^T (the Jacobian is symmetric)."""
+    factored LDL^T (the Jacobian is symmetric) and solved by its factors."""
     direct = sphere_problem(4, 2, "sticking")
     direct.solve()
     iterative = sphere_problem(4, 2, "sticking")
@@ -364,9 +364,15 @@ def test_iterative_preset_in_3d_gives_the_direct_answer():
     iterative.solve()
     scale = np.abs(direct.w.x.array).max()
     assert np.abs(iterative.w.x.array - direct.w.x.array).max() < 1e-8 * scale
-    context = iterative.newton.snes.getKSP().getPC().getPythonContext()
-    assert iterative.newton.J_r.getBlockSize() == context.A_c.getBlockSize() == 3
-    assert context.ksp_band.getPC().getType() == "cholesky"
+    newton = iterative.newton
+    pc = newton.snes.getKSP().getPC()
+    context = pc.getPythonContext()
+    assert not context._built  # the blocks released after the Krylov solve
+    with applied_options(newton._prefix, newton.options):  # as in a Newton step's set-up
+        context.setUp(pc)
+    assert newton.J_r.getType().endswith("baij")
+    assert newton.J_r.getBlockSize() == context.A_c.getBlockSize() == 3
+    assert context.ksp_band is None  # factored LDL^T: solved by its factors, J_bb released
 
 
 @pytest.mark.mpi

@@ -144,6 +144,7 @@ def reduced_matrix(
     blocks: bool = True,
     field_blocks: list[tuple[dolfinx.fem.Form, np.ndarray]] = (),
     fill: bool = True,
+    node_storage: bool = False,
 ) -> PETSc.Mat:
     """An AIJ matrix with the sparsity of ``a`` (and of the ``field_blocks``: forms on
     a field's own space, with the parent dof in ``W`` of each of its local dofs) on
@@ -154,7 +155,10 @@ def reduced_matrix(
     With ``blocks`` and unknowns that group by node (:func:`_node_blocks`) the pattern is
     built on the nodes, as DOLFINx builds a vector space's (a quarter of the entries to
     sort in 2D, a ninth in 3D), and the matrix has the mesh's dimension as block size.
-    With ``fill`` the whole pattern is stored (:func:`_fill_pattern`)."""
+    With ``fill`` the whole pattern is stored (:func:`_fill_pattern`). With
+    ``node_storage`` a matrix of node blocks is stored as such (BAIJ: one column index
+    a block, about 30 % less memory in 3D than AIJ's one an entry); PETSc then extracts
+    sub-matrices of whole blocks only (:func:`aij`)."""
     comm = a.mesh.comm  # lives as long as the mesh (the index map's own does not)
     W = a.function_spaces[0]
     dofmap = W.dofmap.map()  # (num_cells, dofs per cell)
@@ -179,7 +183,9 @@ def reduced_matrix(
             pattern.insert(row, row)
     pattern.insert_diagonal(np.arange(index_map.size_local, dtype=np.int32))
     pattern.finalize()
-    A = dolfinx.cpp.la.petsc.create_matrix(comm, pattern)
+    A = dolfinx.cpp.la.petsc.create_matrix(
+        comm, pattern, "baij" if node_storage and bs > 1 else None
+    )
     if fill:
         _fill_pattern(A, pattern, bs)
     lgmap = PETSc.LGMap().create(chosen.columns.astype(PETSc.IntType), comm=comm)
@@ -187,6 +193,16 @@ def reduced_matrix(
     lgmap.destroy()
     _zeros_outside_the_pattern(A, fill)
     return A
+
+
+def aij(A: PETSc.Mat) -> tuple[PETSc.Mat, bool]:
+    """``A`` in a storage that extracts any rows and columns (``createSubMatrix``) and
+    multiplies with AIJ matrices (``PtAP``): ``A`` itself if AIJ, else an AIJ copy (a
+    node-block matrix, :func:`reduced_matrix`); and whether it is a copy (the caller
+    destroys it). Collective."""
+    if A.getType() in (PETSc.Mat.Type.SEQBAIJ, PETSc.Mat.Type.MPIBAIJ):
+        return A.convert(PETSc.Mat.Type.AIJ, PETSc.Mat()), True  # (no out: in place)
+    return A, False
 
 
 def _fill_pattern(A: PETSc.Mat, pattern, bs: int) -> None:
@@ -313,6 +329,7 @@ class ReducedMatrix:
             :meth:`keep_constant_blocks` the constant ones are assembled once more and
             then added from a copy.
         chosen: :func:`selection` of ``R``, if the caller has it.
+        node_storage: Store node blocks as such (see :func:`reduced_matrix`).
 
     Construction is collective (sparsity, or the full matrix for ``PtAP``).
     """
@@ -325,6 +342,7 @@ class ReducedMatrix:
         blocks: bool = True,
         field_blocks: list[tuple[dolfinx.fem.Form, np.ndarray, bool]] = (),
         chosen: Selection | None = None,
+        node_storage: bool = False,
     ):
         self.a, self.bcs = a, bcs
         W = a.function_spaces[0]
@@ -345,7 +363,9 @@ class ReducedMatrix:
         self.skip_zeros = a.mesh.comm.allreduce(_coupled_cells(a)[1].size > 0, op=MPI.LOR)
         if self.direct:
             pairs = [b[:2] for b in field_blocks]
-            self.mat = reduced_matrix(a, chosen, blocks, pairs, fill=self.skip_zeros)
+            self.mat = reduced_matrix(
+                a, chosen, blocks, pairs, fill=self.skip_zeros, node_storage=node_storage
+            )
             fixed = np.zeros(chosen.columns.size, dtype=np.int8)  # Dirichlet dofs of W
             for bc in bcs:
                 fixed[bc.dof_indices()[0]] = 1

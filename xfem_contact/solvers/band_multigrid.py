@@ -22,9 +22,12 @@ fieldsplit) does not suffice: the ghost-penalty rows make the degree-2 operator 
 aggregate, and the multipliers couple only through the band. With the band solved
 exactly and the bulk by the p-multigrid, the Krylov iteration count does not grow with
 the mesh size nor with tiny cuts (measured by ``bench/iterative.py``). The band has
-O(N) unknowns and the coarse level a quarter of the displacements'; the copies made
-are the band's rows (once: their band columns ``J_bb``, factored and multiplied, and
-the others ``J_bo``), the multipliers' rows ``B`` and the coarse level.
+O(N) unknowns and the coarse level a quarter of the displacements'. The copies made
+are the band's block ``J_bb`` (released once an LDL^T factorisation, which keeps its
+own upper triangle, is made; ``(J x)_b`` is read from ``J`` itself), the multipliers'
+rows ``B`` (during the set-up only) and the coarse level; everything but the
+prolongations is released after each Krylov solve (the next set-up extracts it afresh).
+A Jacobian stored by node blocks (BAIJ) gives its blocks through a transient AIJ copy.
 
 Sub-solver options live under the PC's prefix plus ``bmg_u_`` (the PCMG, or GAMG for
 degree 1) and ``bmg_band_`` (the band's LU); the rows ``band_u``, ``band_u_degree1`` and
@@ -38,6 +41,7 @@ from __future__ import annotations
 import numpy as np
 from petsc4py import PETSc
 
+from xfem_contact.solvers.assembly import aij
 from xfem_contact.solvers.options import PRESETS
 from xfem_contact.solvers.scaling import gather
 from xfem_contact.solvers.symmetry import mark_symmetric
@@ -53,10 +57,11 @@ class BandMultigrid:
     """
 
     def __init__(self):
-        self.u = self.band = None
+        self.u = self.band = self.J = None
         self._interpolation, self._degree2 = None, False
         self._prolongations: tuple | None = None  # (P, P in J's rows, coarse positions)
-        self._modes: list[PETSc.Vec] = []
+        self._modes: list[PETSc.Vec] = []  # owned: destroyed once restricted (degree 2)
+        self._coarse_modes: list[PETSc.Vec] = []
         self._objects: list = []
         self._built = False
 
@@ -66,21 +71,31 @@ class BandMultigrid:
         Args:
             u: The displacement unknowns (owned, global indices of the operator).
             band: The band's unknowns (owned, global indices).
-            modes: Near null space of ``A_uu`` (vectors laid out as ``u``).
+            modes: Near null space of ``A_uu`` (vectors laid out as ``u``); this object
+                takes them over (and destroys them).
             interpolation: ``None`` (degree 1), or ``(rows, cols, weights)``: global
                 unknowns of the operator, rows owned, each a displacement unknown, cols
                 the vertex unknowns it interpolates from (the coarse unknowns).
         """
+        self._forget_prolongations()
+        self._forget_modes()
         self.u, self.band, self._modes = u, band, list(modes)
         self._degree2 = interpolation is not None
         self._interpolation = interpolation  # released once the prolongations are built
-        self._forget_prolongations()
 
     def _forget_prolongations(self) -> None:
         if self._prolongations is not None:
             for mat in self._prolongations[:2]:
                 mat.destroy()
         self._prolongations = None
+        for vector in self._coarse_modes:
+            vector.destroy()
+        self._coarse_modes = []
+
+    def _forget_modes(self) -> None:
+        for vector in self._modes:
+            vector.destroy()
+        self._modes = []
 
     # -- PETSc's callbacks ---------------------------------------------------------
     def setUp(self, pc: PETSc.PC) -> None:
@@ -96,29 +111,48 @@ class BandMultigrid:
                 if ksp.getPC().getType() == PETSc.PC.Type.CHOLESKY:
                     mark_symmetric(ksp.getOperators()[0])  # checked, then flagged
                 ksp.setUp()
+            if ksp is self.ksp_band:
+                self._release_band_block()
+
+    def _release_band_block(self) -> None:
+        """With an LDL^T factorisation (which keeps the band's upper triangle itself),
+        solve the band by the factors and release ``J_bb`` and its solver."""
+        self._solve_band = self.ksp_band.solve
+        if self.ksp_band.getPC().getType() != PETSc.PC.Type.CHOLESKY:
+            return
+        factor = self.ksp_band.getPC().getFactorMatrix()
+        self._solve_band = factor.solve
+        self._objects.append(factor)
+        for obj in (self.ksp_band, self.J_bb):
+            obj.destroy()
+        self.ksp_band = self.J_bb = None
+
+    def postSolve(self, pc: PETSc.PC, ksp: PETSc.KSP, b: PETSc.Vec, x: PETSc.Vec) -> None:
+        """Release the blocks and the factorisation after each Krylov solve: the next
+        Newton step's set-up extracts them afresh anyway, and the residual assembled
+        meanwhile does not add its memory to theirs."""
+        self.reset(pc)
 
     def apply(self, pc: PETSc.PC, r: PETSc.Vec, x: PETSc.Vec) -> None:
+        if not self._built:  # a solve with operators unchanged since the last one
+            self.setUp(pc)
         x.set(0.0)
         r_u, x_u = r.getSubVector(self.u), x.getSubVector(self.u)
         self.ksp_u.solve(r_u, x_u)
         r.restoreSubVector(self.u, r_u)
         x.restoreSubVector(self.u, x_u)
-        # (J x)_b: the band rows only, J_bb x_b + J_bo x_o (o: the unknowns outside)
-        x_o = x.getSubVector(self.outside)
-        self.J_bo.mult(x_o, self.r_b)
-        x.restoreSubVector(self.outside, x_o)
+        self.J.mult(x, self.Jx)  # (r - J x)_b from J itself: no copy of the band's rows
+        self.Jx.aypx(-1.0, r)
+        self.Jx.getSubVector(self.band, self.r_b)
+        self._solve_band(self.r_b, self.x_b)
+        self.Jx.restoreSubVector(self.band, self.r_b)
         x_b = x.getSubVector(self.band)
-        self.J_bb.multAdd(x_b, self.r_b, self.r_b)
-        r_b = r.getSubVector(self.band)
-        self.r_b.aypx(-1.0, r_b)
-        r.restoreSubVector(self.band, r_b)
-        self.ksp_band.solve(self.r_b, self.x_b)
         x_b.axpy(1.0, self.x_b)
         x.restoreSubVector(self.band, x_b)
 
     def view(self, pc: PETSc.PC, viewer: PETSc.Viewer | None = None) -> None:
-        if viewer is not None and self._built:
-            levels = "degree 2 on degree 1, coarse GAMG" if self.P is not None else "GAMG"
+        if viewer is not None and self.u is not None:
+            levels = "degree 2 on degree 1, coarse GAMG" if self._degree2 else "GAMG"
             viewer.printfASCII(
                 f"  band multigrid: {self.band.getSize()} band unknowns (LU), "
                 f"{self.u.getSize()} displacements ({levels})\n"
@@ -131,14 +165,25 @@ class BandMultigrid:
         for obj in self._objects:
             obj.destroy()
         self._objects = []
+        self.J = None
         self._built = False
 
     def destroy(self, pc: PETSc.PC | None = None) -> None:
         self.reset(pc)
         self._forget_prolongations()
+        self._forget_modes()
 
     # -- construction --------------------------------------------------------------
-    def _build(self, J: PETSc.Mat, prefix: str) -> None:
+    def _build(self, J_given: PETSc.Mat, prefix: str) -> None:
+        J, copied = aij(J_given)  # the blocks are taken from AIJ storage
+        try:
+            self._build_from(J, J_given, prefix)
+        finally:
+            if copied:
+                J.destroy()
+
+    def _build_from(self, J: PETSc.Mat, J_given: PETSc.Mat, prefix: str) -> None:
+        """The blocks from ``J`` (AIJ), the fine level reading ``J_given`` in place."""
         comm = J.getComm()
         first, last = J.getOwnershipRange()
         self.all_columns = PETSc.IS().createStride(last - first, first, 1, comm=comm)
@@ -147,12 +192,10 @@ class BandMultigrid:
         # the multipliers' rows: on u for degree 1, on all columns for degree 2 (``B P``
         # as ``B_all P_full``: P_full's rows outside u are zero)
         self.B = J.createSubMatrix(multipliers, self.all_columns if self._degree2 else self.u)
-        # the band's rows once: on the band (factored, and multiplied) and outside it
-        outside = np.setdiff1d(np.arange(first, last), self.band.getIndices())
-        self.outside = PETSc.IS().createGeneral(outside.astype(PETSc.IntType), comm=comm)
-        self.J_bb = J.createSubMatrix(self.band, self.band)
-        self.J_bo = J.createSubMatrix(self.band, self.outside)
-        self.r_b, self.x_b = self.J_bb.createVecLeft(), self.J_bb.createVecRight()
+        self.J = J_given  # multiplied by in place (the residual on the band)
+        self.J_bb = J.createSubMatrix(self.band, self.band)  # to factor
+        self.Jx, self.x_b = J_given.createVecLeft(), self.J_bb.createVecRight()
+        self.r_b = PETSc.Vec()  # a view of Jx's band part during each application
         self.ksp_band = PETSc.KSP().create(comm)
         self.ksp_band.setOptionsPrefix(prefix + PRESETS["band"].prefix)
         self.ksp_band.setOperators(self.J_bb)
@@ -160,32 +203,40 @@ class BandMultigrid:
         self.ksp_u.setOptionsPrefix(prefix + PRESETS["band_u"].prefix)
         space = PETSc.NullSpace().create(vectors=self._modes, comm=comm)
         self.P = self.A_c = None
-        self._objects = [self.all_columns, multipliers, self.B, self.outside, self.J_bb]
-        self._objects.append(self.J_bo)
-        self._objects += [self.r_b, self.x_b, self.ksp_band, self.ksp_u, space]
+        self._objects = [self.all_columns, multipliers, self.J_bb, self.Jx, self.x_b]
+        self._objects += [self.ksp_band, self.ksp_u]
         if not self._degree2:  # degree 1: GAMG on the augmented block
             self.u_preset = PRESETS["band_u_degree1"]
             self.A = J.createSubMatrix(self.u, self.u)
-            self.A.axpy(1.0, _gram(self.B), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            BtB = _gram(self.B)
+            self.A.axpy(1.0, BtB, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             self.A.setBlockSize(self.u.getBlockSize())
+            space = PETSc.NullSpace().create(vectors=self._modes, comm=comm)
             self.A.setNearNullSpace(space)
             self.ksp_u.setOperators(self.A)
-            self._objects.append(self.A)
+            self._objects += [self.A, space]
+            BtB.destroy()
         else:  # degree 2: J's block itself (no copy) smoothed, the coarse level augmented
             self.u_preset = PRESETS["band_u"]
             if self._prolongations is None:  # the pattern of J does not change them
                 self._prolongations = _prolongation(J, self.u, *self._interpolation)
                 self._interpolation = None
+                # the near null space on the coarse unknowns only, the modes released
+                coarse = self._prolongations[2]
+                self._coarse_modes = _orthonormal([_restricted(m, coarse) for m in self._modes])
+                self._forget_modes()
             self.P, self.P_full, coarse = self._prolongations  # P: P_full's rows u (a view)
             #: Local positions in ``u`` of the owned coarse (vertex) unknowns
             self.coarse_positions = coarse
-            self.A = PETSc.Mat().createSubMatrixVirtual(J, self.u, self.u)
-            self.A_c = J.PtAP(self.P_full)
+            self.A = PETSc.Mat().createSubMatrixVirtual(J_given, self.u, self.u)
+            product = J.PtAP(self.P_full)  # which keeps J (maybe a copy) alive: copied
+            self.A_c = product.duplicate(copy=True)
+            product.destroy()
             BP = self.B.matMult(self.P_full)
-            self.A_c.axpy(1.0, _gram(BP), PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            BtB = _gram(BP)
+            self.A_c.axpy(1.0, BtB, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             self.A_c.setBlockSize(self.u.getBlockSize())
-            coarse_modes = _orthonormal([_restricted(m, coarse) for m in self._modes])
-            coarse_space = PETSc.NullSpace().create(vectors=coarse_modes, comm=comm)
+            coarse_space = PETSc.NullSpace().create(vectors=self._coarse_modes, comm=comm)
             self.A_c.setNearNullSpace(coarse_space)
             self.ksp_u.setOperators(self.A)
             mg = self.ksp_u.getPC()
@@ -194,7 +245,11 @@ class BandMultigrid:
             mg.setMGInterpolation(1, self.P)
             mg.getMGCoarseSolve().setOperators(self.A_c, self.A_c)
             mg.getMGSmoother(1).setOperators(self.A, self.A)
-            self._objects += [self.A, self.A_c, BP, coarse_space, *coarse_modes]
+            self._objects += [self.A, self.A_c, coarse_space]
+            for obj in (BP, BtB):
+                obj.destroy()
+        self.B.destroy()  # the multipliers' rows serve the set-up only
+        self.B = None
         self._built = True
 
 

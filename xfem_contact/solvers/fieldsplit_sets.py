@@ -27,8 +27,9 @@ def fieldsplit_sets(
     """Give a fieldsplit preconditioner its index sets ``"u"`` and ``"lambda"`` (and
     ``"u"`` its near null space), or a Python one with a ``configure`` method
     (:class:`~xfem_contact.solvers.band_multigrid.BandMultigrid`) the sets ``"u"``
-    and ``"band"``, the near null space and the ``interpolation`` in the reduced
-    unknowns. Other preconditioners get nothing. Collective.
+    and ``"band"``, the near null space (its vectors then the context's) and the
+    ``interpolation`` in the reduced unknowns. Other preconditioners get nothing.
+    Collective.
 
     Args:
         pc: The Newton steps' preconditioner (its type already set from the options).
@@ -88,15 +89,20 @@ def fieldsplit_sets(
             part.setArray(reduced.getArray(readonly=True)[local])
             vectors.append(part)
         vectors = _orthonormalise(vectors)
-        space = PETSc.NullSpace().create(vectors=vectors, comm=comm)
-        index.compose("nearnullspace", space)
-        objects += [space, squared, *vectors]
+        squared.destroy()
+        if kind == PETSc.PC.Type.FIELDSPLIT:
+            space = PETSc.NullSpace().create(vectors=vectors, comm=comm)
+            index.compose("nearnullspace", space)
+            objects += [space, *vectors]
     marker.destroy()
     reduced.destroy()
     context = pc.getPythonContext() if kind == PETSc.PC.Type.PYTHON else None
     if hasattr(context, "configure"):
         reduced_interpolation = _reduced(interpolation, chosen, D)
         context.configure(dict(sets)["u"], dict(sets)["band"], vectors, reduced_interpolation)
+    elif kind == PETSc.PC.Type.PYTHON:
+        for vector in vectors:
+            vector.destroy()
     return objects
 
 

@@ -34,6 +34,7 @@ from xfem_contact.solvers.options import (
     applied_options,
     checked_prefix,
     merged_options,
+    uses_band_multigrid,
 )
 from xfem_contact.solvers.report import NewtonFailure, NewtonReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
@@ -157,6 +158,8 @@ class ReducedNewton:
         self.y = R.createVecRight()
         self.F_r = R.createVecRight()
         self.status = status
+        #: The PETSc options (without prefix) of this solver's SNES, KSP and PC
+        self.options = merged_options("newton", petsc_options)
         timer = phase("Newton set-up: sparsity")
         self.jacobian = ReducedMatrix(
             self.J,
@@ -165,6 +168,8 @@ class ReducedNewton:
             blocks=not self.couplings,
             field_blocks=self.jacobian_forms.blocks,
             chosen=chosen,
+            # the band multigrid extracts its blocks from a copy (assembly.aij)
+            node_storage=uses_band_multigrid(self.options) and transform is None,
         )
         self.timings["sparsity"] = seconds(timer) + selecting
         if self.couplings and not self.jacobian.direct:
@@ -184,8 +189,6 @@ class ReducedNewton:
         Z = None if transform is None else transform(R, self.J_r)
         self.J_r.diagonalScale(self.D, self.D)
         self.timings["scaling"] = seconds(timer)
-        #: The PETSc options (without prefix) of this solver's SNES, KSP and PC
-        self.options = merged_options("newton", petsc_options)
         self._symmetric = self.options.get("pc_type") == "cholesky"
         #: Whether factorisations are reused across iterates (see the class docstring)
         self.reuses_factor = transform is None and self.options.get("ksp_type") != "preonly"

@@ -28,6 +28,8 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from xfem_contact.solvers.assembly import aij
+
 #: A diagonal at most this fraction of the largest is small (see the module docstring)
 SMALL_DIAGONAL = 1e-8
 
@@ -36,7 +38,7 @@ def saddle_point_scaling(J: PETSc.Mat) -> PETSc.Vec:
     """The scaling ``D`` (diagonal, as a vector laid out as ``J``'s columns). Collective.
 
     Args:
-        J: A square assembled AIJ matrix (the reduced Jacobian ``R^T J R``).
+        J: A square assembled AIJ (or BAIJ) matrix (the reduced Jacobian ``R^T J R``).
 
     Returns:
         ``D`` with ``D_i = d_i^-1/2`` (see the module docstring); the caller destroys it.
@@ -51,9 +53,10 @@ def saddle_point_scaling(J: PETSc.Mat) -> PETSc.Vec:
     rows = PETSc.IS().createGeneral((first + small).astype(PETSc.IntType), comm=comm)
     first_column = J.getOwnershipRangeColumn()[0]
     columns = PETSc.IS().createStride(J.getLocalSize()[1], first_column, 1, comm=comm)
-    part = J.createSubMatrix(rows, columns)  # the small rows, all columns as in J
+    stored, copied = aij(J)
+    part = stored.createSubMatrix(rows, columns)  # the small rows, all columns as in J
     indptr, cols, values = part.getValuesCSR()
-    for obj in (rows, columns, part):
+    for obj in (rows, columns, part) + ((stored,) if copied else ()):
         obj.destroy()
     inverse = J.createVecRight()
     inverse.setArray(np.divide(1.0, d, out=np.zeros_like(d), where=d > 0))
