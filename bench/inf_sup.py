@@ -21,7 +21,9 @@ The treatments (``--treatments``): none, restriction, stabilized; stabilized wit
 ghost penalty raised to the stabilisation's weight (0.1) or with cell aggregation.
 Prints, per element, treatment and n, the least and median beta, the count of
 indefinite pairs (beta^2 < 0; without a treatment, round-off of a zero eigenvalue: a
-spurious multiplier) and the slope of the least beta in log n over the last pair.
+spurious multiplier), the count of samples whose displacement block has a negative
+eigenvalue (unstable even where beta^2 > 0: the stabilisation took more than the bulk
+energy) and the slope of the least beta in log n over the last pair.
 Writes ``bench/results/<name>.{json,md,png}`` after each element and treatment (``name``:
 ``inf_sup``, ``inf_sup_crack``, ``inf_sup_3d``, with the elements and treatments that
 differ from the study's default, or ``--name``). BLAS runs on one thread (the dense
@@ -243,15 +245,16 @@ def table(rows: list[dict], sizes: list[int]) -> list[str]:
     lines = [
         "| cell | element | lbb | "
         + " | ".join(f"n={n}: min / median beta" for n in sizes)
-        + " | slope of min (last pair) | indefinite | multipliers (largest n) |",
-        "|---|---|---|" + "---|" * len(sizes) + "---|---|---|",
+        + " | slope of min (last pair) | indefinite | displacement block indefinite"
+        " | multipliers (largest n) |",
+        "|---|---|---|" + "---|" * len(sizes) + "---|---|---|---|",
     ]
     for cell, element, lbb in dict.fromkeys((r["cell"], r["element"], r["lbb"]) for r in rows):
         sel = [r for r in rows if (r["cell"], r["element"], r["lbb"]) == (cell, element, lbb)]
         if sel[0]["refused"]:
             lines.append(
                 f"| {cell} | {element} | {lbb} | refused: {sel[0]['refused']} |"
-                + " |" * (len(sizes) + 2)
+                + " |" * (len(sizes) + 3)
             )
             continue
         mins = [r["beta_min"] for r in sel]
@@ -263,9 +266,10 @@ def table(rows: list[dict], sizes: list[int]) -> list[str]:
         cells = " | ".join(f"{r['beta_min']:.2e} / {r['beta_median']:.2e}" for r in sel)
         indefinite = sum(r["indefinite"] for r in sel)
         total = sum(len(r["beta_squared"]) for r in sel)
+        modes = sum(sum(m > 0 for m in r.get("negative_displacement_modes", [])) for r in sel)
         lines.append(
             f"| {cell} | {element} | {lbb} | {cells} | {slope:.2f} | {indefinite}/{total} | "
-            f"{max(sel[-1]['multipliers'], default='')} |"
+            f"{modes}/{total} | {max(sel[-1]['multipliers'], default='')} |"
         )
     return lines
 
@@ -328,6 +332,9 @@ def main() -> None:
                         "indefinite": int((np.array(b2) < 0).sum()),
                         "beta_squared": b2,
                         "multipliers": [r.multipliers for r in results or []],
+                        "negative_displacement_modes": [
+                            r.negative_displacement_modes for r in results or []
+                        ],
                         "refused": refused,
                     }
                 )

@@ -6,7 +6,7 @@ Measured (sphere R = 0.2 about the centre of the unit cube, ``python bench/inf_s
 --solid``): P1-P1 tetrahedra, beta at n = 8, 12, 16, 20: 0.231, 0.222, 0.208, 0.205
 with the restriction, 0.082 (n = 4), 0.015 (n = 8) without LBB treatment. The sticking
 sphere's pressure error (P1, quadric level set) at n = 4, 6, 8: 0.478, 0.167, 0.0495
-(the greedy covering of triangles, switched on here, gives 0.10 at n = 8 with P2).
+(the greedy covering, switched on here, gives 0.10 at n = 8 with P2).
 """
 
 import xfem_contact  # noqa: F401  (before dolfinx)
@@ -91,12 +91,12 @@ def test_the_scene_option_in_3d():
 
 def test_tetrahedra_take_the_nearer_end(monkeypatch):
     """The nearer-end rule is the one in use on tetrahedra: switched off (the greedy
-    covering of triangles) the space has fewer unknowns."""
+    covering of quadrilaterals) the space has fewer unknowns."""
     problem = sphere_problem(6, 1, "sticking", levelset="quadric", lbb="restriction")
     R = problem.prolongation()
     nearer = R.getSize()[1]
     R.destroy()
-    monkeypatch.setitem(lbb_space.NEARER_END, 3, False)
+    monkeypatch.setitem(lbb_space.NEARER_END, "tetrahedron", (False, False))
     problem = sphere_problem(6, 1, "sticking", levelset="quadric", lbb="restriction")
     R = problem.prolongation()
     assert R.getSize()[1] < nearer

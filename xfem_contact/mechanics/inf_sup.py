@@ -51,6 +51,9 @@ class InfSup(typing.NamedTuple):
     beta_squared: float  #: the least eigenvalue (negative: the pair's matrix is indefinite)
     multipliers: int  #: reduced multiplier unknowns tested
     without_trace: int  #: of them, directions with no trace on the interface
+    #: negative eigenvalues of the displacement block (its bulk energy minus the
+    #: Barbosa-Hughes term's share): 0 for a stable pair; else ``beta_squared`` < 0
+    negative_displacement_modes: int = 0
 
 
 def inf_sup_constant(problem: Problem, name: str | None = None) -> InfSup:
@@ -93,7 +96,7 @@ def inf_sup_constant(problem: Problem, name: str | None = None) -> InfSup:
     A.axpy(1.0 / size**2, A_mass)
     C.scale(stiffness)
     try:
-        S, Md = _schur_and_norm(A, Bt, C, M, mesh.comm)
+        S, Md, negative = _schur_and_norm(A, Bt, C, M, mesh.comm)
     finally:
         for obj in (K, mass, M_full, A, A_mass, Bt, C, M, R, is_l, is_u):
             obj.destroy()
@@ -102,7 +105,7 @@ def inf_sup_constant(problem: Problem, name: str | None = None) -> InfSup:
     keep = d > TRACE_TOLERANCE * d.max()
     T = Q[:, keep] / np.sqrt(d[keep])
     beta2 = float(np.linalg.eigvalsh(T.T @ S @ T)[0]) if keep.any() else 0.0
-    return InfSup(np.sqrt(max(beta2, 0.0)), beta2, int(S.shape[0]), int((~keep).sum()))
+    return InfSup(np.sqrt(max(beta2, 0.0)), beta2, int(S.shape[0]), int((~keep).sum()), negative)
 
 
 def _reduced(a: dolfinx.fem.Form, R: PETSc.Mat) -> PETSc.Mat:
@@ -127,18 +130,22 @@ def _columns_of(R: PETSc.Mat, W, field: int) -> np.ndarray:
     return found
 
 
-def _schur_and_norm(A, Bt, C, M, comm) -> tuple[np.ndarray, np.ndarray]:
+def _schur_and_norm(A, Bt, C, M, comm) -> tuple[np.ndarray, np.ndarray, int]:
     """``B A^-1 B^T - C_block`` and ``M`` as dense arrays on every process (``C_block``
-    the multiplier block of the problem's matrix, minus the stabilisation). One LU of
-    ``A``, solved for :data:`BLOCK` multiplier columns at a time. Collective."""
+    the multiplier block of the problem's matrix, minus the stabilisation), and the
+    number of negative eigenvalues of ``A`` (the negative pivots of its symmetric
+    indefinite LDL^T, by Sylvester's law of inertia). One factorisation of ``A``,
+    solved for :data:`BLOCK` multiplier columns at a time. Collective."""
     ksp = PETSc.KSP().create(comm)
-    A.setOption(PETSc.Mat.Option.SPD, True)  # the displacement norm: LDL^T's half factor
+    # symmetric, not SPD: with the Barbosa-Hughes term subtracted A may be indefinite
+    A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     ksp.setOperators(A)
     ksp.setType("preonly")
     ksp.getPC().setType("cholesky")
     ksp.getPC().setFactorSolverType("mumps")
     ksp.setUp()
     factor = ksp.getPC().getFactorMatrix()
+    negative = int(factor.getMumpsInfog(12))  # INFOG(12): negative pivots, all ranks
     n = M.getSize()[0]
     S, Md = np.empty((n, n)), np.empty((n, n))
     try:
@@ -155,7 +162,7 @@ def _schur_and_norm(A, Bt, C, M, comm) -> tuple[np.ndarray, np.ndarray]:
                 obj.destroy()
     finally:
         ksp.destroy()
-    return 0.5 * (S + S.T), 0.5 * (Md + Md.T)
+    return 0.5 * (S + S.T), 0.5 * (Md + Md.T), negative
 
 
 def _unit_columns(M: PETSc.Mat, start: int, stop: int) -> PETSc.Mat:

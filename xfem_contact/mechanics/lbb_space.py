@@ -16,11 +16,22 @@ from xfem_contact.fem.prolongation import MultiplierProlongation
 from xfem_contact.geometry.crack import NONE, TIP
 from xfem_contact.mechanics import lbb as lbb_module
 
-#: Per topological dimension, whether each cut edge's vital vertex is its end nearer the
-#: interface (else the greedy covering of :func:`xfem_contact.mechanics.lbb.vital_vertices`):
-#: on tetrahedron edges the covering's few vital vertices lose the pressure's accuracy
-#: (docs' stability page)
-NEARER_END = {1: False, 2: False, 3: True}
+#: Per cell type, whether each cut edge's vital vertex is its end nearer the interface
+#: (else the greedy covering of :func:`xfem_contact.mechanics.lbb.vital_vertices`), for an
+#: interface and for a crack's lips. The nodal multiplier's value where the interface
+#: crosses a cut edge mixes its two ends, and a non-vital end takes the mean of several
+#: vital vertices: where the covering made the farther end vital, the crossing hardly
+#: sees that vertex's unknown, and the inf-sup constant of P1-P1 triangles fell with h
+#: (docs' stability page). The nearer end's shape function is at least 1/2 at the
+#: crossing. On a crack's lips on triangles the covering keeps the larger constant; on
+#: tetrahedron edges the covering's few vital vertices lose the pressure's accuracy.
+NEARER_END = {
+    "interval": (False, False),
+    "triangle": (True, False),
+    "quadrilateral": (False, False),
+    "tetrahedron": (True, True),
+    "hexahedron": (True, True),
+}
 
 
 def _links(cell_type: dolfinx.mesh.CellType) -> np.ndarray:
@@ -63,8 +74,8 @@ def vital_vertex_prolongation(
     cells' own vertices carry the multiplier too; not the cells cut ahead of its tips,
     where it would act on nothing) are gathered globally, vital vertices chosen
     identically on every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`: the
-    greedy covering on triangles and quadrilaterals, the end nearer the interface on
-    tetrahedra and hexahedra, :data:`NEARER_END`), and
+    greedy covering on quadrilaterals and a crack's lips on triangles, else the end
+    nearer the interface, :data:`NEARER_END`), and
     each multiplier dof of a vertex on a cut edge expressed by
     :func:`xfem_contact.mechanics.lbb.prolongation`; a vertex of a cut cell on no cut
     edge takes the mean of the rows of its cut cells' vertices on one.
@@ -82,6 +93,7 @@ def vital_vertex_prolongation(
         interface: The interface whose cut cells carry the field (None: all).
     """
     mesh = cut.mesh
+    nearer = NEARER_END[mesh.topology.cell_type.name][cut.crack is not None]
     tdim = mesh.topology.dim
     mesh.topology.create_connectivity(tdim, 1)
     mesh.topology.create_connectivity(1, 0)
@@ -112,7 +124,7 @@ def vital_vertex_prolongation(
     if degree > 1:  # the vertices' nodes, and every other node tied to its vertices
         nodes, node_of_vertex = _lagrange_nodes(mesh, degree, cell_vertices, vertex_side)
         return _prolongation_of_nodes(
-            mesh, space, field, nodes, node_of_vertex[ends], cut_cells, vertex_phi[ends]
+            mesh, space, field, nodes, node_of_vertex[ends], cut_cells, vertex_phi[ends], nearer
         )
     gdim = mesh.geometry.dim
 
@@ -121,7 +133,9 @@ def vital_vertex_prolongation(
         return mesh.geometry.x[nodes.ravel(), :gdim]
 
     nodes = _Nodes(cell_vertices, vertex_side, vmap, positions)
-    return _prolongation_of_nodes(mesh, space, field, nodes, ends, cut_cells, vertex_phi[ends])
+    return _prolongation_of_nodes(
+        mesh, space, field, nodes, ends, cut_cells, vertex_phi[ends], nearer
+    )
 
 
 def _lagrange_nodes(mesh, degree: int, cell_vertices: np.ndarray, vertex_side: np.ndarray):
@@ -149,13 +163,14 @@ def _prolongation_of_nodes(
     ends: np.ndarray,
     cut_cells: np.ndarray,
     phi_ends: np.ndarray,
+    nearer: bool,
 ) -> MultiplierProlongation:
     """The prolongation of ``field``'s dofs at ``nodes`` from the vital vertices of the
     cut edges ``ends`` (local node pairs of vertices, ``(m, 2)``; duplicates allowed, the
-    level set at them ``phi_ends``) of ``cut_cells``, chosen as :data:`NEARER_END`
-    says; a vertex of a cut cell on no cut edge takes the mean of the rows of its cut
-    cells' vertices on one, a node off the vertices that of its linked vertices
-    (``nodes.links``). Collective."""
+    level set at them ``phi_ends``) of ``cut_cells``, each the end nearer the interface
+    if ``nearer`` (:data:`NEARER_END`), else by the greedy covering; a vertex of a cut
+    cell on no cut edge takes the mean of the rows of its cut cells' vertices on one, a
+    node off the vertices that of its linked vertices (``nodes.links``). Collective."""
     comm, vmap = mesh.comm, nodes.index_map
     vertex_side = nodes.side
     nv_cell = nodes.cells.shape[1] - len({int(n) for n, _ in nodes.links})
@@ -174,7 +189,7 @@ def _prolongation_of_nodes(
     label[order] = np.arange(order.size)
     by_position = label[np.searchsorted(ids, all_ends)]
     distances = None
-    if NEARER_END[mesh.topology.dim]:
+    if nearer:
         distances = np.concatenate(comm.allgather(np.abs(phi_ends).reshape(-1, 2)))
     vital = ids[order][lbb_module.vital_vertices(by_position, all_sides, distances)]
     rows, cols, vals, reduced = lbb_module.prolongation(all_ends, vital)
