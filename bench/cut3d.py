@@ -436,6 +436,19 @@ def _print_signed(errors: dict[int, dict]) -> None:
             print(f"{n:5d} {name:>6} " + " ".join(f"{e:+9.2e}" for e in row[name]))
 
 
+def _print_fitted_rates(errors: dict[int, dict]) -> None:
+    """Print the least-squares slopes of ``log`` (mean relative error) against ``log n``
+    over all sizes (three or more)."""
+    if len(errors) < 3:
+        return
+    sizes = np.array(list(errors))
+    line = f"least-squares rate over n = {', '.join(map(str, sizes))}:"
+    for name in ("volume", "area"):
+        means = [np.abs(row[name]).mean() for row in errors.values()]
+        line += f" {name} {-np.polyfit(np.log(sizes), np.log(means), 1)[0]:.2f}"
+    print(line)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
@@ -546,6 +559,7 @@ def main() -> None:
             errors[n] = _print_errors(shape, n, rows, errors.get(_previous(args.sizes, n)))
         if args.centres:
             _print_signed(errors)
+            _print_fitted_rates(errors)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"\npeak memory {peak:.0f} MB")
 
