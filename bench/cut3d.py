@@ -156,9 +156,9 @@ FRAME = "tetrahedron"
 """Where the P2 tetrahedra's rules run Saye's algorithm (``--frame``)."""
 
 
-CHUNK = 8192
-"""Cut P2 tetrahedra per call of the rules (their volumes and areas are summed: the rules
-of all cut cells at once would hold about 1 GB at n = 64)."""
+CHUNK = 4096
+"""Cut P2 tetrahedra per call of the rules: their volumes and areas are summed, so that
+only one chunk's rules are held at a time."""
 
 
 @functools.lru_cache(maxsize=1)
