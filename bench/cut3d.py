@@ -45,6 +45,7 @@ with ``--levelset callable`` also those of the P2 / Q2 rules on the exact zero s
 from __future__ import annotations
 
 import argparse
+import functools
 import itertools
 import resource
 import time
@@ -76,25 +77,30 @@ def _ellipsoid_area(a: float, b: float, c: float, m: int = 200) -> float:
     return float(wt @ f.sum(axis=1) * np.pi / m)
 
 
-def _torus(x: np.ndarray) -> np.ndarray:
+def _sphere(x: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """The sphere's signed distance."""
+    return np.linalg.norm(x - centre, axis=-1) - R
+
+
+def _torus(x: np.ndarray, centre: np.ndarray) -> np.ndarray:
     big, small = TORUS
-    y = x - CENTRE
+    y = x - centre
     rho2, z2 = y[..., 0] ** 2 + y[..., 1] ** 2, y[..., 2] ** 2
     return ((rho2 + z2 + big**2 - small**2) ** 2 - 4 * big**2 * rho2) / (4 * big**2)
 
 
-def _ellipsoid(x: np.ndarray) -> np.ndarray:
-    return np.linalg.norm((x - CENTRE) / AXES, axis=-1) - 1.0
+def _ellipsoid(x: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    return np.linalg.norm((x - centre) / AXES, axis=-1) - 1.0
 
 
-#: name -> (level set on points (..., 3), exact volume, exact area)
+#: name -> (level set on points (..., 3) about a centre (3,), exact volume, exact area)
 SHAPES = {
-    "sphere": (lambda x: level_set(x), 4.0 / 3.0 * np.pi * R**3, 4.0 * np.pi * R**2),
+    "sphere": (_sphere, 4.0 / 3.0 * np.pi * R**3, 4.0 * np.pi * R**2),
     "torus": (_torus, 2 * np.pi**2 * TORUS[0] * TORUS[1] ** 2, 4 * np.pi**2 * TORUS[0] * TORUS[1]),
     "ellipsoid": (_ellipsoid, 4.0 / 3.0 * np.pi * AXES.prod(), _ellipsoid_area(*AXES)),
     # the sphere as |x - c|^2 - R^2: P2 and Q2 interpolate it exactly, so only the rules err
     "quadric": (
-        lambda x: ((x - CENTRE) ** 2).sum(axis=-1) - R**2,
+        lambda x, centre: ((x - centre) ** 2).sum(axis=-1) - R**2,
         4.0 / 3.0 * np.pi * R**3,
         4.0 * np.pi * R**2,
     ),
@@ -110,11 +116,6 @@ KUHN = [
     [(0, 0, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1)],
     [(0, 0, 0), (0, 0, 1), (0, 1, 1), (1, 1, 1)],
 ]
-
-
-def level_set(x: np.ndarray) -> np.ndarray:
-    """The sphere's signed distance."""
-    return np.linalg.norm(x - CENTRE, axis=-1) - R
 
 
 def origins(n: int) -> np.ndarray:
@@ -155,12 +156,39 @@ FRAME = "tetrahedron"
 """Where the P2 tetrahedra's rules run Saye's algorithm (``--frame``)."""
 
 
-def sphere_tets(n: int, degree: int = 4, shape: str = "sphere") -> tuple[float, float, int, float]:
-    """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P1 level set)."""
-    vertices = kuhn_mesh(n, PERTURB)
+CHUNK = 4096
+"""Cut P2 tetrahedra per call of the rules: their volumes and areas are summed, so that
+only one chunk's rules are held at a time."""
+
+
+@functools.lru_cache(maxsize=1)
+def tet_geometry(
+    n: int, perturb: float, degree: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Vertices ``(6 n^3, 4, 3)``, Jacobians ``(6 n^3, 3, 3)``, ``|det J|`` and the nodes
+    ``(6 n^3, 4 | 10, 3)`` of the P``degree`` level set of :func:`kuhn_mesh` (the last
+    mesh is kept: several centres on one mesh build it once)."""
+    vertices = kuhn_mesh(n, perturb)
     J = np.transpose(vertices[:, 1:] - vertices[:, :1], (0, 2, 1))
     detJ = np.abs(np.linalg.det(J))
-    phi = SHAPES[shape][0](vertices)
+    nodes = vertices
+    if degree == 2:
+        element = basix.create_element(
+            basix.ElementFamily.P, basix.CellType.tetrahedron, 2, basix.LagrangeVariant.gll_warped
+        )
+        nodes = vertices[:, :1] + np.einsum("qk,ndk->nqd", element.points, J)
+    for array in (vertices, J, detJ, nodes):
+        array.flags.writeable = False
+    return vertices, J, detJ, nodes
+
+
+def sphere_tets(
+    n: int, degree: int = 4, shape: str = "sphere", centre: np.ndarray = CENTRE
+) -> tuple[float, float, int, float]:
+    """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P1 level set
+    of ``shape`` about ``centre``)."""
+    _, J, detJ, nodes = tet_geometry(n, PERTURB, 1)
+    phi = SHAPES[shape][0](nodes, centre)
     start = time.process_time()
     side = classify_tets(phi)
     cut = np.flatnonzero(side == 0)
@@ -174,51 +202,59 @@ def sphere_tets(n: int, degree: int = 4, shape: str = "sphere") -> tuple[float, 
 
 
 def sphere_p2_tets(
-    n: int, order: int | None = None, shape: str = "sphere", callable_: bool = False
+    n: int,
+    order: int | None = None,
+    shape: str = "sphere",
+    callable_: bool = False,
+    centre: np.ndarray = CENTRE,
 ) -> tuple[float, float, int, float]:
-    """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P2 level set,
-    Saye's rules on its four hexahedra; with ``callable_`` following the level set's exact
-    zero set, as ``CutMesh(..., exact_zero_set=True)`` does)."""
-    vertices = kuhn_mesh(n, PERTURB)
-    J = np.transpose(vertices[:, 1:] - vertices[:, :1], (0, 2, 1))
-    detJ = np.abs(np.linalg.det(J))
-    element = basix.create_element(
-        basix.ElementFamily.P, basix.CellType.tetrahedron, 2, basix.LagrangeVariant.gll_warped
-    )
-    x = vertices[:, :1] + np.einsum("qk,ndk->nqd", element.points, J)
-    phi = SHAPES[shape][0](x)
+    """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P2 level set
+    of ``shape`` about ``centre``; with ``callable_`` following the level set's exact zero
+    set, as ``CutMesh(..., exact_zero_set=True)`` does)."""
+    vertices, J, detJ, nodes = tet_geometry(n, PERTURB, 2)
+    phi = SHAPES[shape][0](nodes, centre)
     start = time.process_time()
     side = classify_p2_tets(phi)
     cut = np.flatnonzero(side == 0)
-
-    def exact(rows, X):
-        return SHAPES[shape][0](vertices[cut[rows], 0] + np.einsum("mij,mj->mi", J[cut[rows]], X))
-
-    rules = p2_tet_cut_rules(
-        phi[cut],
-        order or ORDER,
-        min_depth=MIN_DEPTH,
-        frame=FRAME,
-        jacobian=lambda rows, X: J[cut[rows]],
-        exact=exact if callable_ else None,
-    )
-    elapsed = time.process_time() - start
     volume = detJ[side == -1].sum() / 6.0
-    volume += (rules.minus.weights * detJ[cut[rules.minus.point_rows]]).sum()
-    area = (rules.interface.weights * detJ[cut[rules.interface.point_rows]]).sum()
+    area = 0.0
+    for first in range(0, cut.size, CHUNK):
+        cells = cut[first : first + CHUNK]
+
+        def exact(rows, X, cells=cells):
+            x = vertices[cells[rows], 0] + np.einsum("mij,mj->mi", J[cells[rows]], X)
+            return SHAPES[shape][0](x, centre)
+
+        rules = p2_tet_cut_rules(
+            phi[cells],
+            order or ORDER,
+            min_depth=MIN_DEPTH,
+            frame=FRAME,
+            jacobian=lambda rows, X, cells=cells: J[cells[rows]],
+            exact=exact if callable_ else None,
+        )
+        volume += (rules.minus.weights * detJ[cells[rules.minus.point_rows]]).sum()
+        area += (rules.interface.weights * detJ[cells[rules.interface.point_rows]]).sum()
+    elapsed = time.process_time() - start
     return volume, area, cut.size, elapsed
 
 
 def sphere_hexes(
-    n: int, degree: int, order: int | None = None, shape: str = "sphere", callable_: bool = False
+    n: int,
+    degree: int,
+    order: int | None = None,
+    shape: str = "sphere",
+    callable_: bool = False,
+    centre: np.ndarray = CENTRE,
 ) -> tuple[float, float, int, float]:
-    """Volume, area, cut-cell count and CPU seconds on ``n^3`` hexahedra (Q``degree``; with
-    ``callable_`` and degree 2, following the level set's exact zero set)."""
+    """Volume, area, cut-cell count and CPU seconds on ``n^3`` hexahedra (Q``degree`` level
+    set of ``shape`` about ``centre``; with ``callable_`` and degree 2, following the level
+    set's exact zero set)."""
     h = 1.0 / n
     element = basix.create_element(
         basix.ElementFamily.P, basix.CellType.hexahedron, degree, basix.LagrangeVariant.gll_warped
     )
-    phi = SHAPES[shape][0](origins(n)[:, None] + h * element.points[None])
+    phi = SHAPES[shape][0](origins(n)[:, None] + h * element.points[None], centre)
     start = time.process_time()
     side = classify_hexes(phi, degree)
     cut = np.flatnonzero(side == 0)
@@ -226,7 +262,7 @@ def sphere_hexes(
     corners = origins(n)[cut]
 
     def exact(rows, X):
-        return SHAPES[shape][0](corners[rows] + h * X)
+        return SHAPES[shape][0](corners[rows] + h * X, centre)
 
     rules = hex_cut_rules(
         phi[cut],
@@ -353,6 +389,74 @@ def _check_batch(
     counts["volume"] += int((np.abs(minus + plus - volume) > 1e-12).sum())
 
 
+def shifted_centres(n: int, count: int, seed: int = 0) -> np.ndarray:
+    """Centres ``(max(count, 1), 3)`` of the surfaces on a mesh of size ``h = 1 / n``: the
+    cube's centre if ``count == 0``, else the cube's centre shifted by ``h u`` with
+    ``count`` vectors ``u`` uniform in ``[0, 1)^3`` (seeded, the same ``u`` for every
+    ``n``)."""
+    if count == 0:
+        return CENTRE[None]
+    u = np.random.default_rng(seed).uniform(0.0, 1.0, size=(count, 3))
+    return CENTRE + u / n
+
+
+def _previous(sizes: list[int], n: int) -> int | None:
+    at = sizes.index(n)
+    return sizes[at - 1] if at else None
+
+
+def _print_errors(shape: str, n: int, rows: list, previous: dict | None) -> dict:
+    """Print the row of size ``n`` from the ``(volume, area, cut cells, cpu s)`` of each
+    centre: the relative errors (their mean and largest magnitude over several centres)
+    and the rates of the means against ``previous``; returns this row's errors."""
+    _, exact_volume, exact_area = SHAPES[shape]
+    volume, area, ncut, elapsed = (np.array(column) for column in zip(*rows, strict=True))
+    row = {
+        "n": n,
+        "volume": (volume - exact_volume) / exact_volume,
+        "area": (area - exact_area) / exact_area,
+    }
+    several = volume.size > 1
+    if previous is None:
+        header = f"{'n':>5} {'cut cells':>10}"
+        for name in ("volume", "area"):
+            header += f" {name + (' mean' if several else ' err'):>11}"
+            header += f" {'max':>9} {'rate':>5}" if several else f" {'rate':>5}"
+        print(header + f" {'cpu s':>7}")
+    line = f"{n:5d} {int(ncut.mean()):10d}"
+    for name in ("volume", "area"):
+        mean = np.abs(row[name]).mean()
+        rate = ""
+        if previous is not None:
+            before = np.abs(previous[name]).mean()
+            rate = f"{np.log(before / mean) / np.log(n / previous['n']):5.2f}"
+        line += f" {mean:11.3e}"
+        line += f" {np.abs(row[name]).max():9.2e} {rate:>5}" if several else f" {rate:>5}"
+    print(line + f" {elapsed.mean():7.2f}", flush=True)
+    return row
+
+
+def _print_signed(errors: dict[int, dict]) -> None:
+    """Print the signed relative errors of each size, one column per centre."""
+    print("signed relative errors, one per centre:")
+    for name in ("volume", "area"):
+        for n, row in errors.items():
+            print(f"{n:5d} {name:>6} " + " ".join(f"{e:+9.2e}" for e in row[name]))
+
+
+def _print_fitted_rates(errors: dict[int, dict]) -> None:
+    """Print the least-squares slopes of ``log`` (mean relative error) against ``log n``
+    over all sizes (three or more)."""
+    if len(errors) < 3:
+        return
+    sizes = np.array(list(errors))
+    line = f"least-squares rate over n = {', '.join(map(str, sizes))}:"
+    for name in ("volume", "area"):
+        means = [np.abs(row[name]).mean() for row in errors.values()]
+        line += f" {name} {-np.polyfit(np.log(sizes), np.log(means), 1)[0]:.2f}"
+    print(line)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
@@ -412,7 +516,17 @@ def main() -> None:
         help="P2 tetrahedra: Saye's rules on truncated boxes of the tetrahedron or on its "
         "four hexahedra (p2_tet_cut_rules frame)",
     )
+    parser.add_argument(
+        "--centres",
+        type=int,
+        default=0,
+        metavar="K",
+        help="average the errors over K centres shifted by up to h per coordinate "
+        "(seeded; 0: the cube's centre only)",
+    )
     args = parser.parse_args()
+    if args.centres < 0:
+        parser.error(f"--centres must be >= 0, got {args.centres}")
     global PERTURB, MIN_DEPTH, ORDER, FRAME
     PERTURB, MIN_DEPTH, ORDER, FRAME = args.perturb, args.min_depth, args.order, args.frame
     for kind, levelset in itertools.product(args.kinds if args.fuzz else [], args.levelset):
@@ -427,40 +541,33 @@ def main() -> None:
             f"({time.perf_counter() - start:.1f} s)"
         )
     runs = {
-        "tet-P1": lambda n, shape, c: sphere_tets(n, shape=shape),
-        "tet-P2": lambda n, shape, c: sphere_p2_tets(n, shape=shape, callable_=c),
-        "hex-Q1": lambda n, shape, c: sphere_hexes(n, 1, shape=shape),
-        "hex-Q2": lambda n, shape, c: sphere_hexes(n, 2, shape=shape, callable_=c),
+        "tet-P1": lambda n, shape, c, centre: sphere_tets(n, shape=shape, centre=centre),
+        "tet-P2": lambda n, shape, c, centre: sphere_p2_tets(
+            n, shape=shape, callable_=c, centre=centre
+        ),
+        "hex-Q1": lambda n, shape, c, centre: sphere_hexes(n, 1, shape=shape, centre=centre),
+        "hex-Q2": lambda n, shape, c, centre: sphere_hexes(
+            n, 2, shape=shape, callable_=c, centre=centre
+        ),
     }
     cases = itertools.product(args.shapes, args.kinds if args.sizes else [], args.levelset)
     for shape, kind, levelset in cases:
         if levelset == "callable" and kind in ("tet-P1", "hex-Q1"):
             continue  # degree 1: the interpolant's cut either way
-        _, exact_volume, exact_area = SHAPES[shape]
         label = f" ({levelset})" if kind in ("tet-P2", "hex-Q2") else ""
+        if args.centres:
+            label += f", {args.centres} centres"
         print(f"\n{kind}: {shape}{label}")
-        print(
-            f"{'n':>5} {'cut cells':>10} {'volume err':>11} {'rate':>5} {'area err':>11} "
-            f"{'rate':>5} {'cpu s':>7}"
-        )
-        previous = None
+        errors = {}
         for n in args.sizes:
-            volume, area, ncut, elapsed = runs[kind](n, shape, levelset == "callable")
-            ev = abs(volume - exact_volume) / exact_volume
-            ea = abs(area - exact_area) / exact_area
-            rates = ["", ""]
-            if previous is not None:
-                ratio = n / previous[0]
-                rates = [
-                    f"{np.log(previous[1] / ev) / np.log(ratio):5.2f}",
-                    f"{np.log(previous[2] / ea) / np.log(ratio):5.2f}",
-                ]
-            print(
-                f"{n:5d} {ncut:10d} {ev:11.3e} {rates[0]:>5} {ea:11.3e} {rates[1]:>5} "
-                f"{elapsed:7.2f}",
-                flush=True,
-            )
-            previous = (n, ev, ea)
+            rows = [
+                runs[kind](n, shape, levelset == "callable", centre)
+                for centre in shifted_centres(n, args.centres)
+            ]
+            errors[n] = _print_errors(shape, n, rows, errors.get(_previous(args.sizes, n)))
+        if args.centres:
+            _print_signed(errors)
+            _print_fitted_rates(errors)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"\npeak memory {peak:.0f} MB")
 
