@@ -163,4 +163,7 @@ def test_tip_basis_is_checked():
         williams_case(4, 2, tip_basis="stable")
     with pytest.raises(ValueError, match="tip_basis='shifted' needs displacement degree 2"):
         williams_case(4, 1, tip_basis="shifted")
+    with pytest.raises(ValueError, match="got degree 2, aggregation on: use 'plain'"):
+        williams_case(4, 2, tip_basis="shifted", aggregation=0.25)
     assert williams_case(4, 1).problem.space.tip_basis == "plain"
+    assert williams_case(4, 2, aggregation=0.25).problem.space.tip_basis == "plain"

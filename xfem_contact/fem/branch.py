@@ -4,7 +4,8 @@
 coordinates ``(r, t)`` (m, rad; ``t`` in ``[-pi, pi]``, the crack at ``t = +-pi``): they
 span the leading term of the Williams expansion of the displacement near a crack tip
 (:mod:`xfem_contact.mechanics.fracture.williams`). An :class:`Ops` (:data:`NUMPY` or
-:data:`UFL`) says which pointwise functions evaluate them.
+:data:`UFL`) says which pointwise functions evaluate them. Also the tip enrichment's
+bases (:data:`TIP_BASES`) and the values of the shifted basis' interpolants.
 """
 
 from __future__ import annotations
@@ -15,7 +16,21 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-__all__ = ["NUMPY", "UFL", "Ops", "angular", "branch_values", "null_pins"]
+__all__ = [
+    "NUMPY",
+    "TIP_BASES",
+    "UFL",
+    "Ops",
+    "angular",
+    "branch_values",
+    "checked_tip_basis",
+    "null_pins",
+    "side_values",
+    "tied_values",
+]
+
+#: The bases of the tip enrichment (:class:`~xfem_contact.fem.enrichment.EnrichedSpace`)
+TIP_BASES = ("auto", "plain", "shifted")
 
 
 def _np_vector(components) -> np.ndarray:
@@ -52,6 +67,40 @@ def branch_values(r, theta, ops: Ops = NUMPY) -> tuple:
     ``F = sqrt(r) (sin(t/2), cos(t/2), sin(t/2) sin(t), cos(t/2) sin(t))``."""
     sr = ops.sqrt(r)
     return tuple(sr * a for a in angular(theta, ops)[0])
+
+
+def side_values(phi, psi, ramp) -> dict[int, np.ndarray]:
+    """Per side ``s``, ``R F_k`` of that side (m^1/2, shape ``(4, n)``) at ``n`` points
+    with the crack's level sets ``phi``, ``psi`` (m) and the ramp ``R`` (a number or
+    ``(n,)``): ``r = sqrt(phi^2 + psi^2)``, ``theta = s |atan2(phi, psi)|``."""
+    r, angle = np.sqrt(phi**2 + psi**2), np.abs(np.arctan2(phi, psi))
+    return {s: ramp * np.array(branch_values(r, s * angle)) for s in (-1, 1)}
+
+
+def tied_values(values: dict[int, np.ndarray], tied: np.ndarray, phi) -> dict[int, np.ndarray]:
+    """``values`` of :func:`side_values` with, at the points where ``tied`` (the two
+    sides share one unknown), both sides' taking those of the side the point lies on
+    (by the sign of ``phi``)."""
+    own = np.where(phi > 0, values[1], values[-1])
+    return {s: np.where(tied, own, v) for s, v in values.items()}
+
+
+def checked_tip_basis(tip_basis: str, degree: int, aggregated: bool = False) -> str:
+    """``tip_basis`` (one of :data:`TIP_BASES`) for displacement ``degree``, resolved:
+    ``"auto"`` is ``"shifted"`` for degree 2 without cell aggregation (``aggregated``),
+    else ``"plain"``. ``"shifted"`` needs both: its vertex interpolant times a hat must
+    be a function of the standard space (degree 2, no dof extended from another cell)."""
+    if tip_basis not in TIP_BASES:
+        raise ValueError(f"tip_basis must be one of {TIP_BASES}, got {tip_basis!r}")
+    if tip_basis == "auto":
+        return "shifted" if degree == 2 and not aggregated else "plain"
+    if tip_basis == "shifted" and (degree != 2 or aggregated):
+        raise ValueError(
+            f"tip_basis='shifted' needs displacement degree 2 and no cell aggregation (its "
+            f"vertex interpolant times a hat is then a standard function), got degree "
+            f"{degree}, aggregation {'on' if aggregated else 'off'}: use 'plain'"
+        )
+    return tip_basis
 
 
 def null_pins(x, tips, directions, offset: float, comm: MPI.Comm) -> np.ndarray:

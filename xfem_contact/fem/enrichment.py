@@ -31,7 +31,14 @@ from xfem_contact.fem.aggregation import (
     check_threshold,
     side_areas,
 )
-from xfem_contact.fem.branch import UFL, branch_values, null_pins
+from xfem_contact.fem.branch import (
+    UFL,
+    branch_values,
+    checked_tip_basis,
+    null_pins,
+    side_values,
+    tied_values,
+)
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.subspaces import collapse
 from xfem_contact.fem.tip_scale import default_tip_radius
@@ -53,25 +60,6 @@ class DofCounts(typing.NamedTuple):
     @property
     def total(self) -> int:
         return self.standard + self.enriched + self.multiplier
-
-
-TIP_BASES = ("auto", "plain", "shifted")
-
-
-def _checked_tip_basis(tip_basis: str, degree: int) -> str:
-    """``tip_basis`` resolved (``"auto"``: ``"shifted"`` for degree 2, else
-    ``"plain"``); a word not in :data:`TIP_BASES`, or ``"shifted"`` with degree 1, is
-    refused."""
-    if tip_basis not in TIP_BASES:
-        raise ValueError(f"tip_basis must be one of {TIP_BASES}, got {tip_basis!r}")
-    if tip_basis == "auto":
-        return "shifted" if degree == 2 else "plain"
-    if tip_basis == "shifted" and degree != 2:
-        raise ValueError(
-            f"tip_basis='shifted' needs displacement degree 2 (its vertex interpolant "
-            f"times a hat is then a standard function), got degree {degree}: use 'plain'"
-        )
-    return tip_basis
 
 
 class EnrichedSpace:
@@ -106,8 +94,8 @@ class EnrichedSpace:
         tip_basis: The functions of a crack's branch dofs: ``"plain"``, ``R F_k``;
             ``"shifted"``, ``R F_k - I(R F_k)`` with ``I`` the interpolant on the
             vertices (the same space for degree 2, where ``N_i I(R F_k)`` is a standard
-            function; degree 1 takes ``"plain"`` only); ``"auto"`` (default): ``"shifted"``
-            for degree 2, else ``"plain"``.
+            function; degree 1 and cell aggregation take ``"plain"`` only); ``"auto"``
+            (default): ``"shifted"`` for degree 2 without aggregation, else ``"plain"``.
 
     A crack's multipliers live on the nodes of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillates, ``docs/crack_enrichment.md``). A crack
@@ -194,7 +182,7 @@ class EnrichedSpace:
         if self.branch_field is not None and tip_radius is not None:
             self.ramp = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 1)))
         self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
-        self.tip_basis = _checked_tip_basis(tip_basis, degree)
+        self.tip_basis = checked_tip_basis(tip_basis, degree, aggregation is not None)
         #: Per side, ``I(R F_k)`` (four P1 functions, set with the active dofs) with
         #: ``tip_basis="shifted"``, else None
         self.interpolants: dict[int, tuple[dolfinx.fem.Function, ...]] | None = None
@@ -392,19 +380,16 @@ class EnrichedSpace:
                 f.interpolate(g)
             values.append(f.x.array[:nodes])
         phi, psi, ramp = values
-        r, angle = np.sqrt(phi**2 + psi**2), np.abs(np.arctan2(phi, psi))
-        F = {s: ramp * np.array(branch_values(r, s * angle)) for s in (-1, 1)}  # (4, nodes)
         V0 = self.field_space(0)[0]
         gdim, vertices = V0.dofmap.index_map_bs, P1.dofmap.list.shape[1]
         tied = np.zeros(nodes, dtype=bool)  # the vertex nodes come first in each cell
         tied[P1.dofmap.list] = self._tied_nodes(active).reshape(-1, gdim)[
             V0.dofmap.list[:, :vertices], 0
         ]
-        own = np.where(tied, np.where(phi > 0, 1, -1), 0)
+        at = tied_values(side_values(phi, psi, ramp), tied, phi)
         for s, functions in self.interpolants.items():
-            at = np.where(own > 0, F[1], np.where(own < 0, F[-1], F[s]))
             for k, f in enumerate(functions):
-                f.x.array[:] = at[k]
+                f.x.array[:] = at[s][k]
                 f.x.scatter_forward()
 
     def _tied(self, active: npt.NDArray[np.bool_]) -> npt.NDArray[np.int64]:

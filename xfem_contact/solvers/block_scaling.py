@@ -37,7 +37,7 @@ import dolfinx.fem
 import numpy as np
 from petsc4py import PETSc
 
-from xfem_contact.fem.branch import branch_values
+from xfem_contact.fem.branch import side_values
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.symmetry import TOLERANCE, mark_symmetric, symmetry_gap
@@ -191,9 +191,7 @@ def _branch_at_nodes(space: EnrichedSpace) -> tuple[dict[int, np.ndarray], np.nd
         at[nodes] = f.x.array[: nodes.size]
         values.append(at)
     phi, psi = values[:2]
-    r, angle = np.sqrt(phi**2 + psi**2), np.abs(np.arctan2(phi, psi))
-    ramp = values[2] if len(values) > 2 else 1.0
-    F = {s: ramp * np.array(branch_values(r, s * angle)) for s in (-1, 1)}
+    F = side_values(phi, psi, values[2] if len(values) > 2 else 1.0)
     if space.interpolants is not None:
         for s, functions in space.interpolants.items():
             for k, g in enumerate(functions):
