@@ -31,7 +31,7 @@ top of the ghost penalty, and aggregation alone.
 
 Part ``crack``: the Williams crack on Q2 quadrilaterals (geometric tip enrichment,
 r_e = 0.3), n = 32, 64, 128, without and with ``aggregation=0.25`` (the default tip
-basis of each: ``"shifted"`` without, ``"plain"`` with aggregation): the energy error,
+basis, ``"plain"``): the energy error,
 its rate and the condition number of the matrix the solver factors (tip-transformed;
 ``bench/crack_convergence.py``'s estimate, n <= 64).
 

@@ -191,6 +191,7 @@ def griffith_case(
     offset: tuple[float, float] = tuple(OFFSET),
     cell: str = "triangle",
     mesh: dolfinx.mesh.Mesh | None = None,
+    tip_basis: str = "auto",
 ) -> CrackCase:
     """A Griffith crack of half length ``a = 1`` m, inclined at ``beta`` (rad) to a
     remote tension of 1 Pa, in the square of half width ``width`` (m) meshed with
@@ -210,7 +211,15 @@ def griffith_case(
         degree=degree,
         tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
     )
-    problem = Problem(cut, degree, MATERIAL, "free", ghost_penalty=0.0, tip_radius=tip_radius)
+    problem = Problem(
+        cut,
+        degree,
+        MATERIAL,
+        "free",
+        ghost_penalty=0.0,
+        tip_radius=tip_radius,
+        tip_basis=tip_basis,
+    )
 
     def displacement(side: int) -> Callable:
         return lambda x: crack.displacement(x, MATERIAL.E, MATERIAL.nu, MATERIAL.plane)

@@ -32,6 +32,7 @@ from xfem_contact.fem.aggregation import (
     side_areas,
 )
 from xfem_contact.fem.branch import (
+    ROUND_OFF,
     UFL,
     branch_values,
     checked_tip_basis,
@@ -95,7 +96,7 @@ class EnrichedSpace:
             ``"shifted"``, ``R F_k - I(R F_k)`` with ``I`` the interpolant on the
             vertices (the same space for degree 2, where ``N_i I(R F_k)`` is a standard
             function; degree 1 and cell aggregation take ``"plain"`` only); ``"auto"``
-            (default): ``"shifted"`` for degree 2 without aggregation, else ``"plain"``.
+            (default): ``"plain"``.
 
     A crack's multipliers live on the nodes of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillates, ``docs/crack_enrichment.md``). A crack
@@ -182,6 +183,9 @@ class EnrichedSpace:
         if self.branch_field is not None and tip_radius is not None:
             self.ramp = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 1)))
         self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
+        extent = mesh.comm.allreduce(float(np.abs(mesh.geometry.x).max()), op=MPI.MAX)
+        #: Level set values (m) taken for 0: a node on a crack's line
+        self.round_off = ROUND_OFF * extent
         self.tip_basis = checked_tip_basis(tip_basis, degree, aggregation is not None)
         #: Per side, ``I(R F_k)`` (four P1 functions, set with the active dofs) with
         #: ``tip_basis="shifted"``, else None
@@ -367,8 +371,8 @@ class EnrichedSpace:
 
     def _interpolate(self, active: npt.NDArray[np.bool_]) -> None:
         """Set :attr:`interpolants`: per side ``s``, ``R F_k`` of side ``s`` at each
-        vertex, of the side the vertex lies on (by the sign of ``phi``) where the two
-        sides share one unknown. Collective."""
+        vertex, of the side the vertex lies on where the two sides share one unknown
+        (:func:`~xfem_contact.fem.branch.tied_values`). Collective."""
         P1 = self.interpolants[1][0].function_space
         nodes = P1.dofmap.index_map.size_local + P1.dofmap.index_map.num_ghosts
         values = []
@@ -386,7 +390,7 @@ class EnrichedSpace:
         tied[P1.dofmap.list] = self._tied_nodes(active).reshape(-1, gdim)[
             V0.dofmap.list[:, :vertices], 0
         ]
-        at = tied_values(side_values(phi, psi, ramp), tied, phi)
+        at = tied_values(side_values(phi, psi, ramp), tied, phi, self.round_off)
         for s, functions in self.interpolants.items():
             for k, f in enumerate(functions):
                 f.x.array[:] = at[s][k]

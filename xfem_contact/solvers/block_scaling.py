@@ -37,7 +37,7 @@ import dolfinx.fem
 import numpy as np
 from petsc4py import PETSc
 
-from xfem_contact.fem.branch import side_values
+from xfem_contact.fem.branch import side_of, side_values
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.symmetry import TOLERANCE, mark_symmetric, symmetry_gap
@@ -176,7 +176,7 @@ def _branch_at_nodes(space: EnrichedSpace) -> tuple[dict[int, np.ndarray], np.nd
     """Per side, the functions of the branch dofs at the nodes of field 0's own space,
     shape ``(4, nodes)`` (the branch functions times the space's ramp where it has one,
     minus its interpolants where it has them), and the side each node lies on (by the
-    sign of ``phi``)."""
+    sign of ``phi``, :func:`~xfem_contact.fem.branch.side_of`)."""
     V = space.field_space(0)[0]
     bs = V.dofmap.index_map_bs
     S, dofs = V.sub(0).collapse()
@@ -198,7 +198,7 @@ def _branch_at_nodes(space: EnrichedSpace) -> tuple[dict[int, np.ndarray], np.nd
                 f = dolfinx.fem.Function(S)
                 f.interpolate(g)
                 F[s][k, nodes] -= f.x.array[: nodes.size]
-    return F, np.where(phi > 0, 1, -1)
+    return F, side_of(phi, space.round_off)
 
 
 def shift_matrix(space: EnrichedSpace, R: PETSc.Mat, columns: np.ndarray) -> PETSc.Mat:
