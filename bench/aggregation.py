@@ -30,7 +30,8 @@ penalty 0.01), none (no ghost penalty, the dofs of empty support dropped), aggre
 top of the ghost penalty, and aggregation alone.
 
 Part ``crack``: the Williams crack on Q2 quadrilaterals (geometric tip enrichment,
-r_e = 0.3), n = 32, 64, 128, without and with ``aggregation=0.25``: the energy error,
+r_e = 0.3), n = 32, 64, 128, without and with ``aggregation=0.25`` (the default tip
+basis, ``"plain"``): the energy error,
 its rate and the condition number of the matrix the solver factors (tip-transformed;
 ``bench/crack_convergence.py``'s estimate, n <= 64).
 

@@ -18,6 +18,10 @@ The studies (``--parts``, all by default), on the cases of ``xfem_contact.cases.
   errors, plates of half width 2a and 4a;
 - ``p1_error``: where P1's error lies (squared energy error in annuli around a tip) next
   to its K error;
+- ``tip_basis``: the Williams field with P2 on triangles and quadrilaterals (r_e = 0.3,
+  n = 32, 64, 128), the tip enrichment's bases ``"plain"`` and ``"shifted"`` (one space):
+  energy error, rate, and the condition number of the matrix the solver factors
+  (n <= 64);
 - ``conditioning``: the condition number of the scaled reduced stiffness (power and
   inverse iterations) against h at fixed r_e, and against r_e / h at fixed h: Jacobi
   scaling alone (``kappa_jacobi``) and the tip enrichment's change of unknowns the
@@ -116,6 +120,34 @@ def williams(say, quick: bool) -> list[dict]:
                         f"Williams {cell} P{degree} {enrichment} n = {n}: {row['dofs']} dofs, "
                         f"energy error {errors[-1]:.3e}{rate} ({row['time']:.1f} s)"
                     )
+    return rows
+
+
+def tip_basis(say, quick: bool) -> list[dict]:
+    rows = []
+    for cell in ("triangle", "quadrilateral"):
+        for basis in ("plain", "shifted"):
+            errors = []
+            for n in [16, 32] if quick else [32, 64, 128]:
+                case = williams_case(n, 2, tip_radius=0.3, cell=cell, tip_basis=basis)
+                case.problem.solve()
+                errors.append(williams_energy_error(case))
+                kappa = condition_number(case.problem) if n <= 64 else math.nan
+                row = dict(
+                    case="tip_basis",
+                    cell=cell,
+                    basis=basis,
+                    n=n,
+                    energy_error=errors[-1],
+                    rate=rates(errors)[-1],
+                    kappa=kappa,
+                )
+                rows.append(row)
+                rate = "" if row["rate"] is None else f", rate {row['rate']:.2f}"
+                say(
+                    f"Williams {cell} P2 {basis} n = {n}: energy error {errors[-1]:.3e}{rate}, "
+                    f"condition number {kappa:.2e}"
+                )
     return rows
 
 
@@ -510,6 +542,7 @@ PARTS = {
     "griffith": griffith,
     "friction": friction,
     "conditioning": conditioning,
+    "tip_basis": tip_basis,
     "growth": growth,
     "defaults": defaults,
     "p1_error": p1_error,

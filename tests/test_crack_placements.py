@@ -360,3 +360,32 @@ def test_distorted_meshes_with_nodes_on_the_line(degree):
         exact["interface"] = (2.5 + c) / ROOT5
         for key, value in exact.items():
             assert measured[key] == pytest.approx(value, abs=1e-12), (done, key)
+
+
+@pytest.mark.mpi
+@pytest.mark.parallel
+def test_shifted_tip_basis_equal_serial():
+    """The closed crack along cell edges, tips mid-edge, with the shifted tip basis: the
+    standard dofs the same on all ranks as on one. Its null vectors of the ramp carry
+    standard dofs, so the pinned node must be the same: of the nodes equally near the
+    pin's point, the first by position (the nearest by round-off differed: 1.4e-2)."""
+    from parallel import gathered_fields, max_relative_difference
+
+    angle, offset = PLACEMENTS["along edges, tips mid-edge"]
+    runs = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        case = frictional_crack_case(
+            4,
+            2,
+            friction=0.3,
+            tip_radius=0.5,
+            lbb="restriction",
+            angle=angle,
+            offset=offset,
+            comm=comm,
+            tip_basis="shifted",
+        )
+        case.problem.solve()
+        runs.append(gathered_fields(case.problem))
+    differences = max_relative_difference(*runs)
+    assert all(v <= 1e-10 for v in differences.values()), differences

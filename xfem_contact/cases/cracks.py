@@ -104,11 +104,12 @@ def williams_case(
     cell: str = "triangle",
     comm: MPI.Comm = MPI.COMM_WORLD,
     aggregation: float | None = None,
+    tip_basis: str = "auto",
 ) -> CrackCase:
     """The exact Williams field of ``K = (K_I, K_II)`` on the square ``[-1, 1]^2`` (``n``
     cells a side) with a crack from its left side to a tip near the centre, imposed on the
     whole boundary (each lip's value where the crack meets it). Geometric tip enrichment
-    of radius ``tip_radius`` (m; None: topological); ``aggregation``: see
+    of radius ``tip_radius`` (m; None: topological); ``aggregation``, ``tip_basis``: see
     :class:`~xfem_contact.mechanics.problem.Problem`."""
     d, normal = _frame()
     tip = OFFSET
@@ -127,6 +128,7 @@ def williams_case(
         ghost_penalty=0.0,
         tip_radius=tip_radius,
         aggregation=aggregation,
+        tip_basis=tip_basis,
     )
     displacement = _williams_sides(field)
     problem.loads.add_displacement(_on_boundary(1.0), {-1: displacement(-1), 1: displacement(1)})
@@ -189,6 +191,7 @@ def griffith_case(
     offset: tuple[float, float] = tuple(OFFSET),
     cell: str = "triangle",
     mesh: dolfinx.mesh.Mesh | None = None,
+    tip_basis: str = "auto",
 ) -> CrackCase:
     """A Griffith crack of half length ``a = 1`` m, inclined at ``beta`` (rad) to a
     remote tension of 1 Pa, in the square of half width ``width`` (m) meshed with
@@ -208,7 +211,15 @@ def griffith_case(
         degree=degree,
         tangent=lambda x: np.abs((x[0] - centre[0]) * d[0] + (x[1] - centre[1]) * d[1]) - a,
     )
-    problem = Problem(cut, degree, MATERIAL, "free", ghost_penalty=0.0, tip_radius=tip_radius)
+    problem = Problem(
+        cut,
+        degree,
+        MATERIAL,
+        "free",
+        ghost_penalty=0.0,
+        tip_radius=tip_radius,
+        tip_basis=tip_basis,
+    )
 
     def displacement(side: int) -> Callable:
         return lambda x: crack.displacement(x, MATERIAL.E, MATERIAL.nu, MATERIAL.plane)
@@ -233,6 +244,7 @@ def frictional_crack_case(
     cell: str = "triangle",
     along_row: float | None = None,
     multiplier_degree: int = 1,
+    tip_basis: str = "auto",
 ) -> CrackCase:
     """A closed crack of half length ``a = 1`` m inclined at ``beta`` to a remote
     compression of 1 Pa, Coulomb friction ``friction`` on its lips, in the square of half
@@ -245,7 +257,7 @@ def frictional_crack_case(
     ``cell``: ``"triangle"`` or ``"quadrilateral"``; ``along_row``: None, or the crack
     along a row of cells, this fraction of a cell above a mesh line (``angle`` and the
     second component of ``offset`` are then unused); ``multiplier_degree``: the lips'
-    multiplier's (1 or 2)."""
+    multiplier's (1 or 2); ``tip_basis``: see :class:`~xfem_contact.mechanics.problem.Problem`."""
     a, (d, normal) = 1.0, _frame(angle)
     centre = np.asarray(offset, dtype=float) * a
     if along_row is not None:
@@ -280,7 +292,15 @@ def frictional_crack_case(
         if friction > 0
         else crack_law("frictionless", **options)
     )
-    problem = Problem(cut, degree, MATERIAL, law, ghost_penalty=0.0, tip_radius=tip_radius)
+    problem = Problem(
+        cut,
+        degree,
+        MATERIAL,
+        law,
+        ghost_penalty=0.0,
+        tip_radius=tip_radius,
+        tip_basis=tip_basis,
+    )
     problem.loads.add_displacement(_on_boundary(width), _boundary_values(width, exact))
     K = (0.0, T * math.sqrt(math.pi * a))
     return CrackCase(problem, [K] * len(cut.crack.tips), lambda side: exact, a)

@@ -31,7 +31,15 @@ from xfem_contact.fem.aggregation import (
     check_threshold,
     side_areas,
 )
-from xfem_contact.fem.branch import UFL, branch_values, null_pins
+from xfem_contact.fem.branch import (
+    ROUND_OFF,
+    UFL,
+    branch_values,
+    checked_tip_basis,
+    null_pins,
+    side_values,
+    tied_values,
+)
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.subspaces import collapse
 from xfem_contact.fem.tip_scale import default_tip_radius
@@ -84,6 +92,11 @@ class EnrichedSpace:
             dofs of that side's displacement in badly cut cells alone are extended from a
             root cell's (:attr:`aggregation`); the multipliers likewise, by the interface's
             measure in a cell; None: off.
+        tip_basis: The functions of a crack's branch dofs: ``"plain"``, ``R F_k``;
+            ``"shifted"``, ``R F_k - I(R F_k)`` with ``I`` the interpolant on the
+            vertices (the same space for degree 2, where ``N_i I(R F_k)`` is a standard
+            function; degree 1 and cell aggregation take ``"plain"`` only); ``"auto"``
+            (default): ``"plain"``.
 
     A crack's multipliers live on the nodes of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillates, ``docs/crack_enrichment.md``). A crack
@@ -99,7 +112,13 @@ class EnrichedSpace:
     2008): the P1 function 1 on the vertices within the radius, 0 on the others; every
     node of the cells where ``R > 0`` has branch dofs, so ``R F_k`` is in the space and
     no cell blends. ``R = 1``
-    without a radius (topological).
+    without a radius (topological). With ``tip_basis="shifted"`` the branch dofs'
+    functions are ``R F_k - I(R F_k)`` (:attr:`interpolants`: per side, ``I`` on the
+    vertices; at a vertex whose two sides share one unknown, both sides take the
+    functions of the side the vertex lies on, so the tied sides stay continuous): they
+    vanish at the vertices and, far from a tip, are ``O(h^2)`` where ``R F_k`` is
+    ``O(1)``, so the stiffness is assembled without the cancellation of ``R F_k``
+    against the standard functions (the stable GFEM shift, Babuška and Banerjee 2012).
     """
 
     def __init__(
@@ -111,6 +130,7 @@ class EnrichedSpace:
         multipliers: Sequence[tuple[int, str | None]] | None = None,
         tip_radius: float | str | None = None,
         aggregation: float | None = None,
+        tip_basis: str = "auto",
     ):
         if degree not in (1, 2):
             raise ValueError(f"Displacement degree must be 1 or 2, got {degree}")
@@ -163,6 +183,18 @@ class EnrichedSpace:
         if self.branch_field is not None and tip_radius is not None:
             self.ramp = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 1)))
         self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
+        extent = mesh.comm.allreduce(float(np.abs(mesh.geometry.x).max()), op=MPI.MAX)
+        #: Level set values (m) taken for 0: a node on a crack's line
+        self.round_off = ROUND_OFF * extent
+        self.tip_basis = checked_tip_basis(tip_basis, degree, aggregation is not None)
+        #: Per side, ``I(R F_k)`` (four P1 functions, set with the active dofs) with
+        #: ``tip_basis="shifted"``, else None
+        self.interpolants: dict[int, tuple[dolfinx.fem.Function, ...]] | None = None
+        if self.branch_field is not None and self.tip_basis == "shifted":
+            P1 = dolfinx.fem.functionspace(mesh, ("Lagrange", 1))
+            self.interpolants = {
+                s: tuple(dolfinx.fem.Function(P1) for _ in range(4)) for s in (-1, 1)
+            }
         self.min_support_fraction = min_support_fraction
         check_threshold(aggregation)
         self.aggregation_threshold = aggregation
@@ -214,12 +246,17 @@ class EnrichedSpace:
         return tuple(out)
 
     def branch_functions(self, side: int) -> tuple:
-        """The four branch functions (m^1/2, UFL) on side ``side`` of the crack, times
-        the :attr:`ramp` with a tip radius."""
+        """The functions of the four branch dofs (m^1/2, UFL) on side ``side`` of the
+        crack: the branch functions, times the :attr:`ramp` with a tip radius, minus
+        their :attr:`interpolants` with ``tip_basis="shifted"``."""
         phi, psi = self.cut.levelset.function, self.cut.crack.tangent.function
         theta = side * abs(ufl.atan2(phi, psi))
         F = branch_values(ufl.sqrt(phi**2 + psi**2), theta, UFL)
-        return F if self.ramp is None else tuple(self.ramp * f for f in F)
+        if self.ramp is not None:
+            F = tuple(self.ramp * f for f in F)
+        if self.interpolants is not None:
+            F = tuple(f - g for f, g in zip(F, self.interpolants[side], strict=True))
+        return F
 
     def subspace(self, field: int) -> dolfinx.fem.FunctionSpace:
         """Sub-space of field 0 (side -1), 1 (side +1) or 2 (multiplier)."""
@@ -278,6 +315,8 @@ class EnrichedSpace:
         if self.branch_field is not None:
             active |= self._branch_support()
         self._ties = self._tied(active)
+        if self.interpolants is not None:
+            self._interpolate(active)
         if self.aggregation_threshold is not None:
             self._aggregation = aggregate(self, self.aggregation_threshold, active)
         return active
@@ -318,18 +357,52 @@ class EnrichedSpace:
         flags[parent[(np.flatnonzero(pins)[:, None] * bs + np.arange(2 * gdim)).ravel()]] = False
         return flags
 
-    def _tied(self, active: npt.NDArray[np.bool_]) -> npt.NDArray[np.int64]:
-        """``(kept, follower)`` owned dofs of fields 0 and 1 at the same node and
-        component, both active, whose support the crack does not cut completely."""
+    def _tied_nodes(self, active: npt.NDArray[np.bool_]) -> npt.NDArray[np.bool_]:
+        """Per local dof of field 0's own space (:meth:`field_space`): whether it and
+        field 1's at its node and component are both active and the crack does not cut
+        their support completely (a crack's)."""
         crack = self.cut.crack
-        if crack is None:
-            return np.zeros((0, 2), dtype=np.int64)
         cut_cells = self.cut.cut_cells
         crossed = cut_cells[crack.kind == CROSSED]
         ends = cut_cells[crack.kind != CROSSED]  # tip cells and the crack's extension
         heaviside = (self._mark(0, crossed) > 0) & ~(self._mark(0, ends) > 0)
         minus, plus = (self.field_space(i)[1] for i in (0, 1))
-        both = active[minus] & active[plus] & ~heaviside[minus]
+        return active[minus] & active[plus] & ~heaviside[minus]
+
+    def _interpolate(self, active: npt.NDArray[np.bool_]) -> None:
+        """Set :attr:`interpolants`: per side ``s``, ``R F_k`` of side ``s`` at each
+        vertex, of the side the vertex lies on where the two sides share one unknown
+        (:func:`~xfem_contact.fem.branch.tied_values`). Collective."""
+        P1 = self.interpolants[1][0].function_space
+        nodes = P1.dofmap.index_map.size_local + P1.dofmap.index_map.num_ghosts
+        values = []
+        for g in (self.cut.levelset.function, self.cut.crack.tangent.function, self.ramp):
+            f = dolfinx.fem.Function(P1)
+            if g is None:  # no ramp: R = 1
+                f.x.array[:] = 1.0
+            else:
+                f.interpolate(g)
+            values.append(f.x.array[:nodes])
+        phi, psi, ramp = values
+        V0 = self.field_space(0)[0]
+        gdim, vertices = V0.dofmap.index_map_bs, P1.dofmap.list.shape[1]
+        tied = np.zeros(nodes, dtype=bool)  # the vertex nodes come first in each cell
+        tied[P1.dofmap.list] = self._tied_nodes(active).reshape(-1, gdim)[
+            V0.dofmap.list[:, :vertices], 0
+        ]
+        at = tied_values(side_values(phi, psi, ramp), tied, phi, self.round_off)
+        for s, functions in self.interpolants.items():
+            for k, f in enumerate(functions):
+                f.x.array[:] = at[s][k]
+                f.x.scatter_forward()
+
+    def _tied(self, active: npt.NDArray[np.bool_]) -> npt.NDArray[np.int64]:
+        """``(kept, follower)`` owned dofs of fields 0 and 1 at the same node and
+        component, both active, whose support the crack does not cut completely."""
+        if self.cut.crack is None:
+            return np.zeros((0, 2), dtype=np.int64)
+        minus, plus = (self.field_space(i)[1] for i in (0, 1))
+        both = self._tied_nodes(active)
         n_owned = self.W.dofmap.index_map.size_local * self.W.dofmap.index_map_bs
         pairs = np.stack([minus[both], plus[both]], axis=1).astype(np.int64)
         owned = pairs[:, 0] < n_owned

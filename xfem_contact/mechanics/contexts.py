@@ -26,6 +26,7 @@ def interface_context(
     w_old: dolfinx.fem.Function,
     split: Callable = ufl.split,
     ramp: dolfinx.fem.Function | None = None,
+    interpolants: dict | None = None,
 ) -> InterfaceContext:
     """The context of interface ``name`` on the current cut of ``cut``.
 
@@ -39,6 +40,7 @@ def interface_context(
         w_old: The last accepted state.
         split: The fields of a Function on ``W`` (the space's ``split``).
         ramp: The ramp of a crack's branch functions (the space's), None without.
+        interpolants: The interpolants subtracted from them (the space's), None without.
 
     Collective.
     """
@@ -59,6 +61,7 @@ def interface_context(
         w_old=w_old,
         split=split,
         ramp=ramp,
+        interpolants=interpolants,
     )
 
 

@@ -68,6 +68,8 @@ class Problem:
         tip_radius: A crack's tip enrichment radius (m), ``"auto"`` (default: a fixed
             fraction of the tips' crack length, not of the mesh) or None (the tip cells'
             nodes), see :class:`EnrichedSpace`.
+        tip_basis: The functions of a crack's branch dofs, ``"auto"`` (default),
+            ``"plain"`` or ``"shifted"``, see :class:`EnrichedSpace`.
         petsc_options: PETSc options (names without prefix) of the solver, over the
             defaults and presets of :mod:`xfem_contact.solvers.options` (see
             :meth:`solver_options`); change them later with :attr:`petsc_options`.
@@ -92,6 +94,7 @@ class Problem:
         slave: int = DEFAULT.slave,
         pairing: str = DEFAULT.pairing,
         tip_radius: float | str | None = "auto",
+        tip_basis: str = "auto",
         petsc_options: dict | None = None,
         petsc_options_prefix: str | None = None,
     ):
@@ -124,6 +127,7 @@ class Problem:
             min_support_fraction=min_support_fraction,
             tip_radius=tip_radius,
             aggregation=aggregation,
+            tip_basis=tip_basis,
         )
         check_ghosts(self.mesh)
         #: Loads, supports and Dirichlet data (``loads.bcs``), and the pseudo-time
@@ -168,6 +172,7 @@ class Problem:
                 self.w_old,
                 self.space.split,
                 self.space.ramp,
+                self.space.interpolants,
             )
             for name in self.laws
         }

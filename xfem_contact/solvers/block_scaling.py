@@ -37,7 +37,7 @@ import dolfinx.fem
 import numpy as np
 from petsc4py import PETSc
 
-from xfem_contact.fem.branch import branch_values
+from xfem_contact.fem.branch import side_of, side_values
 from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.solvers.scaling import saddle_point_scaling
 from xfem_contact.solvers.symmetry import TOLERANCE, mark_symmetric, symmetry_gap
@@ -173,15 +173,16 @@ def _hats_at_nodes(space: EnrichedSpace) -> np.ndarray:
 
 
 def _branch_at_nodes(space: EnrichedSpace) -> tuple[dict[int, np.ndarray], np.ndarray]:
-    """Per side, the branch functions at the nodes of field 0's own space, shape
-    ``(4, nodes)`` (times the space's ramp where it has one), and the side each node
-    lies on (by the sign of ``phi``)."""
+    """Per side, the functions of the branch dofs at the nodes of field 0's own space,
+    shape ``(4, nodes)`` (the branch functions times the space's ramp where it has one,
+    minus its interpolants where it has them), and the side each node lies on (by the
+    sign of ``phi``, :func:`~xfem_contact.fem.branch.side_of`)."""
     V = space.field_space(0)[0]
     bs = V.dofmap.index_map_bs
     S, dofs = V.sub(0).collapse()
     nodes = np.asarray(dofs).ravel() // bs
     values = []
-    ramp = getattr(space, "ramp", None)
+    ramp = space.ramp
     functions = [space.cut.levelset.function, space.cut.crack.tangent.function]
     for g in functions + ([] if ramp is None else [ramp]):
         f = dolfinx.fem.Function(S)
@@ -190,10 +191,14 @@ def _branch_at_nodes(space: EnrichedSpace) -> tuple[dict[int, np.ndarray], np.nd
         at[nodes] = f.x.array[: nodes.size]
         values.append(at)
     phi, psi = values[:2]
-    r, angle = np.sqrt(phi**2 + psi**2), np.abs(np.arctan2(phi, psi))
-    ramp = values[2] if len(values) > 2 else 1.0
-    F = {s: ramp * np.array(branch_values(r, s * angle)) for s in (-1, 1)}
-    return F, np.where(phi > 0, 1, -1)
+    F = side_values(phi, psi, values[2] if len(values) > 2 else 1.0)
+    if space.interpolants is not None:
+        for s, functions in space.interpolants.items():
+            for k, g in enumerate(functions):
+                f = dolfinx.fem.Function(S)
+                f.interpolate(g)
+                F[s][k, nodes] -= f.x.array[: nodes.size]
+    return F, side_of(phi, space.round_off)
 
 
 def shift_matrix(space: EnrichedSpace, R: PETSc.Mat, columns: np.ndarray) -> PETSc.Mat:

@@ -79,6 +79,8 @@ class InterfaceContext:
             space's ``split``: the displacements with a crack's branch functions).
         ramp: The ramp ``R`` of a crack's branch functions (P1; see
             :class:`~xfem_contact.fem.enrichment.EnrichedSpace`), None without.
+        interpolants: Per side, the interpolants subtracted from ``R F_k`` (the space's
+            :attr:`~xfem_contact.fem.enrichment.EnrichedSpace.interpolants`), None without.
     """
 
     cut: CutMesh
@@ -93,6 +95,7 @@ class InterfaceContext:
     aligned_cells: dolfinx.fem.Function | None = None
     split: typing.Callable = ufl.split
     ramp: dolfinx.fem.Function | None = None
+    interpolants: dict[int, tuple[dolfinx.fem.Function, ...]] | None = None
     #: Point values cached for the fixed rules (basis tables, dofs, the normal) and the
     #: objects made :meth:`once`
     _cache: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
@@ -196,7 +199,8 @@ class InterfaceContext:
     def jump_at(self, w: dolfinx.fem.Function) -> npt.NDArray[np.float64]:
         """``[u]`` of ``w`` at the rule points, ``(npoints, gdim)`` (m); on a crack's
         lips with the branch functions' jump: ``[F_1] = 2 sqrt(r)`` (``r = |psi|``
-        there), the others vanish at ``theta = +-pi``."""
+        there), the others vanish at ``theta = +-pi``; minus the jump of the
+        :attr:`interpolants` where the space has them."""
         jump = self.values_at(w, 1) - self.values_at(w, 0)
         crack = self.cut.crack
         if crack is not None:
@@ -207,6 +211,16 @@ class InterfaceContext:
             b = self.values_at(w, w.function_space.num_sub_spaces - 1)  # the branch field
             ramp = self._ramp_at()[:, None]  # the space's R of R F_k
             jump += 2 * self._cache["sqrt_r"] * ramp * b[:, : jump.shape[1]]
+            if self.interpolants is not None:
+                cells = self.cut.cut_cells[self.rules.point_rows]
+                gdim = jump.shape[1]
+                pairs = zip(self.interpolants[-1], self.interpolants[1], strict=True)
+                for k, pair in enumerate(pairs):
+                    minus, plus = (
+                        CellMaps(self.cut.mesh, LevelSet(f, None)).values(cells, self.rules.points)
+                        for f in pair
+                    )
+                    jump -= (plus - minus)[:, None] * b[:, gdim * k : gdim * (k + 1)]
         return jump
 
     def _ramp_at(self) -> npt.NDArray[np.float64]:
