@@ -22,7 +22,8 @@ tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--write] [--name NAME]
 prints one row per run, the iteration histogram and the failures per law; ``--write``
 writes ``bench/results/robustness3d.{json,md}`` (``robustness3d_hexahedron.*`` on
 hexahedra, ``NAME.*`` with ``--name``),
-``--render`` rewrites the ``.md`` from the ``.json``, ``--resume`` goes on from it.
+``--render`` rewrites the ``.md`` from the ``.json``, ``--resume`` goes on from it;
+``--placements I J ...`` runs only those (the medians are then theirs).
 """
 
 import argparse
@@ -173,7 +174,7 @@ def summary(rows: list[dict]) -> dict:
 def markdown(table: dict, rows: list[dict], args, done: int) -> str:
     lines = [
         f"# Random inclusions, degree {args.degree} on {args.cell} cells, n = {args.n} "
-        f"({done} placements, seed {args.seed})",
+        f"({placed(args, done)}, seed {args.seed})",
         "",
         f"Command: `{getattr(args, 'command', 'python bench/robustness3d.py')}`. A run fails "
         f"when it raises, does not converge, takes more than {MAX_ITERATIONS} Newton "
@@ -220,6 +221,14 @@ def markdown(table: dict, rows: list[dict], args, done: int) -> str:
     return "\n".join(lines) + "\n"
 
 
+def placed(args, done: int) -> str:
+    """The placements run, in words: ``100 placements`` or ``placements 3, 7 of 100``."""
+    chosen = getattr(args, "placements", None)
+    if not chosen:
+        return f"{done} placements"
+    return f"placements {', '.join(map(str, sorted(chosen)))} of {args.count}"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--count", type=int, default=100, help="placements")
@@ -229,6 +238,9 @@ def main() -> None:
     parser.add_argument("--laws", nargs="+", default=list(EXACT), choices=list(LAWS))
     parser.add_argument("--name", default=None, help="of the results (default from --cell)")
     parser.add_argument("--seed", type=int, default=0, help="of the random placements")
+    parser.add_argument(
+        "--placements", type=int, nargs="+", default=None, help="run only these (indices)"
+    )
     parser.add_argument("--write", action="store_true", help="write bench/results/")
     parser.add_argument(
         "--render", action="store_true", help="rewrite the .md from the .json run before"
@@ -240,7 +252,7 @@ def main() -> None:
     args.command = "python bench/robustness3d.py " + " ".join(sys.argv[1:])
     if args.render:
         record = json.loads((RESULTS / f"{results_name(args)}.json").read_text())
-        for key in ("n", "degree", "seed", "command"):
+        for key in ("n", "degree", "seed", "command", "placements"):
             setattr(args, key, record.get(key, getattr(args, key)))
         write(record["runs"], args, record["count"])
         return
@@ -251,7 +263,7 @@ def main() -> None:
         record = json.loads((RESULTS / f"{results_name(args)}.json").read_text())
         rows, done = record["runs"], record["count"]
     for index, placement in enumerate(placements(args.count, args.seed)):
-        if index < done:
+        if index < done or (args.placements and index not in args.placements):
             continue
         for law in args.laws:
             row = run(placement, law, args.n, args.degree, args.cell) | {"index": index}
@@ -296,6 +308,7 @@ def write(rows: list[dict], args, done: int) -> dict:
     name = results_name(args)
     record = {"n": args.n, "degree": args.degree, "cell": args.cell, "count": done}
     record["seed"], record["command"] = args.seed, args.command
+    record["placements"] = args.placements
     record |= {"summary": table, "runs": rows}
     (RESULTS / f"{name}.json").write_text(json.dumps(record, indent=1, default=str))
     (RESULTS / f"{name}.md").write_text(markdown(table, rows, args, done))

@@ -29,8 +29,9 @@ __all__ = ["plot_cut_3d"]
 
 POINT_COLOUR = "#202020"
 EDGE_COLOUR = "#404040"
-#: At most this many interface rule points are drawn (a random choice, seeded)
-MAX_POINTS = 1500
+#: At most this many interface rule points are drawn (a random choice, seeded; more hide
+#: the interface in a small picture)
+MAX_POINTS = 500
 
 
 def _cut_cell_grid(cut: CutMesh, levels: int) -> pyvista.UnstructuredGrid:

@@ -96,11 +96,12 @@ BREAK_TOLERANCE = 1e-12
 length, are one: the same crossing found on two edges of a symmetric box gives one
 breakpoint, not an interval of a few ulps whose presence round-off decides."""
 
-MIN_SLOPE = 0.2
+MIN_SLOPE = 0.4
 """Boxes whose best pair of axes has certified slopes below this score (the lower bound of a
 slope relative to the gradient's bound, step 2 of the module) are subdivided, down to
 ``max_depth``: on such boxes the roots are steep functions of the outer coordinates and
-the Gauss rules converge slowly (the docs' 3D cut page gives the errors measured)."""
+the Gauss rules converge slowly (the docs' 3D cut page gives the errors measured). The
+tetrahedron frame has its own (:data:`xfem_contact.quadrature.tet_saye.MIN_SLOPE`)."""
 
 
 @dataclass(frozen=True)

@@ -58,7 +58,6 @@ from xfem_contact.geometry.tensor_levelset import (
     line_roots,
 )
 from xfem_contact.quadrature.saye import (
-    MIN_SLOPE,
     SayePoints,
     _gather,
     _pieces,
@@ -74,7 +73,13 @@ from xfem_contact.quadrature.saye_axes import (
     mean_slopes,
 )
 
-__all__ = ["truncated_saye_points"]
+__all__ = ["MIN_SLOPE", "truncated_saye_points"]
+
+MIN_SLOPE = 0.2
+"""Boxes inside the tetrahedron whose best pair of axes scores below this are subdivided,
+as Saye's boxes of the unit cube by :data:`xfem_contact.quadrature.saye.MIN_SLOPE`; lower
+here, where the boxes are those of a sixth of a cube and :data:`CURVED` subdivides the
+curved ones too."""
 
 
 def truncated_saye_points(
