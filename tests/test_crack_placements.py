@@ -291,13 +291,10 @@ def test_tip_radius_below_the_tip_cells(caplog):
     assert np.abs(K - np.array(case.K)).max() < 2e-3 * case.K[0][0]
 
 
-@pytest.mark.mpi
-@pytest.mark.parallel
-@pytest.mark.parametrize("placement", ["along edges, tips mid-edge", "along edges, tips on nodes"])
-def test_closed_crack_on_mesh_lines_equal_serial(placement):
-    """K and the lips' fields of the closed crack along a row of cell edges are the same
-    on all ranks as on one (the tip cell and the cut cell of an edge chosen per cell)."""
-    from parallel import gathered_fields, max_relative_difference
+def _closed_crack_on_all_ranks_and_one(placement: str, **options) -> list[tuple]:
+    """``(K, gathered fields)`` of the closed P2 crack with friction at ``placement`` (the
+    restriction, ``options`` to the case) solved on all ranks, then on this one."""
+    from parallel import gathered_fields
 
     angle, offset = PLACEMENTS[placement]
     runs = []
@@ -311,12 +308,24 @@ def test_closed_crack_on_mesh_lines_equal_serial(placement):
             angle=angle,
             offset=offset,
             comm=comm,
+            **options,
         )
         case.problem.solve()
         runs.append(
             (_griffith_K(case, np.array([1.0, 0.0]), solve=False), gathered_fields(case.problem))
         )
-    (K_all, fields_all), (K_one, fields_one) = runs
+    return runs
+
+
+@pytest.mark.mpi
+@pytest.mark.parallel
+@pytest.mark.parametrize("placement", ["along edges, tips mid-edge", "along edges, tips on nodes"])
+def test_closed_crack_on_mesh_lines_equal_serial(placement):
+    """K and the lips' fields of the closed crack along a row of cell edges are the same
+    on all ranks as on one (the tip cell and the cut cell of an edge chosen per cell)."""
+    from parallel import max_relative_difference
+
+    (K_all, fields_all), (K_one, fields_one) = _closed_crack_on_all_ranks_and_one(placement)
     assert np.abs(K_all - K_one).max() <= 1e-10 * np.abs(K_one).max()
     differences = max_relative_difference(fields_all, fields_one)
     assert all(v <= 1e-10 for v in differences.values()), differences
@@ -369,23 +378,8 @@ def test_shifted_tip_basis_equal_serial():
     standard dofs the same on all ranks as on one. Its null vectors of the ramp carry
     standard dofs, so the pinned node must be the same: of the nodes equally near the
     pin's point, the first by position (the nearest by round-off differed: 1.4e-2)."""
-    from parallel import gathered_fields, max_relative_difference
+    from parallel import max_relative_difference
 
-    angle, offset = PLACEMENTS["along edges, tips mid-edge"]
-    runs = []
-    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
-        case = frictional_crack_case(
-            4,
-            2,
-            friction=0.3,
-            tip_radius=0.5,
-            lbb="restriction",
-            angle=angle,
-            offset=offset,
-            comm=comm,
-            tip_basis="shifted",
-        )
-        case.problem.solve()
-        runs.append(gathered_fields(case.problem))
-    differences = max_relative_difference(*runs)
+    runs = _closed_crack_on_all_ranks_and_one("along edges, tips mid-edge", tip_basis="shifted")
+    differences = max_relative_difference(*(fields for _, fields in runs))
     assert all(v <= 1e-10 for v in differences.values()), differences
