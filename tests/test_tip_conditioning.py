@@ -164,5 +164,26 @@ def test_tip_basis_is_checked():
         williams_case(4, 1, tip_basis="shifted")
     with pytest.raises(ValueError, match="got degree 2, aggregation on: use 'plain'"):
         williams_case(4, 2, tip_basis="shifted", aggregation=0.25)
+    # the default: shifted where it applies (P2 without aggregation), else plain
     assert williams_case(4, 1).problem.space.tip_basis == "plain"
-    assert williams_case(4, 2).problem.space.tip_basis == "plain"
+    assert williams_case(4, 2).problem.space.tip_basis == "shifted"
+    assert williams_case(4, 2, aggregation=0.25).problem.space.tip_basis == "plain"
+
+
+def test_shifted_functions_vanish_at_a_vertex_on_a_tip():
+    """Tips on vertices whose coordinates carry round-off (x = -1 - 2e-16, y = -5e-18 on
+    one process): the shifted basis' interpolants are 0 there, as ``F_k(0)``. The square
+    root made them 1e-9 .. 5e-9 at an angle set by the round-off, which differs between
+    1 and 2 processes: the standard dofs then differed by 5.6e-10 (relative) between them,
+    the field by 1e-14 (the same span)."""
+    from xfem_contact.cases.cracks import griffith_case
+
+    space = griffith_case(4, 2, tip_radius=0.5, angle=0.0, offset=(0.0, 0.0)).problem.space
+    P1 = space.interpolants[1][0].function_space
+    x = P1.tabulate_dof_coordinates()[:, :2]
+    distance = np.linalg.norm(x[:, None, :] - space.cut.crack.tips[None], axis=2).min(axis=1)
+    on_tip = distance < 1e-9
+    assert MPI.COMM_WORLD.allreduce(int(on_tip.sum()), op=MPI.SUM) >= 2  # the case is present
+    for functions in space.interpolants.values():
+        for f in functions:
+            assert np.all(f.x.array[on_tip] == 0.0)

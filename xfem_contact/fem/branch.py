@@ -73,11 +73,15 @@ def branch_values(r, theta, ops: Ops = NUMPY) -> tuple:
     return tuple(sr * a for a in angular(theta, ops)[0])
 
 
-def side_values(phi, psi, ramp) -> dict[int, np.ndarray]:
+def side_values(phi, psi, ramp, tolerance: float) -> dict[int, np.ndarray]:
     """Per side ``s``, ``R F_k`` of that side (m^1/2, shape ``(4, n)``) at ``n`` points
     with the crack's level sets ``phi``, ``psi`` (m) and the ramp ``R`` (a number or
-    ``(n,)``): ``r = sqrt(phi^2 + psi^2)``, ``theta = s |atan2(phi, psi)|``."""
+    ``(n,)``): ``r = sqrt(phi^2 + psi^2)``, ``theta = s |atan2(phi, psi)|``. A point with
+    ``r <= tolerance`` (m) lies on a tip: its values are 0 (``F_k(0) = 0``; the square
+    root would turn the level sets' round-off there, which differs between meshes of the
+    same nodes, into values of order ``sqrt(tolerance)`` at a meaningless angle)."""
     r, angle = np.sqrt(phi**2 + psi**2), np.abs(np.arctan2(phi, psi))
+    r = np.where(r <= tolerance, 0.0, r)
     return {s: ramp * np.array(branch_values(r, s * angle)) for s in (-1, 1)}
 
 
@@ -99,19 +103,20 @@ def tied_values(
 
 
 def checked_tip_basis(tip_basis: str, degree: int, aggregated: bool = False) -> str:
-    """``tip_basis`` (one of :data:`TIP_BASES`) for displacement ``degree``, resolved
-    (``"auto"`` is ``"plain"``). ``"shifted"`` needs degree 2 and no cell aggregation
-    (``aggregated``): its vertex interpolant times a hat must be a function of the
-    standard space (no dof extended from another cell)."""
+    """``tip_basis`` (one of :data:`TIP_BASES`) for displacement ``degree``, resolved:
+    ``"auto"`` is ``"shifted"`` for degree 2 without cell aggregation (``aggregated``),
+    else ``"plain"``. ``"shifted"`` asked for needs degree 2 and no cell aggregation: its
+    vertex interpolant times a hat must be a function of the standard space (no dof
+    extended from another cell)."""
     if tip_basis not in TIP_BASES:
         raise ValueError(f"tip_basis must be one of {TIP_BASES}, got {tip_basis!r}")
     if tip_basis == "auto":
-        return "plain"
+        return "shifted" if degree == 2 and not aggregated else "plain"
     if tip_basis == "shifted" and (degree != 2 or aggregated):
         raise ValueError(
             f"tip_basis='shifted' needs displacement degree 2 and no cell aggregation (its "
             f"vertex interpolant times a hat is then a standard function), got degree "
-            f"{degree}, aggregation {'on' if aggregated else 'off'}: use 'plain'"
+            f"{degree}, aggregation {'on' if aggregated else 'off'}: use 'plain' or 'auto'"
         )
     return tip_basis
 

@@ -96,7 +96,7 @@ class EnrichedSpace:
             ``"shifted"``, ``R F_k - I(R F_k)`` with ``I`` the interpolant on the
             vertices (the same space for degree 2, where ``N_i I(R F_k)`` is a standard
             function; degree 1 and cell aggregation take ``"plain"`` only); ``"auto"``
-            (default): ``"plain"``.
+            (default): ``"shifted"`` for degree 2 without aggregation, else ``"plain"``.
 
     A crack's multipliers live on the nodes of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillates, ``docs/crack_enrichment.md``). A crack
@@ -390,7 +390,7 @@ class EnrichedSpace:
         tied[P1.dofmap.list] = self._tied_nodes(active).reshape(-1, gdim)[
             V0.dofmap.list[:, :vertices], 0
         ]
-        at = tied_values(side_values(phi, psi, ramp), tied, phi, self.round_off)
+        at = tied_values(side_values(phi, psi, ramp, self.round_off), tied, phi, self.round_off)
         for s, functions in self.interpolants.items():
             for k, f in enumerate(functions):
                 f.x.array[:] = at[s][k]

@@ -68,7 +68,8 @@ class Problem:
         tip_radius: A crack's tip enrichment radius (m), ``"auto"`` (default: a fixed
             fraction of the tips' crack length, not of the mesh) or None (the tip cells'
             nodes), see :class:`EnrichedSpace`.
-        tip_basis: The functions of a crack's branch dofs, ``"auto"`` (default),
+        tip_basis: The functions of a crack's branch dofs, ``"auto"`` (default:
+            ``"shifted"`` for degree 2 without ``aggregation``, else ``"plain"``),
             ``"plain"`` or ``"shifted"``, see :class:`EnrichedSpace`.
         petsc_options: PETSc options (names without prefix) of the solver, over the
             defaults and presets of :mod:`xfem_contact.solvers.options` (see

@@ -191,7 +191,8 @@ def _branch_at_nodes(space: EnrichedSpace) -> tuple[dict[int, np.ndarray], np.nd
         at[nodes] = f.x.array[: nodes.size]
         values.append(at)
     phi, psi = values[:2]
-    F = side_values(phi, psi, values[2] if len(values) > 2 else 1.0)
+    ramp = values[2] if len(values) > 2 else 1.0
+    F = side_values(phi, psi, ramp, space.round_off)
     if space.interpolants is not None:
         for s, functions in space.interpolants.items():
             for k, g in enumerate(functions):
