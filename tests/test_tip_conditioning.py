@@ -109,13 +109,13 @@ def test_no_extra_workspace_with_the_change_of_unknowns():
 @pytest.mark.serial
 def test_shifted_tip_basis_keeps_the_rate_on_a_large_zone():
     """Williams field on Q2 quadrilaterals, tip zone r_e = 0.9 (most of the square): with
-    the shifted basis the energy error falls at about Q2's rate 2 from n = 22 to 44
-    (2.42e-4, 6.63e-5: 1.87); with ``"plain"`` (the same space) it does not (rounding in
-    the stiffness' cancellation of ``R F_k`` against the standard functions: 1.4e-3 at
-    n = 44, 0.20 at n = 64)."""
+    the default basis (``"shifted"`` for P2) the energy error falls at about Q2's rate 2
+    from n = 22 to 44 (2.42e-4, 6.63e-5: 1.87); with ``"plain"`` (the same space) it does
+    not (rounding in the stiffness' cancellation of ``R F_k`` against the standard
+    functions: 1.4e-3 at n = 44, 0.20 at n = 64)."""
     errors = []
     for n in (22, 44):
-        case = williams_case(n, 2, tip_radius=0.9, cell="quadrilateral", tip_basis="shifted")
+        case = williams_case(n, 2, tip_radius=0.9, cell="quadrilateral")
         case.problem.solve()
         errors.append(williams_energy_error(case))
     rate = math.log2(errors[0] / errors[1])
