@@ -200,6 +200,8 @@ class EnrichedSpace:
         self.aggregation_threshold = aggregation
         self._aggregation: Aggregation | None = None
         self._collapsed: dict[int, tuple[dolfinx.fem.FunctionSpace, npt.NDArray]] = {}
+        #: Measure of each owned cell (m^2 in 2D, m^3 in 3D), shape ``(num_owned,)``
+        self.cell_areas = cell_areas(cut)
         self._active = self._active_dofs()
         self._scalar: tuple | None = None  # one displacement component, its nodes
 
@@ -425,7 +427,7 @@ class EnrichedSpace:
 
     def _side_fraction(self, field: int, side: int) -> np.ndarray:
         """Per dof: (area of its support on ``side``) / (area of its support)."""
-        areas = cell_areas(self.cut)
+        areas = self.cell_areas
         side_area = side_areas(self.cut, side, areas)
         on_side = self._mark(field, np.arange(areas.size, dtype=np.int32), side_area)
         total = self._mark(field, np.arange(areas.size, dtype=np.int32), areas)
