@@ -1,11 +1,9 @@
 """Each stability test fails with the guard it checks switched off.
 
-Guards: cell aggregation, the default treatment of small cuts (cut fractions with
-neither it nor the ghost penalty; cut fractions without the ghost penalty; the stabilised
-pair's inf-sup constant, and its sign with the defaults in 2D and 3D), the harmonic-mean
-augmentation (stiffness contrast), the Coulomb clamp (friction cone), the objective bulk
-(a large rotation in one step or ten). The LBB check carries its own counter-test
-(``lbb="none"``).
+Guards: the ghost penalty (cut fractions), cell aggregation (cut fractions without the
+ghost penalty; the stabilised pair's inf-sup constant), the harmonic-mean augmentation
+(stiffness contrast), the Coulomb clamp (friction cone), the objective bulk (a large
+rotation in one step or ten). The LBB check carries its own counter-test (``lbb="none"``).
 Marked ``guards``: ``pytest -m guards`` runs these alone.
 """
 
@@ -23,12 +21,10 @@ from xfem_contact.mechanics.laws import contact
 from xfem_contact.solvers.newton import NewtonFailure
 
 
-def without_small_cut_treatment(monkeypatch):
+def without_ghost_penalty(monkeypatch):
     solve_at = test_cuts.solve_at
     monkeypatch.setattr(
-        test_cuts,
-        "solve_at",
-        lambda f, d, comm=None, **o: solve_at(f, d, ghost_penalty=0.0, aggregation=None),
+        test_cuts, "solve_at", lambda f, d, comm=None, **o: solve_at(f, d, ghost_penalty=0.0)
     )
     return lambda: test_cuts.test_condition_and_error_stay_bounded_as_the_cut_vanishes(2)
 
@@ -47,24 +43,6 @@ def without_aggregation_in_the_inf_sup_test(monkeypatch):
         lambda *args, **options: betas(*args, **options | {"aggregation": None}),
     )
     return test_inf_sup.test_aggregation_keeps_the_stabilised_constant_bounded
-
-
-def without_aggregation_in_the_default_stabilised_pair(monkeypatch):
-    least = test_inf_sup.least_eigenvalue
-    monkeypatch.setattr(
-        test_inf_sup, "least_eigenvalue", lambda **options: least(**options | {"aggregation": None})
-    )
-    return test_inf_sup.test_the_stabilisation_is_positive_with_the_defaults
-
-
-def without_aggregation_in_the_default_3d_stabilised_pair(monkeypatch):
-    least = test_inf_sup.sphere_least_eigenvalue
-    monkeypatch.setattr(
-        test_inf_sup,
-        "sphere_least_eigenvalue",
-        lambda **options: least(**options | {"aggregation": None}),
-    )
-    return test_inf_sup.test_the_3d_stabilisation_is_positive_with_the_defaults
 
 
 def with_arithmetic_mean_augmentation(monkeypatch):
@@ -89,11 +67,9 @@ def with_small_strain_bulk(monkeypatch):
 
 
 GUARDS = {
-    "cell aggregation (cut fractions)": without_small_cut_treatment,
+    "ghost penalty": without_ghost_penalty,
     "cell aggregation": without_aggregation,
     "cell aggregation (inf-sup)": without_aggregation_in_the_inf_sup_test,
-    "cell aggregation (stabilised pair, 2D)": without_aggregation_in_the_default_stabilised_pair,
-    "cell aggregation (stabilised pair, 3D)": without_aggregation_in_the_default_3d_stabilised_pair,
     "harmonic-mean augmentation": with_arithmetic_mean_augmentation,
     "Coulomb clamp": without_coulomb_clamp,
     "objective bulk": with_small_strain_bulk,

@@ -46,7 +46,7 @@ def betas(
     circle=(0.51, 0.47, 0.23),
     multiplier_degree: int = 1,
     sizes=SIZES,
-    aggregation: float | str | None = "auto",
+    aggregation: float | None = None,
 ) -> list[float]:
     cx, cy, r = circle
     out = []
@@ -186,40 +186,39 @@ def test_without_lbb_treatment_the_3d_constant_falls():
 
 
 #: A sphere (centre, radius) through a node to 1e-6 h on which the stabilised pair of
-#: P1-P1 tetrahedra (n = 4) without cell aggregation (ghost penalty 0.01) is indefinite:
-#: beta^2 = -0.613
+#: P1-P1 tetrahedra (n = 4, default ghost penalty) is indefinite: beta^2 = -0.613
 INDEFINITE_SPHERE = (0.5322067495985089, 0.46294597531318177, 0.5905703620957422, 0.2387676915746)
 
 
-def sphere_least_eigenvalue(ghost_penalty=None, aggregation="auto") -> float:
+def sphere_least_eigenvalue(ghost_penalty=None) -> float:
     *c, r = INDEFINITE_SPHERE
     mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, 4, 4, 4)
     cut = CutMesh(mesh, lambda x: np.sqrt(((x.T - c) ** 2).sum(axis=1)) - r, degree=2)
     law = Bonded(lbb="stabilized")
-    problem = Problem(
-        cut, 1, Material(100e6, 0.3), law, ghost_penalty=ghost_penalty, aggregation=aggregation
-    )
+    problem = Problem(cut, 1, Material(100e6, 0.3), law, ghost_penalty=ghost_penalty)
     return inf_sup_constant(problem).beta_squared
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason="the stabilisation with the default ghost penalty is indefinite on some 3D cuts",
+)
 def test_the_3d_stabilisation_is_positive_with_the_defaults():
-    """beta^2 = 0.110 with the defaults (cell aggregation, no ghost penalty); -0.613
-    without aggregation (ghost penalty 0.01: the guard's failure, ``test_guards.py``)."""
-    assert sphere_least_eigenvalue() > 0.05
+    assert sphere_least_eigenvalue() > 0.0
 
 
 def test_the_3d_stabilisation_is_positive_with_a_ghost_penalty_as_large_as_its_weight():
-    """Without aggregation: beta^2 = 0.130 with ``ghost_penalty=0.1`` (-0.613 with 0.01)."""
-    assert sphere_least_eigenvalue(ghost_penalty=0.1, aggregation=None) > 0.1
+    """beta^2 = 0.130 with ``ghost_penalty=0.1`` (-0.613 with the default 0.01: the
+    expected failure above)."""
+    assert sphere_least_eigenvalue(ghost_penalty=0.1) > 0.1
 
 
-#: A circle on which the Barbosa-Hughes stabilisation (weight 0.1) without cell
-#: aggregation (ghost penalty 0.01) gives an indefinite pair: P2 triangles, n = 16,
-#: beta^2 = -16.8
+#: A circle on which the Barbosa-Hughes stabilisation (weight 0.1) with the default ghost
+#: penalty (0.01) gives an indefinite pair: P2 triangles, n = 16, beta^2 = -16.8
 INDEFINITE = (0.5897298894274488, 0.4623662904020971, 0.21349896734588636)
 
 
-def indefinite_inf_sup(ghost_penalty=None, aggregation="auto") -> InfSup:
+def indefinite_inf_sup(ghost_penalty=None, aggregation=None) -> InfSup:
     cx, cy, r = INDEFINITE
     mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 16, 16, dolfinx.mesh.CellType.triangle)
     cut = CutMesh(mesh, lambda x: np.hypot(x[0] - cx, x[1] - cy) - r, degree=2)
@@ -230,47 +229,47 @@ def indefinite_inf_sup(ghost_penalty=None, aggregation="auto") -> InfSup:
     return inf_sup_constant(problem)
 
 
-def least_eigenvalue(ghost_penalty=None, aggregation="auto") -> float:
+def least_eigenvalue(ghost_penalty=None, aggregation=None) -> float:
     return indefinite_inf_sup(ghost_penalty, aggregation).beta_squared
 
 
 def test_an_indefinite_stabilised_pair_has_an_indefinite_displacement_block():
     """beta^2 < 0 is no artefact of the measure: the displacement block (bulk energy
     and ghost penalty minus the Barbosa-Hughes term's ``s |t(u)|^2``) has 2 negative
-    eigenvalues on this cut (the inertia of its LDL^T) without cell aggregation (ghost
-    penalty 0.01), none with the ghost penalty at the stabilisation's weight."""
-    weak = indefinite_inf_sup(aggregation=None)
-    ghost = indefinite_inf_sup(ghost_penalty=0.1, aggregation=None)
-    assert weak.beta_squared < 0.0 and weak.negative_displacement_modes > 0, weak
+    eigenvalues on this cut (the inertia of its LDL^T), none with the ghost penalty at
+    the stabilisation's weight."""
+    default, ghost = indefinite_inf_sup(), indefinite_inf_sup(ghost_penalty=0.1)
+    assert default.beta_squared < 0.0 and default.negative_displacement_modes > 0, default
     assert ghost.beta_squared > 0.1 and ghost.negative_displacement_modes == 0, ghost
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason="the stabilisation with the default ghost penalty is indefinite on some cuts",
+)
 def test_the_stabilisation_is_positive_with_the_defaults():
-    """beta^2 = 0.130 with the defaults (cell aggregation, no ghost penalty); -16.8
-    without aggregation (the test above; the guard's failure, ``test_guards.py``)."""
-    assert least_eigenvalue() > 0.1
+    assert least_eigenvalue() > 0.0
 
 
 def test_the_stabilisation_is_positive_with_a_ghost_penalty_as_large_as_its_weight():
-    """Without aggregation: beta^2 = 0.13 (beta 0.36) with the ghost penalty at the
-    Barbosa-Hughes weight 0.1."""
-    assert least_eigenvalue(ghost_penalty=0.1, aggregation=None) > 0.1
+    """beta^2 = 0.13 (beta 0.36) with the ghost penalty at the Barbosa-Hughes weight 0.1."""
+    assert least_eigenvalue(ghost_penalty=0.1) > 0.1
 
 
 def test_aggregation_keeps_the_stabilised_constant_bounded():
     """On the circle where the default stabilised pair is indefinite at n = 16, cell
     aggregation keeps beta bounded: 0.366, 0.361, 0.361 on n = 8, 16, 32 (without it
     0.267, 0 (indefinite), 0.361: the guard's failure)."""
-    values = betas("triangle", 2, "stabilized", circle=INDEFINITE)
+    values = betas("triangle", 2, "stabilized", circle=INDEFINITE, aggregation=0.25)
     assert min(values) > FLOOR, values
     assert slope(values) >= SLOPE, values
 
 
-def test_the_stabilisation_is_positive_with_cell_aggregation_and_a_ghost_penalty():
-    """beta^2 = 0.137 with ``aggregation=0.25`` and the ghost penalty 0.01 as well: the
-    badly cut cells' dofs extend a well cut neighbour's polynomial, so the stress trace
-    on a small cut is that of a whole cell, which the bulk energy controls."""
-    assert least_eigenvalue(ghost_penalty=0.01, aggregation=0.25) > 0.1
+def test_the_stabilisation_is_positive_with_cell_aggregation():
+    """beta^2 = 0.13 with the default weights once the badly cut cells' dofs extend a
+    well cut neighbour's polynomial (``aggregation=0.25``): the stress trace on a small
+    cut is then that of a whole cell, which the bulk energy controls (-16.8 without)."""
+    assert least_eigenvalue(aggregation=0.25) > 0.1
 
 
 def test_only_linear_laws_with_a_multiplier():

@@ -143,8 +143,7 @@ def rotating_annulus_problem(
             points then integrate across those kinks (see the docs' large-sliding
             page).
         options: Passed to :class:`~xfem_contact.mechanics.problem.Problem` (e.g.
-            ``pairing``, ``slave``, ``ghost_penalty``, ``aggregation``) or to the law
-            (``lbb``, ...).
+            ``pairing``, ``slave``, ``ghost_penalty``) or to the law (``lbb``, ...).
     """
     from xfem_contact.io.meshes import annulus
 
@@ -158,7 +157,7 @@ def rotating_annulus_problem(
         outer = "tangential_spring"
     if outer not in OUTER_SUPPORTS:
         raise ValueError(f"Unknown outer support {outer!r}; valid: {OUTER_SUPPORTS}")
-    problem_keys = ("pairing", "slave", "ghost_penalty", "min_support_fraction", "aggregation")
+    problem_keys = ("pairing", "slave", "ghost_penalty", "min_support_fraction")
     problem_keys += ("petsc_options", "petsc_options_prefix")
     problem_options = {k: options.pop(k) for k in problem_keys if k in options}
     r_in, r_gamma, r_out = ANNULUS_RADII

@@ -28,9 +28,7 @@ DEFAULTS: dict[str, Default] = {
         None, "enriched dofs kept down to this cut fraction (None: all with the ghost penalty)"
     ),
     "aggregation": Default(
-        0.15,
-        "cell aggregation: side volume fraction of a badly cut cell (None: off); "
-        "interfaces only, a crack's problem has none",
+        None, "cell aggregation: side volume fraction of a badly cut cell (None: off)"
     ),
     "augmentation": Default(1.0, "dimensionless factor of r = augmentation E / h (contact laws)"),
     "lbb": Default("stabilized", "LBB treatment: 'stabilized', 'restriction' or 'none'"),

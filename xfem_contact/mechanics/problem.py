@@ -59,8 +59,7 @@ class Problem:
             ghost penalty (it extends the field), else those with support on their side.
         aggregation: Cell aggregation (see :class:`EnrichedSpace`): the side volume
             fraction below which a cut cell's dofs are extended from a root cell; None:
-            off. ``"auto"`` (default): the default fraction on interfaces, off on a
-            crack. Dirichlet dofs, and dofs whose extension reads one, stay unknowns.
+            off. Dirichlet dofs, and dofs whose extension reads one, stay unknowns.
         kinematics: ``"small"`` (linear elasticity, small sliding) or ``"large"`` (Saint
             Venant-Kirchhoff bulk, contact laws in large sliding: the slave/master hybrid
             element of :mod:`xfem_contact.mechanics.sliding`).
@@ -90,7 +89,7 @@ class Problem:
         *,
         ghost_penalty: float | None = None,
         min_support_fraction: float | None = DEFAULT.min_support_fraction,
-        aggregation: float | str | None = "auto",
+        aggregation: float | None = DEFAULT.aggregation,
         kinematics: str = DEFAULT.kinematics,
         slave: int = DEFAULT.slave,
         pairing: str = DEFAULT.pairing,
@@ -112,13 +111,6 @@ class Problem:
         # the laws' parameters become Constants of these forms (copied if bound elsewhere)
         self.laws = {n: bound_copy(law, self.mesh) for n, law in self.laws.items()}
         side_materials = side_and_law_materials(cut, materials)
-        if isinstance(aggregation, str) and aggregation != "auto":
-            raise ValueError(
-                f"aggregation must be 'auto', None (off) or a side volume fraction in (0, 1), "
-                f"got {aggregation!r}"
-            )
-        if aggregation == "auto":
-            aggregation = DEFAULT.aggregation if cut.crack is None else None
         if ghost_penalty is None:
             ghost_penalty = DEFAULT.ghost_penalty if cut.crack is None else 0.0
         if min_support_fraction is None:
