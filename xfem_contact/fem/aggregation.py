@@ -151,7 +151,7 @@ def aggregate(space: EnrichedSpace, threshold: float, active: npt.NDArray[np.boo
             constrained).
     """
     cut = space.cut
-    areas = space.cell_areas
+    areas = cell_areas(cut)
     eligible = _eligible_cells(space)
     codes = [
         (field, _cell_codes(cut, side, threshold, areas, eligible))
