@@ -18,7 +18,8 @@ the whole error is that of the cut rules' quadrature, 1e-6 to 1e-5, whose spread
 about its median says nothing a user would act on.
 
 Run: ``python bench/robustness3d.py [--count 100] [--n 4] [--degree 2] [--cell
-tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--write] [--name NAME]``;
+tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--aggregation 0.15] [--write]
+[--name NAME]``;
 prints one row per run, the iteration histogram and the failures per law; ``--write``
 writes ``bench/results/robustness3d.{json,md}`` (``robustness3d_hexahedron.*`` on
 hexahedra, ``NAME.*`` with ``--name``),
@@ -93,10 +94,19 @@ def quadric(placement: dict):
     return levelset, normals
 
 
-def run(placement: dict, law: str, n: int, degree: int, cell: str = "tetrahedron") -> dict:
+def run(
+    placement: dict,
+    law: str,
+    n: int,
+    degree: int,
+    cell: str = "tetrahedron",
+    aggregation: float | None = None,
+) -> dict:
     """One solve: its Newton iterations, convergence, pressure error, NaN and the
-    warnings or the error it raised."""
+    warnings or the error it raised; ``aggregation``: the problem's cell aggregation
+    threshold (None: off)."""
     name, options, stress = LAWS[law]
+    options = options | {"aggregation": aggregation}
     levelset, normals = quadric(placement)
     row = {"law": law, "shape": placement["shape"], "iterations": None, "error": None}
     start = time.perf_counter()
@@ -241,6 +251,9 @@ def main() -> None:
     parser.add_argument(
         "--placements", type=int, nargs="+", default=None, help="run only these (indices)"
     )
+    parser.add_argument(
+        "--aggregation", type=float, default=None, help="cell aggregation threshold (default: off)"
+    )
     parser.add_argument("--write", action="store_true", help="write bench/results/")
     parser.add_argument(
         "--render", action="store_true", help="rewrite the .md from the .json run before"
@@ -266,7 +279,8 @@ def main() -> None:
         if index < done or (args.placements and index not in args.placements):
             continue
         for law in args.laws:
-            row = run(placement, law, args.n, args.degree, args.cell) | {"index": index}
+            row = run(placement, law, args.n, args.degree, args.cell, args.aggregation)
+            row |= {"index": index}
             rows.append(row)
             error = "-" if row["error"] is None else f"{row['error']:.2e}"
             print(

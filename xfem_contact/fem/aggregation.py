@@ -210,8 +210,13 @@ def _interface_codes(cut, name, threshold, areas, eligible) -> npt.NDArray[np.fl
         measure[cut.cut_cells[cut.crack.kind != CROSSED]] = 0.0
     tdim = cut.mesh.topology.dim
     fraction = measure / areas ** ((tdim - 1) / tdim)
+    # a piece along a line of the reference coordinates leaves vertex modes without a
+    # trace, which the law's extension term fixes on the cell itself: extended from a
+    # root, they would carry that strong term onto the root's multiplier
+    aligned = np.zeros(cut.cell_sides.size, dtype=bool)
+    aligned[cut.cut_cells[cut.trace_nullity(name) >= 2]] = True
     codes = np.where(measure > 0.0, _WELL, _OUTSIDE).astype(np.float64)
-    codes[(measure > 0.0) & eligible & (fraction < threshold)] = _BAD
+    codes[(measure > 0.0) & eligible & ~aligned & (fraction < threshold)] = _BAD
     return codes
 
 

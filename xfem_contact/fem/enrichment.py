@@ -293,6 +293,7 @@ class EnrichedSpace:
     def _active_dofs(self) -> npt.NDArray[np.bool_]:
         cut = self.cut
         sides = cut.cell_sides
+        areas = cell_areas(cut) if self.min_support_fraction > 0.0 else None
         owned = np.arange(sides.size, dtype=np.int32)
         active = np.zeros(
             self.W.dofmap.index_map.size_local + self.W.dofmap.index_map.num_ghosts, dtype=bool
@@ -302,7 +303,7 @@ class EnrichedSpace:
             touched = owned[(sides == side) | (sides == 0)]
             support = self._mark(field, touched) > 0
             if self.min_support_fraction > 0.0:
-                fraction = self._side_fraction(field, side)
+                fraction = self._side_fraction(field, side, areas)
                 support &= fraction >= self.min_support_fraction
             active |= support
         for field, _, name in self.multiplier_fields:
@@ -423,9 +424,8 @@ class EnrichedSpace:
         completely; none without a crack)."""
         return self._ties
 
-    def _side_fraction(self, field: int, side: int) -> np.ndarray:
+    def _side_fraction(self, field: int, side: int, areas: np.ndarray) -> np.ndarray:
         """Per dof: (area of its support on ``side``) / (area of its support)."""
-        areas = cell_areas(self.cut)
         side_area = side_areas(self.cut, side, areas)
         on_side = self._mark(field, np.arange(areas.size, dtype=np.int32), side_area)
         total = self._mark(field, np.arange(areas.size, dtype=np.int32), areas)
