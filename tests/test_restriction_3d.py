@@ -20,7 +20,7 @@ from parallel import gathered_fields, max_relative_difference
 from test_multiplier_degree import assert_p2_restriction_is_p1s
 from test_scenes_3d import solved, sphere_scene
 
-from xfem_contact.cases.solid import TRIAXIAL, sphere_errors, sphere_problem
+from xfem_contact.cases.solid import TRIAXIAL, sphere_errors, sphere_problem, unstructured_cube
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.mechanics import lbb_space
 from xfem_contact.mechanics.inf_sup import inf_sup_constant
@@ -50,6 +50,41 @@ def test_without_lbb_treatment_the_constant_falls_below_the_floor():
     """The guard's failure: the same pair with the full P1 multiplier."""
     values = [sphere_beta(n, "none") for n in (4, 8)]
     assert max(values) < FLOOR and values[1] < 0.5 * values[0], values
+
+
+def test_the_restriction_on_unstructured_tetrahedra():
+    """gmsh's unstructured tetrahedra (h = 0.2, 0.15: 705 and 1488 cells), P1-P1, the
+    exact sphere: the restricted pair's constant above the floor (0.381, 0.361), the pair
+    without LBB treatment below (0.026, 0.019: its guard switched off)."""
+    for h in (0.2, 0.15):
+        mesh = unstructured_cube(h)
+        beta = {
+            lbb: inf_sup_constant(
+                sphere_problem(None, 1, "bonded", mesh=mesh, levelset="quadric", lbb=lbb)
+            ).beta
+            for lbb in ("restriction", "none")
+        }
+        assert beta["restriction"] > FLOOR > beta["none"], (h, beta)
+
+
+def test_the_unstructured_cube_holds_the_point_constraints():
+    """Every face centre of :func:`unstructured_cube` is a mesh node (the uniform-stress
+    cases hold their rigid modes there), and a bad size is refused in one line."""
+    mesh = unstructured_cube(0.3)
+    x = mesh.geometry.x
+    centres = [
+        c
+        for k in range(3)
+        for c in (np.eye(3)[k] * v + 0.5 * (1 - np.eye(3)[k]) for v in (0.0, 1.0))
+    ]
+    found = [
+        MPI.COMM_WORLD.allreduce(bool(np.isclose(x, c).all(axis=1).any()), MPI.LOR) for c in centres
+    ]
+    assert all(found), found
+    with pytest.raises(ValueError, match="h must be a cell size"):
+        unstructured_cube(0.0)
+    with pytest.raises(ValueError, match="give n"):
+        sphere_problem(4, 1, "sticking", mesh=mesh)
 
 
 def test_the_sticking_sphere_pressure_with_the_restriction():
@@ -101,6 +136,20 @@ def test_tetrahedra_take_the_nearer_end(monkeypatch):
     R = problem.prolongation()
     assert R.getSize()[1] < nearer
     R.destroy()
+
+
+@pytest.mark.mpi
+def test_the_restricted_sphere_on_unstructured_tetrahedra_parallel_equals_serial():
+    """The sticking sphere with the restriction on gmsh's cube (P1, h = 0.2; gmsh meshes
+    on one rank, the mesh is the same): its fields gathered by position, 2 ranks = 1."""
+    fields = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        mesh = unstructured_cube(0.2, comm)
+        problem = sphere_problem(None, 1, "sticking", comm=comm, mesh=mesh, lbb="restriction")
+        problem.solve()
+        fields.append(gathered_fields(problem))
+    for name, difference in max_relative_difference(*fields).items():
+        assert difference < 1e-10, (name, difference)
 
 
 @pytest.mark.mpi

@@ -10,6 +10,7 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
+from xfem_contact.cases.body_fitted import mesh_geo
 from xfem_contact.cases.paper import integrate
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.evaluation import interface_points, rule_cells
@@ -33,6 +34,25 @@ SOLID = Material(100.0, 0.3)
 #: Sphere case: centre (m), radius (m), principal stresses (Pa) along x, y, z
 SPHERE_CENTRE, SPHERE_RADIUS = (0.5, 0.5, 0.5), 0.2
 TRIAXIAL = (-1.0, -2.0, -3.0)
+
+#: The unit cube for gmsh (OpenCASCADE) with a geometry point embedded at the centre of
+#: each face (mesh nodes for the point constraints of :func:`uniform_stress_problem`);
+#: the boundary parts ``left``/``right`` (x = 0, 1), ``bottom``/``top`` (y),
+#: ``back``/``front`` (z), the cells ``cube``; format with the cell size ``h`` (m)
+UNIT_CUBE_GEO = """SetFactory("OpenCASCADE");
+lc = {h};
+Box(1) = {{0, 0, 0, 1, 1, 1}};
+Point(101) = {{0, 0.5, 0.5, lc}}; Point(102) = {{1, 0.5, 0.5, lc}};
+Point(103) = {{0.5, 0, 0.5, lc}}; Point(104) = {{0.5, 1, 0.5, lc}};
+Point(105) = {{0.5, 0.5, 0, lc}}; Point(106) = {{0.5, 0.5, 1, lc}};
+Point{{101}} In Surface{{1}}; Point{{102}} In Surface{{2}}; Point{{103}} In Surface{{3}};
+Point{{104}} In Surface{{4}}; Point{{105}} In Surface{{5}}; Point{{106}} In Surface{{6}};
+MeshSize{{PointsOf{{Volume{{1}};}}}} = lc;
+Physical Surface("left", 1) = {{1}}; Physical Surface("right", 2) = {{2}};
+Physical Surface("bottom", 3) = {{3}}; Physical Surface("top", 4) = {{4}};
+Physical Surface("back", 5) = {{5}}; Physical Surface("front", 6) = {{6}};
+Physical Volume("cube", 7) = {{1}};
+"""
 
 
 def _strain_factor(side: int, material: Material) -> np.ndarray:
@@ -117,7 +137,7 @@ def _sphere_levelset(levelset: str, R: float = SPHERE_RADIUS):
 
 
 def sphere_problem(
-    n: int,
+    n: int | None,
     degree: int,
     law: str,
     cell: str = "tetrahedron",
@@ -127,34 +147,49 @@ def sphere_problem(
     **options,
 ) -> ElasticityProblem:
     """A sphere (``SPHERE_RADIUS``) in the unit cube: :func:`uniform_stress_problem`
-    with ``levelset``: ``"distance"`` (the signed distance, whose P2 interpolant's zero
-    set is a sphere to O(h^3)) or ``"quadric"`` (``(|x - c|^2 - R^2) / (2 R)``, which P2
-    represents exactly: the exact sphere and normal)."""
+    (``n`` None with its ``mesh`` option) with ``levelset``: ``"distance"`` (the signed
+    distance, whose P2 interpolant's zero set is a sphere to O(h^3)) or ``"quadric"``
+    (``(|x - c|^2 - R^2) / (2 R)``, which P2 represents exactly: the exact sphere and
+    normal)."""
     return uniform_stress_problem(
         n, degree, law, _sphere_levelset(levelset), cell, comm, stress, **options
     )
 
 
+def unstructured_cube(h: float, comm: MPI.Comm = MPI.COMM_WORLD) -> dolfinx.mesh.Mesh:
+    """The unit cube meshed by gmsh into unstructured tetrahedra of size ``h`` (m), with a
+    node at the centre of each face (:data:`UNIT_CUBE_GEO`). Collective."""
+    if not (np.isfinite(h) and 0.0 < h <= 1.0):
+        raise ValueError(f"h must be a cell size in (0, 1] m, got {h!r}")
+    return mesh_geo(UNIT_CUBE_GEO.format(h=h), 1, "tetrahedron", comm).mesh
+
+
 def uniform_stress_problem(
-    n: int,
+    n: int | None,
     degree: int,
     law: str,
     levelset,
     cell: str = "tetrahedron",
     comm: MPI.Comm = MPI.COMM_WORLD,
     stress: tuple[float, float, float] = TRIAXIAL,
+    mesh: dolfinx.mesh.Mesh | None = None,
     **options,
 ) -> ElasticityProblem:
     """An inclusion (``levelset < 0``: a numpy callable of ``x`` ``(3, n)``, a closed
-    surface inside the cube) in the unit cube (``n`` cells per edge, even), one material
+    surface inside the cube) in the unit cube (``n`` cells per edge, even; or ``mesh``, a
+    mesh of the unit cube with a node at the centre of each face, e.g.
+    :func:`unstructured_cube`, with ``n`` None), one material
     on both sides, pressures ``-stress`` (Pa) on the three pairs of faces and the six
     rigid modes held by point constraints the exact field satisfies (``u_i = 0`` where
     ``x_i = 1/2``): the exact stress is ``diag(stress)`` everywhere, the exact contact
     traction ``sigma n``. ``law``: ``bonded``, ``sticking`` (a contact law stays closed:
     every ``n.sigma.n < 0``), ...; ``options`` go to the problem."""
-    if n % 2:
-        raise ValueError(f"n must be even (the point constraints are mesh nodes), got {n}")
-    mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
+    if (n is None) == (mesh is None):
+        raise ValueError(f"give n (cells per edge) or mesh, not both nor neither; got n={n!r}")
+    if mesh is None:
+        if n % 2:
+            raise ValueError(f"n must be even (the point constraints are mesh nodes), got {n}")
+        mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
     cut = CutMesh(mesh, levelset, degree=2)
     cls = ContactProblem if law in ContactProblem.LAWS else ElasticityProblem
     problem = cls(cut, degree, SOLID, law, **options)
