@@ -29,7 +29,8 @@ million dofs; ``scale3d_1m_memory`` the same again), ``--sizes 40 --solvers plai
 iterative --name scale3d_1_6m``, ``--sizes 50 --solvers plain iterative --name scale3d_3m``
 (3.1 M dofs: about 13 GB for the iterative preset), ``--sizes 12 --ranks 1 2
 --direct-max 12 --name scale3d_ranks``, ``--sizes 20 --ranks 1 2 --solvers plain iterative
---repeat 2 --sleep-waits --name scale3d_ranks20_band3d`` and ``--sizes 16 --ranks 1 2
+--repeat 2 --sleep-waits --name scale3d_ranks20_band3d`` (n = 24: ``--sizes 24 ... --name
+scale3d_ranks24_band3d``) and ``--sizes 16 --ranks 1 2
 --solvers plain direct --direct-max 16 --sleep-waits --name scale3d_direct16``.
 ``bench/memory3d.py`` shows where the memory goes.
 """
