@@ -283,7 +283,8 @@ def main():
         "--sleep-waits",
         action="store_true",
         help="MPICH's waiting ranks sleep instead of spinning (MPIR_CVAR_ENABLE_HEAVY_YIELD): "
-        "a rank's CPU time is then its work, not its waits",
+        "a rank's CPU time is then its work, not its waits; the waits last longer (to the "
+        "next wake-up), so such runs' wall times are not the ones to compare",
     )
     parser.add_argument("--case", nargs="+", help=argparse.SUPPRESS)
     args = parser.parse_args()
