@@ -15,15 +15,16 @@ the displacement written as VTX, as the demo does (``--out ''``: not written).
 (``xfem_contact.cases.solid.sphere_problem`` without its sphere: 1, 2, 3 Pa on the
 faces normal to x, y, z) and its seven point constraints. ``--factor gamg``: CG +
 algebraic multigrid with the rigid modes (3 in 2D, 6 in 3D). Prints one JSON line
-of dofs and wall times per phase (s); ``bench/scaling.py`` runs it as a process of its
-own next to the demo. Run: ``python bench/plain_elasticity.py --n 160 [--degree 2]``,
-also under ``mpiexec``.
+of dofs, wall times per phase (s) and each rank's CPU time (s); ``bench/scaling.py``
+runs it as a process of its own next to the demo. Run: ``python
+bench/plain_elasticity.py --n 160 [--degree 2]``, also under ``mpiexec``.
 """
 
 import argparse
 import functools
 import json
 import pathlib
+import resource
 import time
 
 # isort: split
@@ -226,6 +227,13 @@ def solve(setup, out: pathlib.Path | None, mumps: dict[str, int], factor: str = 
     return {"dofs": dofs, "timings": times, "krylov": iterations}, uh
 
 
+def cpu_seconds() -> float:
+    """This process's CPU time so far (s: user + system, all its threads). Not
+    collective."""
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--n", type=int, default=160)
@@ -263,6 +271,7 @@ def main():
         setup = functools.partial(annulus, comm, args.n, args.degree)
     out = pathlib.Path(args.out) if args.out else None
     result, _ = solve(setup, out, mumps, args.factor)
+    result["rank_cpu_s"] = comm.gather(cpu_seconds())
     if MPI.COMM_WORLD.rank == 0:
         print(json.dumps(result))
 

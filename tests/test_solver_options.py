@@ -73,7 +73,7 @@ def _petsc_option_dicts(tree) -> list[int]:
 
 
 #: Option names of PETSc solvers (a dict with one of these as a key is a set of options)
-PETSC_KEYS = ("ksp_", "pc_", "snes_", "mat_mumps_", "mg_")
+PETSC_KEYS = ("ksp_", "pc_", "snes_", "mat_mumps_", "mg_", "bmg_")
 
 
 def test_only_the_table_defines_petsc_options():
@@ -111,6 +111,9 @@ def test_every_preset_is_a_row_with_what_selects_it():
         (Facts({"ksp_type": "preonly"}, couplings=True), set()),
         (Facts(preset("iterative"), symmetric=True), {"symmetric_band"}),
         (Facts(preset("iterative"), symmetric=False), set()),
+        (Facts(preset("iterative"), symmetric=True, tdim=3), {"symmetric_band", "band_3d"}),
+        (Facts(preset("iterative"), tdim=3), {"band_3d"}),
+        (Facts({}, symmetric=True, tdim=3), {"symmetric"}),
     ],
 )
 def test_problem_options_add_the_rows_that_apply(facts, added):

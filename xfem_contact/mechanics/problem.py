@@ -253,7 +253,13 @@ class Problem:
         crack_tip = self.space.branch_field is not None
         if petsc_options is None:
             petsc_options = self._petsc_options
-        facts = Facts(dict(petsc_options), self.symmetric, crack_tip, bool(self.couplings))
+        facts = Facts(
+            dict(petsc_options),
+            self.symmetric,
+            crack_tip,
+            bool(self.couplings),
+            self.mesh.topology.dim,
+        )
         return problem_options(solver, facts)
 
     def law(self, name: str | None = None) -> InterfaceLaw:

@@ -33,7 +33,8 @@ Sub-solver options live under the PC's prefix plus ``bmg_u_`` (the PCMG, or GAMG
 degree 1) and ``bmg_band_`` (the band's LU); the rows ``band_u``, ``band_u_degree1`` and
 ``band`` of :data:`~xfem_contact.solvers.options.PRESETS` are the defaults, which options
 in the database override; a symmetric problem's band is factored LDL^T (the row
-``symmetric_band``), its matrix checked symmetric first.
+``symmetric_band``), its matrix checked symmetric first, and a 3D problem's is ordered by
+METIS (the row ``band_3d``).
 """
 
 from __future__ import annotations

@@ -134,12 +134,14 @@ class Facts(typing.NamedTuple):
         symmetric: The Jacobian is symmetric (``Problem.symmetric``).
         crack_tip: The space has a crack's tip enrichment.
         couplings: The problem has terms coupling two cells (large sliding).
+        tdim: The mesh's topological dimension.
     """
 
     options: dict
     symmetric: bool = False
     crack_tip: bool = False
     couplings: bool = False
+    tdim: int = 2
 
 
 class Preset(typing.NamedTuple):
@@ -205,6 +207,15 @@ PRESETS: dict[str, Preset] = {
         "MUMPS LDL^T of the band: about half the memory of its LU "
         "(xfem_contact.solvers.symmetry checks the band's matrix first)",
         lambda facts: facts.symmetric and uses_band_multigrid(facts.options),
+    ),
+    "band_3d": Preset(
+        {"bmg_band_mat_mumps_icntl_7": 5, "bmg_band_mat_mumps_icntl_13": 1},
+        "the band multigrid on a 3D mesh",
+        "the band's MUMPS factorisation ordered by METIS (fewer factor entries and flops "
+        "than PORD on the shell of cells around a surface) and its root front factored "
+        "without ScaLAPACK (on 2 ranks the triangular solves then share the work instead "
+        "of each doing more than one rank alone)",
+        lambda facts: facts.tdim == 3 and uses_band_multigrid(facts.options),
     ),
     "crack": Preset(
         {"mat_mumps_icntl_14": 100},
