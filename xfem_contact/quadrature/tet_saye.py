@@ -27,6 +27,18 @@ the tensor machinery of :mod:`xfem_contact.geometry.tensor_levelset` applies unc
    are one (the same crossing found on two edges or faces), so that a few ulps in ``psi``
    do not change a rule.
 
+4. Raised orders: the rules of every cut box are also computed with ``order - 1`` points
+   per interval, and a box whose interface area or side -1 volume moves by more than
+   :data:`RAISE_TOLERANCE` (reference units) between the two gets ``2 order`` points.
+   These are the boxes near branch points of the roots (high curvature of the zero set
+   in the cell, shallow slopes), where Gauss rules converge slowly; elsewhere the rules
+   keep ``order`` points.
+
+Given the level set that ``psi`` interpolates as a function (``exact``), the boxes and
+axes stay ``psi``'s, but the breakpoints of every line (the slanted face's included) are
+the function's roots near ``psi``'s, the sides of the height intervals its signs and the
+area vectors its gradient, as in :mod:`xfem_contact.quadrature.saye`.
+
 Every breakpoint is a root of ``psi`` restricted to a straight line, every interval end
 an affine function of the outer coordinates: for a planar ``psi`` the rules integrate
 polynomials of degree ``2 order - 1`` per direction exactly, and for a curved one their
