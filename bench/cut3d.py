@@ -31,7 +31,9 @@ hexahedra; default 4, as ``quadrature_degree = 6`` in ``CutMesh``). ``--min-dept
 splits every box of the P2 tetrahedra that the interface may cross before Saye's rules,
 ``--frame hexahedra`` runs them on the four hexahedra of each tetrahedron instead of on
 truncated boxes of the tetrahedron itself
-(:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`).
+(:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`), and
+``--raise-tolerance T`` (``off``: none) sets the tetrahedron frame's raised orders. With
+``--centres K`` each rate of the means gets a 95 % bootstrap interval over the centres.
 
 The fuzz (``--fuzz N``) cuts ``N`` reference cells per kind by random spheres, ellipsoids,
 tori and planes (a third of them moved to pass exactly through a node) and counts the
