@@ -31,7 +31,9 @@ hexahedra; default 4, as ``quadrature_degree = 6`` in ``CutMesh``). ``--min-dept
 splits every box of the P2 tetrahedra that the interface may cross before Saye's rules,
 ``--frame hexahedra`` runs them on the four hexahedra of each tetrahedron instead of on
 truncated boxes of the tetrahedron itself
-(:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`).
+(:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`), and
+``--raise-tolerance T`` (``off``: none) sets the tetrahedron frame's raised orders. With
+``--centres K`` each rate of the means gets a 95 % bootstrap interval over the centres.
 
 The fuzz (``--fuzz N``) cuts ``N`` reference cells per kind by random spheres, ellipsoids,
 tori and planes (a third of them moved to pass exactly through a node) and counts the
@@ -54,6 +56,7 @@ import basix
 import numpy as np
 
 from xfem_contact.geometry.cut_tets import classify_tets, cut_tets
+from xfem_contact.quadrature import tet_saye
 from xfem_contact.quadrature.curved_tet_rules import classify_p2_tets, p2_tet_cut_rules
 from xfem_contact.quadrature.cut_tet_rules import tet_interface_rule, tet_side_rules
 from xfem_contact.quadrature.saye import classify_hexes, hex_cut_rules
@@ -156,6 +159,11 @@ FRAME = "tetrahedron"
 """Where the P2 tetrahedra's rules run Saye's algorithm (``--frame``)."""
 
 
+RAISE_TOLERANCE = tet_saye.RAISE_TOLERANCE
+"""Rule-change tolerance of the P2 tetrahedra's boxes above which their order is doubled
+(``--raise-tolerance``; ``None``: off)."""
+
+
 CHUNK = 4096
 """Cut P2 tetrahedra per call of the rules: their volumes and areas are summed, so that
 only one chunk's rules are held at a time."""
@@ -184,9 +192,10 @@ def tet_geometry(
 
 def sphere_tets(
     n: int, degree: int = 4, shape: str = "sphere", centre: np.ndarray = CENTRE
-) -> tuple[float, float, int, float]:
-    """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P1 level set
-    of ``shape`` about ``centre``)."""
+) -> tuple[float, float, int, float, int]:
+    """Volume, area, cut-cell count, CPU seconds on ``6 n^3`` tetrahedra (P1 level set
+    of ``shape`` about ``centre``) and the points of the cut cells' rules (both sides and
+    the interface)."""
     _, J, detJ, nodes = tet_geometry(n, PERTURB, 1)
     phi = SHAPES[shape][0](nodes, centre)
     start = time.process_time()
@@ -198,7 +207,9 @@ def sphere_tets(
     elapsed = time.process_time() - start
     volume = detJ[side == -1].sum() / 6.0 + (minus.weights * detJ[cut[minus.point_rows]]).sum()
     area = (gamma.weights * detJ[cut[gamma.point_rows]]).sum()
-    return volume, area, cut.size, elapsed
+    plus = tet_side_rules(geometry, 1, degree)
+    points = minus.weights.size + plus.weights.size + gamma.weights.size
+    return volume, area, cut.size, elapsed, points
 
 
 def sphere_p2_tets(
@@ -207,17 +218,18 @@ def sphere_p2_tets(
     shape: str = "sphere",
     callable_: bool = False,
     centre: np.ndarray = CENTRE,
-) -> tuple[float, float, int, float]:
-    """Volume, area, cut-cell count and CPU seconds on ``6 n^3`` tetrahedra (P2 level set
+) -> tuple[float, float, int, float, int]:
+    """Volume, area, cut-cell count, CPU seconds on ``6 n^3`` tetrahedra (P2 level set
     of ``shape`` about ``centre``; with ``callable_`` following the level set's exact zero
-    set, as ``CutMesh(..., exact_zero_set=True)`` does)."""
+    set, as ``CutMesh(..., exact_zero_set=True)`` does) and the points of the cut cells'
+    rules."""
     vertices, J, detJ, nodes = tet_geometry(n, PERTURB, 2)
     phi = SHAPES[shape][0](nodes, centre)
     start = time.process_time()
     side = classify_p2_tets(phi)
     cut = np.flatnonzero(side == 0)
     volume = detJ[side == -1].sum() / 6.0
-    area = 0.0
+    area, points = 0.0, 0
     for first in range(0, cut.size, CHUNK):
         cells = cut[first : first + CHUNK]
 
@@ -230,13 +242,15 @@ def sphere_p2_tets(
             order or ORDER,
             min_depth=MIN_DEPTH,
             frame=FRAME,
+            raise_tolerance=RAISE_TOLERANCE,
             jacobian=lambda rows, X, cells=cells: J[cells[rows]],
             exact=exact if callable_ else None,
         )
         volume += (rules.minus.weights * detJ[cells[rules.minus.point_rows]]).sum()
         area += (rules.interface.weights * detJ[cells[rules.interface.point_rows]]).sum()
+        points += sum(r.weights.size for r in (rules.minus, rules.plus, rules.interface))
     elapsed = time.process_time() - start
-    return volume, area, cut.size, elapsed
+    return volume, area, cut.size, elapsed, points
 
 
 def sphere_hexes(
@@ -246,10 +260,10 @@ def sphere_hexes(
     shape: str = "sphere",
     callable_: bool = False,
     centre: np.ndarray = CENTRE,
-) -> tuple[float, float, int, float]:
-    """Volume, area, cut-cell count and CPU seconds on ``n^3`` hexahedra (Q``degree`` level
+) -> tuple[float, float, int, float, int]:
+    """Volume, area, cut-cell count, CPU seconds on ``n^3`` hexahedra (Q``degree`` level
     set of ``shape`` about ``centre``; with ``callable_`` and degree 2, following the level
-    set's exact zero set)."""
+    set's exact zero set) and the points of the cut cells' rules."""
     h = 1.0 / n
     element = basix.create_element(
         basix.ElementFamily.P, basix.CellType.hexahedron, degree, basix.LagrangeVariant.gll_warped
@@ -274,7 +288,8 @@ def sphere_hexes(
     elapsed = time.process_time() - start
     volume = ((side == -1).sum() + rules.minus.weights.sum()) * h**3
     area = rules.interface.weights.sum() * h**3
-    return volume, area, cut.size, elapsed
+    points = sum(r.weights.size for r in (rules.minus, rules.plus, rules.interface))
+    return volume, area, cut.size, elapsed, points
 
 
 def random_level_set(rng: np.random.Generator):
@@ -406,11 +421,11 @@ def _previous(sizes: list[int], n: int) -> int | None:
 
 
 def _print_errors(shape: str, n: int, rows: list, previous: dict | None) -> dict:
-    """Print the row of size ``n`` from the ``(volume, area, cut cells, cpu s)`` of each
-    centre: the relative errors (their mean and largest magnitude over several centres)
+    """Print the row of size ``n`` from the ``(volume, area, cut cells, cpu s, points)`` of
+    each centre: the relative errors (their mean and largest magnitude over several centres)
     and the rates of the means against ``previous``; returns this row's errors."""
     _, exact_volume, exact_area = SHAPES[shape]
-    volume, area, ncut, elapsed = (np.array(column) for column in zip(*rows, strict=True))
+    volume, area, ncut, elapsed, points = (np.array(c) for c in zip(*rows, strict=True))
     row = {
         "n": n,
         "volume": (volume - exact_volume) / exact_volume,
@@ -422,7 +437,7 @@ def _print_errors(shape: str, n: int, rows: list, previous: dict | None) -> dict
         for name in ("volume", "area"):
             header += f" {name + (' mean' if several else ' err'):>11}"
             header += f" {'max':>9} {'rate':>5}" if several else f" {'rate':>5}"
-        print(header + f" {'cpu s':>7}")
+        print(header + f" {'cpu s':>7} {'points':>9}")
     line = f"{n:5d} {int(ncut.mean()):10d}"
     for name in ("volume", "area"):
         mean = np.abs(row[name]).mean()
@@ -432,7 +447,7 @@ def _print_errors(shape: str, n: int, rows: list, previous: dict | None) -> dict
             rate = f"{np.log(before / mean) / np.log(n / previous['n']):5.2f}"
         line += f" {mean:11.3e}"
         line += f" {np.abs(row[name]).max():9.2e} {rate:>5}" if several else f" {rate:>5}"
-    print(line + f" {elapsed.mean():7.2f}", flush=True)
+    print(line + f" {elapsed.mean():7.2f} {int(points.mean()):9d}", flush=True)
     return row
 
 
@@ -442,6 +457,31 @@ def _print_signed(errors: dict[int, dict]) -> None:
     for name in ("volume", "area"):
         for n, row in errors.items():
             print(f"{n:5d} {name:>6} " + " ".join(f"{e:+9.2e}" for e in row[name]))
+
+
+BOOTSTRAP = 10000
+"""Resamples of the centres for the rates' confidence intervals."""
+
+
+def _print_rate_intervals(errors: dict[int, dict]) -> None:
+    """Print, for each pair of consecutive sizes, the rate of the mean ``|relative error|``
+    with a 95 % bootstrap interval: the centres (the same ``u`` at every size) resampled
+    with replacement :data:`BOOTSTRAP` times, seeded."""
+    sizes = list(errors)
+    count = np.asarray(errors[sizes[0]]["volume"]).size
+    if count < 2 or len(sizes) < 2:
+        return
+    draw = np.random.default_rng(1).integers(0, count, size=(BOOTSTRAP, count))
+    print(f"rates of the means, 95 % bootstrap interval over the {count} centres:")
+    for before, n in itertools.pairwise(sizes):
+        line = f"{before:5d} -> {n:<5d}"
+        for name in ("volume", "area"):
+            a, b = np.abs(errors[before][name]), np.abs(errors[n][name])
+            rate = np.log(a.mean() / b.mean()) / np.log(n / before)
+            resampled = np.log(a[draw].mean(axis=1) / b[draw].mean(axis=1)) / np.log(n / before)
+            low, high = np.percentile(resampled, [2.5, 97.5])
+            line += f" {name} {rate:5.2f} [{low:5.2f}, {high:5.2f}]"
+        print(line)
 
 
 def _print_fitted_rates(errors: dict[int, dict]) -> None:
@@ -524,11 +564,21 @@ def main() -> None:
         help="average the errors over K centres shifted by up to h per coordinate "
         "(seeded; 0: the cube's centre only)",
     )
+    parser.add_argument(
+        "--raise-tolerance",
+        type=lambda text: None if text == "off" else float(text),
+        default=tet_saye.RAISE_TOLERANCE,
+        metavar="T",
+        help="P2 tetrahedra (tetrahedron frame): boxes whose rules move by more than T between "
+        "order - 1 and order get 2 order points ('off': never; p2_tet_cut_rules "
+        f"raise_tolerance, default {tet_saye.RAISE_TOLERANCE:g})",
+    )
     args = parser.parse_args()
     if args.centres < 0:
         parser.error(f"--centres must be >= 0, got {args.centres}")
-    global PERTURB, MIN_DEPTH, ORDER, FRAME
+    global PERTURB, MIN_DEPTH, ORDER, FRAME, RAISE_TOLERANCE
     PERTURB, MIN_DEPTH, ORDER, FRAME = args.perturb, args.min_depth, args.order, args.frame
+    RAISE_TOLERANCE = args.raise_tolerance
     for kind, levelset in itertools.product(args.kinds if args.fuzz else [], args.levelset):
         if levelset == "callable" and kind in ("tet-P1", "hex-Q1"):
             continue
@@ -567,6 +617,7 @@ def main() -> None:
             errors[n] = _print_errors(shape, n, rows, errors.get(_previous(args.sizes, n)))
         if args.centres:
             _print_signed(errors)
+            _print_rate_intervals(errors)
             _print_fitted_rates(errors)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"\npeak memory {peak:.0f} MB")

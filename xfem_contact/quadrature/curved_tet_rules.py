@@ -39,7 +39,7 @@ from xfem_contact.geometry.tensor_levelset import coefficients
 from xfem_contact.quadrature.rules import RuleSet
 from xfem_contact.quadrature.saye import MAX_DEPTH, CutRules, certified_sides, saye_points
 from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
-from xfem_contact.quadrature.tet_saye import truncated_saye_points
+from xfem_contact.quadrature.tet_saye import RAISE_TOLERANCE, truncated_saye_points
 
 __all__ = ["FRAMES", "HEXAHEDRA", "classify_p2_tets", "hexahedron_map", "p2_tet_cut_rules"]
 
@@ -172,6 +172,7 @@ def p2_tet_cut_rules(
     max_depth: int = MAX_DEPTH,
     min_depth: int = 0,
     frame: str = "tetrahedron",
+    raise_tolerance: float | None = RAISE_TOLERANCE,
     jacobian: Jacobian | None = None,
     exact: ExactLevelSet | None = None,
 ) -> CutRules:
@@ -187,13 +188,18 @@ def p2_tet_cut_rules(
         frame: ``"tetrahedron"``: Saye's rules on truncated boxes of the reference
             tetrahedron (exact for planes), a cell left unresolved at ``max_depth`` going
             to the hexahedra; ``"hexahedra"``: on the four hexahedra of every cell.
+        raise_tolerance: In the tetrahedron's frame, a cut box whose rules with
+            ``order - 1`` points per interval differ from ``order``'s by more than this
+            (interface area or side -1 volume, reference units) gets ``2 order`` points
+            (:func:`~xfem_contact.quadrature.tet_saye.truncated_saye_points`); ``None``:
+            ``order`` everywhere. Not used on the hexahedra.
         jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule;
             ``None``: reference cells.
         exact: ``(rows, X) -> (m,)``: the level set that ``phi`` interpolates, at points
             ``X`` ``(m, 3)`` of the reference tetrahedron of cells ``rows``; the rules
             then follow its zero set (as
-            :func:`~xfem_contact.quadrature.saye.hex_cut_rules`'s), on the four hexahedra
-            whatever ``frame``; ``None``: ``phi``'s.
+            :func:`~xfem_contact.quadrature.saye.hex_cut_rules`'s) in either frame;
+            ``None``: ``phi``'s.
 
     Returns:
         A :class:`~xfem_contact.quadrature.saye.CutRules`: points in the reference
@@ -219,9 +225,14 @@ def p2_tet_cut_rules(
         found: dict[str, list[tuple[np.ndarray, ...]]] = {side: [] for side in merged}
         size = chunk.shape[0]
         rest = np.arange(size)
-        if frame == "tetrahedron" and exact is None:
+        if frame == "tetrahedron":
             points, rest = truncated_saye_points(
-                _tet_coefficients(chunk), order, max_depth=max_depth, min_depth=min_depth
+                _tet_coefficients(chunk),
+                order,
+                max_depth=max_depth,
+                min_depth=min_depth,
+                raise_tolerance=raise_tolerance,
+                exact=None if exact is None else _from_row(exact, start),
             )
             reduced.append(points.reduced + start)
             if rest.size == 0:  # points sorted by row, vectors as (N, 3): nothing to merge
@@ -329,6 +340,11 @@ class _Buffer:
 
     def arrays(self) -> list[np.ndarray]:
         return [c[: self.size] for c in self.columns]
+
+
+def _from_row(exact: ExactLevelSet, start: int) -> ExactLevelSet:
+    """``exact`` (of tetrahedron rows) for the rows of the batch from ``start``."""
+    return lambda rows, X: exact(rows + start, X)
 
 
 def _on_cube(exact: ExactLevelSet, k: int, start: int) -> ExactLevelSet:

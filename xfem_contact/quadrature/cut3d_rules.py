@@ -5,7 +5,7 @@ three kernels (pure numpy and Basix, no DOLFINx).
 cell           degree  kernel
 =============  ======  ===========================================================
 tetrahedron    1       exact planar cut (:mod:`~xfem_contact.quadrature.cut_tet_rules`)
-tetrahedron    2       Saye on four hexahedra (:mod:`~xfem_contact.quadrature.curved_tet_rules`)
+tetrahedron    2       Saye on truncated boxes (:mod:`~xfem_contact.quadrature.curved_tet_rules`)
 hexahedron     1, 2    Saye (:mod:`~xfem_contact.quadrature.saye`)
 =============  ======  ===========================================================
 

@@ -27,6 +27,18 @@ the tensor machinery of :mod:`xfem_contact.geometry.tensor_levelset` applies unc
    are one (the same crossing found on two edges or faces), so that a few ulps in ``psi``
    do not change a rule.
 
+4. Raised orders: the rules of every cut box are also computed with ``order - 1`` points
+   per interval, and a box whose interface area or side -1 volume moves by more than
+   :data:`RAISE_TOLERANCE` (reference units) between the two gets ``2 order`` points.
+   These are the boxes near branch points of the roots (high curvature of the zero set
+   in the cell, shallow slopes), where Gauss rules converge slowly; elsewhere the rules
+   keep ``order`` points.
+
+Given the level set that ``psi`` interpolates as a function (``exact``), the boxes and
+axes stay ``psi``'s, but the breakpoints of every line (the slanted face's included) are
+the function's roots near ``psi``'s, the sides of the height intervals its signs and the
+area vectors its gradient, as in :mod:`xfem_contact.quadrature.saye`.
+
 Every breakpoint is a root of ``psi`` restricted to a straight line, every interval end
 an affine function of the outer coordinates: for a planar ``psi`` the rules integrate
 polynomials of degree ``2 order - 1`` per direction exactly, and for a curved one their
@@ -45,10 +57,13 @@ when ``psi < 0`` inside next to it).
 
 from __future__ import annotations
 
+import functools
 import itertools
 
 import numpy as np
 
+from xfem_contact.geometry import exact_lines
+from xfem_contact.geometry.exact_lines import ExactLevelSet, central_gradient
 from xfem_contact.geometry.tensor_levelset import (
     bernstein,
     derivative,
@@ -73,7 +88,7 @@ from xfem_contact.quadrature.saye_axes import (
     mean_slopes,
 )
 
-__all__ = ["MIN_SLOPE", "truncated_saye_points"]
+__all__ = ["MIN_SLOPE", "RAISE_TOLERANCE", "truncated_saye_points"]
 
 MIN_SLOPE = 0.2
 """Boxes inside the tetrahedron whose best pair of axes scores below this are subdivided,
@@ -82,8 +97,20 @@ here, where the boxes are those of a sixth of a cube and :data:`CURVED` subdivid
 curved ones too."""
 
 
+RAISE_TOLERANCE = 1e-6
+"""Default ``raise_tolerance`` of :func:`truncated_saye_points`: a cut box whose rules'
+interface area or side -1 volume (reference units) changes by more than this between
+``order - 1`` and ``order`` points per interval gets rules of ``2 order`` points."""
+
+
 def truncated_saye_points(
-    C: np.ndarray, order: int, *, max_depth: int, min_depth: int = 0
+    C: np.ndarray,
+    order: int,
+    *,
+    max_depth: int,
+    min_depth: int = 0,
+    raise_tolerance: float | None = RAISE_TOLERANCE,
+    exact: ExactLevelSet | None = None,
 ) -> tuple[SayePoints, np.ndarray]:
     """Saye's rules on the reference tetrahedron of P2 polynomials (see the module).
 
@@ -93,6 +120,18 @@ def truncated_saye_points(
         order: Gauss-Legendre points per interval.
         max_depth: Box subdivision levels.
         min_depth: Levels of boxes subdivided whenever the interface may cross them.
+        raise_tolerance: The rules of each cut box are also computed with
+            ``max(1, order - 1)`` points per interval; a box whose interface area or side
+            -1 volume (reference units) differs between the two by more than this gets
+            rules of ``2 order`` points instead (where the roots' branch points are close
+            to the box, the rules converge slowly). ``None``: ``order`` everywhere.
+        exact: ``(rows, X) -> (m,)``: the level set that ``C`` interpolates, at points
+            ``X`` ``(m, 3)`` of the reference tetrahedron of cells ``rows``; the boxes and
+            axes stay ``C``'s, but the breakpoints of every line are its roots near
+            ``C``'s (:func:`~xfem_contact.geometry.exact_lines.line_roots`), the sides of
+            the height intervals its signs and the interface's area vectors its gradient
+            (:func:`~xfem_contact.geometry.exact_lines.central_gradient`). ``None``:
+            ``C``'s zero set.
 
     Returns:
         The points of the resolved cells (a :class:`~xfem_contact.quadrature.saye.SayePoints`;
@@ -104,9 +143,10 @@ def truncated_saye_points(
         ValueError: Bad ``order``, ``max_depth`` or ``min_depth``.
     """
     check_parameters(order, max_depth, min_depth)
+    if raise_tolerance is not None and not raise_tolerance >= 0:
+        raise ValueError(f"raise_tolerance must be >= 0 or None, got {raise_tolerance!r}")
     ncells = C.shape[0]
-    gx, gw = np.polynomial.legendre.leggauss(order)
-    gauss = (0.5 * (gx + 1.0), 0.5 * gw)
+    gauss = _gauss(order)
     parts: dict[str, list[tuple[np.ndarray, ...]]] = {"minus": [], "plus": [], "interface": []}
     unresolved, reduced = [], []
     cell = np.arange(ncells)
@@ -146,7 +186,8 @@ def truncated_saye_points(
         for index, (k3, k2) in enumerate(PAIRS):
             group = pair == index
             if group.any():
-                _clipped_rules(C, cell[group], lo[group], hi[group], k3, k2, gauss, parts, None)
+                box = (cell[group], lo[group], hi[group], k3, k2)
+                _raised_rules(C, box, order, parts, raise_tolerance, exact)
         subdivided = pair < 0
         if depth == max_depth:
             unresolved.append(cell[subdivided])
@@ -164,6 +205,65 @@ def truncated_saye_points(
         gathered.append(tuple(columns))
     reduced = np.unique(np.concatenate([np.zeros(0, int), *reduced])).astype(np.int64)
     return SayePoints(*gathered, reduced[~np.isin(reduced, bad)]), bad
+
+
+@functools.cache
+def _gauss(order: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre points and weights of ``order`` points on ``[0, 1]``."""
+    gx, gw = np.polynomial.legendre.leggauss(order)
+    return 0.5 * (gx + 1.0), 0.5 * gw
+
+
+def _raised_rules(C, box, order, parts, tolerance, exact):
+    """Nested rules of the cut truncated boxes ``box = (cell, lo, hi, k3, k2)`` with
+    ``order`` points per interval, and ``2 order`` in the boxes whose rules move by more
+    than ``tolerance`` from ``max(1, order - 1)`` points (see :func:`truncated_saye_points`),
+    appended to ``parts``."""
+    cell, lo, hi, k3, k2 = box
+    low = max(1, order - 1)
+    if tolerance is None or low == order:
+        _clipped_rules(C, cell, lo, hi, k3, k2, _gauss(order), parts, None, exact)
+        return
+    m = cell.size
+    local = np.arange(m)
+    Cb = C[cell]
+    on_box = None if exact is None else (lambda rows, X: exact(cell[rows], X))
+    found, coarse = ({"minus": [], "plus": [], "interface": []} for _ in range(2))
+    _clipped_rules(Cb, local, lo, hi, k3, k2, _gauss(order), found, None, on_box)
+    _clipped_rules(Cb, local, lo, hi, k3, k2, _gauss(low), coarse, None, on_box)
+    moved = np.zeros(m, dtype=bool)
+    for measure in (_box_areas, _box_volumes):
+        moved |= np.abs(measure(found, m) - measure(coarse, m)) > tolerance
+    if moved.any():
+        raised = np.flatnonzero(moved)
+        fine = {"minus": [], "plus": [], "interface": []}
+        on_raised = None if exact is None else (lambda rows, X: exact(cell[raised[rows]], X))
+        _clipped_rules(
+            Cb[raised], local[: raised.size], lo[raised], hi[raised], k3, k2,
+            _gauss(2 * order), fine, None, on_raised,
+        )  # fmt: skip
+        for side, pieces in fine.items():
+            parts[side].extend((cell[raised[p[0]]], *p[1:]) for p in pieces)
+    for side, pieces in found.items():
+        for rows, *columns in pieces:
+            keep = ~moved[rows]
+            parts[side].append((cell[rows[keep]], *(c[keep] for c in columns)))
+
+
+def _box_areas(parts, m):
+    """Interface area (reference units) per box of ``parts`` (rows: boxes), ``(m,)``."""
+    areas = np.zeros(m)
+    for rows, _, w, area in parts["interface"]:
+        areas += np.bincount(rows, w * np.linalg.norm(area, axis=1), minlength=m)
+    return areas
+
+
+def _box_volumes(parts, m):
+    """Side -1 volume per box of ``parts`` (rows: boxes), ``(m,)``."""
+    volumes = np.zeros(m)
+    for rows, _, w in parts["minus"]:
+        volumes += np.bincount(rows, w, minlength=m)
+    return volumes
 
 
 def _truncated_axes(C, lo, hi, B, DB):
@@ -266,9 +366,24 @@ def _slanted_line(C, P0, a, b):
     return np.stack([evaluate(C, P0), evaluate(Dd, P0), 0.5 * evaluate(Ddd, P0)], axis=1)
 
 
-def _roots_between(c, a, b):
-    """Roots ``(m, 2)`` of polynomials ``c`` in ``[a, b]`` (NaN: none or an empty range)."""
-    r = line_roots(c, a, np.maximum(a, b))
+def _roots_between(c, a, b, exact=None, X=None, axis=None, back=None):
+    """Roots ``(m, 2)`` of polynomials ``c`` in ``[a, b]`` (NaN: none or an empty range).
+    With ``exact`` (``(lines, Y) -> (k,)``), its roots near those of ``c`` on the lines
+    through ``X`` ``(m, 3)`` whose ``axis`` coordinate is the parameter; ``back``: the axis
+    that goes down as ``axis`` goes up (a line of the slanted face), else ``None``."""
+    b_ = np.maximum(a, b)
+    if exact is None:
+        r = line_roots(c, a, b_)
+    else:
+        on_line = exact
+        if back is not None:
+
+            def on_line(lines, Y):
+                Z = Y.copy()
+                Z[:, back] = X[lines, back] - (Y[:, axis] - X[lines, axis])
+                return exact(lines, Z)
+
+        r = exact_lines.line_roots(on_line, X, axis, a, b_, c)
     return np.where((b > a)[:, None], r, np.nan)
 
 
@@ -277,10 +392,16 @@ def _inside(values, a, b):
     return np.where((values > a) & (values < b), values, np.nan)[:, None]
 
 
-def _clipped_rules(C, cell, lo, hi, k3, k2, gauss, parts, side):
+def _clipped_rules(C, cell, lo, hi, k3, k2, gauss, parts, side, exact=None):
     """Nested Gauss rules of truncated boxes sharing the axes ``k3`` (height) and ``k2``;
     ``side``: ``"minus"`` / ``"plus"`` for boxes certified on one side (no roots), else
-    ``None``."""
+    ``None``; ``exact``: the level set ``C`` interpolates, as a function of ``(cell, X)``
+    (its roots, signs and gradient), or ``None``."""
+
+    def on(rows):
+        """``exact`` on the lines of boxes ``rows``."""
+        return None if exact is None else (lambda lines, Y: exact(cell[rows[lines]], Y))
+
     k1 = 3 - k3 - k2
     m = cell.size
     C1 = C[cell]
@@ -295,14 +416,16 @@ def _clipped_rules(C, cell, lo, hi, k3, k2, gauss, parts, side):
             X = np.zeros((m, 3))
             X[:, k2], X[:, k3] = c2, c3
             end = np.minimum(hi1, 1.0 - c2 - c3)
-            breaks.append(_roots_between(line_coefficients(C1, k1, X), lo1, end))
+            c = line_coefficients(C1, k1, X)
+            breaks.append(_roots_between(c, lo1, end, on(np.arange(m)), X, k1))
         for fixed, free, (c_lo, c_hi) in ((k2, k3, (lo3, hi3)), (k3, k2, (lo2, hi2))):
             for c in (lo[:, fixed], hi[:, fixed]):  # the slanted face on the face x_fixed = c
                 P0 = np.zeros((m, 3))
                 P0[:, fixed], P0[:, free] = c, 1.0 - c
                 a = np.maximum(lo1, 1.0 - c - c_hi)
                 b = np.minimum(hi1, 1.0 - c - c_lo)
-                breaks.append(_roots_between(_slanted_line(C1, P0, k1, free), a, b))
+                c = _slanted_line(C1, P0, k1, free)
+                breaks.append(_roots_between(c, a, b, on(np.arange(m)), P0, k1, free))
     box1, u, w1, _, _ = _pieces(np.concatenate(breaks, axis=1), lo1, top1, gauss, merge=True)
     # level 2: along k2 at each u, breakpoints at the kink and the roots on the three faces
     lo2, hi2, lo3, hi3 = lo2[box1], hi2[box1], lo3[box1], hi3[box1]
@@ -315,10 +438,12 @@ def _clipped_rules(C, cell, lo, hi, k3, k2, gauss, parts, side):
         X[:, k1] = u
         for c, end in ((lo3, top2), (hi3, np.minimum(top2, kink))):
             X[:, k3] = c
-            breaks.append(_roots_between(line_coefficients(C1, k2, X), lo2, end))
+            line = line_coefficients(C1, k2, X)
+            breaks.append(_roots_between(line, lo2, end, on(box1), X, k2))
         P0 = np.zeros((u.size, 3))
         P0[:, k1], P0[:, k3] = u, 1.0 - u
-        breaks.append(_roots_between(_slanted_line(C1, P0, k2, k3), np.maximum(lo2, kink), top2))
+        line = _slanted_line(C1, P0, k2, k3)
+        breaks.append(_roots_between(line, np.maximum(lo2, kink), top2, on(box1), P0, k2, k3))
     p1, v, w2, _, _ = _pieces(np.concatenate(breaks, axis=1), lo2, top2, gauss, merge=True)
     box2 = box1[p1]
     W = w1[p1] * w2
@@ -329,7 +454,7 @@ def _clipped_rules(C, cell, lo, hi, k3, k2, gauss, parts, side):
     # level 3: along k3 at each (u, v), breakpoints at the roots of psi
     if side is None:
         C2 = C1[p1]
-        r = _roots_between(line_coefficients(C2, k3, X), lo3, top3)
+        r = _roots_between(line_coefficients(C2, k3, X), lo3, top3, on(box2), X, k3)
     else:
         r = np.full((v.size, 0), np.nan)
     p2, w, w3, piece, (pline, mid) = _pieces(r, lo3, top3, gauss)
@@ -342,7 +467,10 @@ def _clipped_rules(C, cell, lo, hi, k3, k2, gauss, parts, side):
         return
     Xmid = X[pline].copy()
     Xmid[:, k3] = mid
-    negative = evaluate(C2[pline], Xmid) < 0
+    if exact is None:
+        negative = evaluate(C2[pline], Xmid) < 0
+    else:
+        negative = exact(cell[box2[pline]], Xmid) < 0
     for name, keep in (("minus", negative[piece]), ("plus", ~negative[piece])):
         parts[name].append((rows[keep], Xq[keep], weights[keep]))
     # interface: each root of a height line bounding side -1
@@ -350,7 +478,10 @@ def _clipped_rules(C, cell, lo, hi, k3, k2, gauss, parts, side):
         line = np.flatnonzero(~np.isnan(r[:, j]))
         Xs = X[line].copy()
         Xs[:, k3] = r[line, j]
-        grad = gradient(C2[line], Xs)
+        if exact is None:
+            grad = gradient(C2[line], Xs)
+        else:
+            grad = central_gradient(lambda Y, c=cell[box2[line]]: exact(c, Y), Xs)
         slope = grad[:, k3]
         at_lo, at_hi = r[line, j] == lo3[line], r[line, j] == top3[line]
         bounding = ~(at_lo | at_hi) | (at_hi & (slope > 0)) | (at_lo & (slope < 0))
