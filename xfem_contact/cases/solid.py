@@ -221,6 +221,54 @@ def sphere_errors(problem) -> tuple[float, float]:
     return traction_errors(problem, lambda n: n @ np.diag(problem.stress))
 
 
+def uniform_stress_state(problem, w: dolfinx.fem.Function) -> None:
+    """Write into ``w`` (a Function on ``problem.space.W``) the exact solution of
+    :func:`sphere_problem`'s ``problem`` interpolated: on both sides the linear
+    displacement ``eps (x - 1/2)`` (m) of the uniform stress (``eps`` its strain in
+    ``SOLID``: it meets the point constraints), and the Cartesian multiplier
+    ``sigma (x - c) / R`` (Pa), the traction ``sigma n`` on the exact sphere and linear.
+    With the quadric level set and degree 2 (or a multiplier of degree 1 or 2) every
+    field lies in its discrete space. Local (no communication but the ghost update)."""
+    stress = np.diag(problem.stress)
+    E, nu = SOLID.E, SOLID.nu
+    strain = ((1.0 + nu) * stress - nu * np.trace(stress) * np.eye(3)) / E
+    centre = np.asarray(SPHERE_CENTRE)[:, None]
+    fields = {0: lambda x: strain @ (x - 0.5), 1: lambda x: strain @ (x - 0.5)}
+    for field, _, _ in problem.space.multiplier_fields:
+        fields[field] = lambda x: stress @ (x - centre) / SPHERE_RADIUS
+    for field, exact in fields.items():
+        V, parent = problem.space.field_space(field)
+        if V.value_size != 3:
+            raise ValueError(
+                f"uniform_stress_state: field {field} has {V.value_size} components; valid: "
+                "the 3 of a displacement or of a Cartesian multiplier (not frictionless)"
+            )
+        values = dolfinx.fem.Function(V)
+        values.interpolate(exact)
+        w.x.array[parent] = values.x.array
+    w.x.scatter_forward()
+
+
+def patch_residual(problem) -> float:
+    """The patch test of a solved :func:`sphere_problem` with a contact law: the norm of
+    the scaled reduced residual ``|D R^T F|`` at its exact solution
+    (:func:`uniform_stress_state`) over that at zero (the loads'). Consistent rules give
+    0; the cut rules' error leaves its trace. ``problem.w`` is restored; ``nan`` for a
+    linear law (``bonded``: no Newton solver) and a scalar multiplier (``frictionless``).
+    Collective."""
+    newton = problem.newton
+    if newton is None or any(c != 3 for _, c, _ in problem.space.multiplier_fields):
+        return float("nan")
+    solution = problem.w.x.array.copy()
+    uniform_stress_state(problem, problem.w)
+    exact = newton.residual_of_w()
+    problem.w.x.array[:] = 0.0
+    zero = newton.residual_of_w()
+    problem.w.x.array[:] = solution
+    newton.residual_of_w()  # its iterate back at the solution
+    return exact / zero
+
+
 def sphere_normals(points: np.ndarray) -> np.ndarray:
     """The unit normals ``(p, 3)`` at ``points`` ``(p, 3)`` (m) of the spheres about
     ``SPHERE_CENTRE``."""

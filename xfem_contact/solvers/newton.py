@@ -343,6 +343,13 @@ class ReducedNewton:
         self._residual(None, self.y, self.F_r)
         return self.F_r.norm()
 
+    def residual_of_w(self) -> float:
+        """``|D R^T F(R D y)|`` with ``y`` the projection of the current ``w`` on the
+        range of ``R D`` (as a solve starts from it); ``w`` becomes ``R D y`` and the
+        current iterate ``y``. Collective."""
+        self._start_from_w()
+        return self.final_residual()
+
     def solve(self) -> NewtonReport:
         """Run SNES from the current reduced iterate. Collective.
 
