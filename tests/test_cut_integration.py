@@ -231,6 +231,7 @@ def test_curved_q2_cells_disc_area():
 
 
 @pytest.mark.mpi
+@pytest.mark.parallel
 def test_parallel_equals_serial_integrals():
     """Disc area, circle length and a polynomial moment: this communicator vs each
     process alone, to 1e-12."""

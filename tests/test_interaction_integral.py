@@ -232,6 +232,7 @@ def _K_on(comm):
 
 
 @pytest.mark.mpi
+@pytest.mark.parallel
 def test_parallel_K_equal_serial():
     """All ranks report the same K, equal to a serial run's to 1e-10."""
     here = _K_on(MPI.COMM_WORLD)

@@ -139,6 +139,7 @@ def test_tetrahedra_take_the_nearer_end(monkeypatch):
 
 
 @pytest.mark.mpi
+@pytest.mark.parallel
 def test_the_restricted_sphere_on_unstructured_tetrahedra_parallel_equals_serial():
     """The sticking sphere with the restriction on gmsh's cube (P1, h = 0.2; gmsh meshes
     on one rank, the mesh is the same): its fields gathered by position, 2 ranks = 1."""
@@ -153,6 +154,7 @@ def test_the_restricted_sphere_on_unstructured_tetrahedra_parallel_equals_serial
 
 
 @pytest.mark.mpi
+@pytest.mark.parallel
 def test_the_restricted_sphere_parallel_equals_serial():
     """The sticking sphere with the restriction (P1, n = 6): its fields gathered by
     position, 2 ranks = 1 rank."""

@@ -117,6 +117,7 @@ def test_3d_outputs_and_show(tmp_path):
 
 
 @pytest.mark.mpi
+@pytest.mark.parallel
 def test_sphere_scene_parallel_equals_serial():
     """The 3D scene's fields gathered by position: 2 ranks = 1 rank."""
     scene = load_scene(sphere_scene())

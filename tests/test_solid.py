@@ -332,6 +332,7 @@ def test_sphere_coulomb_partial_slip():
 
 
 @pytest.mark.mpi
+@pytest.mark.parallel
 @pytest.mark.parametrize("law, options", [("sticking", {}), ("coulomb", {"friction": 0.1})])
 def test_sphere_parallel_equals_serial(law, options):
     fields = []
@@ -394,6 +395,7 @@ def test_iterative_preset_in_3d_gives_the_direct_answer():
 
 
 @pytest.mark.mpi
+@pytest.mark.parallel
 @pytest.mark.parametrize("degree", [1, 2])
 def test_sphere_iterative_parallel_equals_serial(degree):
     """The iterative preset on 1 and 2 ranks: the same fields (gathered by position)."""

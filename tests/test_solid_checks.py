@@ -122,6 +122,7 @@ def test_friction_limits_on_the_sphere():
 
 
 @pytest.mark.mpi
+@pytest.mark.parallel
 def test_concentric_spheres_parallel_equals_serial():
     fields = []
     for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):

@@ -122,6 +122,7 @@ def test_extension_reproduces_polynomials(cell, degree):
 
 
 @pytest.mark.mpi
+@pytest.mark.parallel
 def test_aggregation_is_the_same_on_one_and_two_ranks():
     """The constrained dofs (their count) and the solution's pressure error of case 2
     (Q2, tiny cut, no ghost penalty) agree between one process and all of them."""

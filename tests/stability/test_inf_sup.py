@@ -140,6 +140,7 @@ def test_without_lbb_treatment_the_crack_constant_falls():
 
 
 @pytest.mark.mpi
+@pytest.mark.parallel
 def test_the_crack_constant_is_the_same_on_one_and_two_ranks():
     beta, beta_self = crack_beta("restriction", 16), crack_beta("restriction", 16, MPI.COMM_SELF)
     assert abs(beta - beta_self) <= 1e-8 * beta_self
