@@ -20,10 +20,12 @@ on one thread.
 Part ``crack_conditioning``: the same over random straight cracks of the unit square
 (tip uniform in [0.3, 0.7]^2, any direction, running back to the boundary; two thirds
 passing within ``eps h`` of a node behind the tip), free lips, the boundary clamped,
-topological tip enrichment; the matrix is the one the solver factors, ``Z^T A Z`` of
-the tip transform (:mod:`xfem_contact.solvers.block_scaling`). ``--treatments`` picks
-the treatments of both parts, ``--tip-basis`` the cracks' tip basis (default ``"auto"``;
-another is written to ``aggregation_crack_conditioning_BASIS``).
+geometric tip enrichment of the default radius, set on the first crack (tip (0.5, 0.5),
+0.3 rad: ``r_e = 0.262``) and kept as the crack moves; the matrix is the one the solver
+factors, ``Z^T A Z`` of the tip transform (:mod:`xfem_contact.solvers.block_scaling`).
+``--treatments`` picks the treatments of both parts, ``--tip-basis`` the cracks' tip
+basis (default ``"auto"``; another is written to
+``aggregation_crack_conditioning_BASIS``).
 
 Condition numbers: the extreme eigenvalues of the symmetric scaled matrix (dense below
 1500 unknowns, else SLEPc: Krylov-Schur, shift-and-invert at 0 with an LU for the least
@@ -171,8 +173,9 @@ def crack_levelsets(tip, angle):
 
 
 def free_crack(mesh, tip, angle, degree, ghost_penalty, aggregation, tip_basis="auto") -> Problem:
-    """A crack with free lips in the unit square, its boundary clamped, topological tip
-    enrichment (the tip cell's nodes), the tip basis ``tip_basis``."""
+    """A crack with free lips in the unit square, its boundary clamped, geometric tip
+    enrichment of the default radius (of this crack; kept by ``update_interface``), the
+    tip basis ``tip_basis``."""
     phi, psi = crack_levelsets(tip, angle)
     cut = CutMesh(mesh, phi, degree=degree, tangent=psi)
     problem = Problem(
