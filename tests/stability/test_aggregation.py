@@ -199,7 +199,7 @@ def test_a_prescribed_dof_is_never_a_source():
 @pytest.mark.serial
 @pytest.mark.parametrize("cell", ["triangle", "quadrilateral"])
 def test_a_sliver_next_to_a_crack_tip_is_aggregated(cell):
-    """A crack (P2, 8 x 8, clamped boundary) passing 1e-5 m from a node one cell behind
+    """A crack (P2, 8 x 8, clamped boundary) passing 1e-5 m from a node 1.5 cells behind
     its tip: the slivers of the crossed cells next to the tip cell (cells holding tied
     dofs) left one side's untied dofs with nothing else in their support. With those
     cells badly cut, C = cond h^2 is 36 (triangles) and 1.2e3 (quadrilaterals), against
