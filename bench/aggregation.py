@@ -20,10 +20,13 @@ on one thread.
 Part ``crack_conditioning``: the same over random straight cracks of the unit square
 (tip uniform in [0.3, 0.7]^2, any direction, running back to the boundary; two thirds
 passing within ``eps h`` of a node behind the tip), free lips, the boundary clamped,
-topological tip enrichment; the matrix is the one the solver factors, ``Z^T A Z`` of
-the tip transform (:mod:`xfem_contact.solvers.block_scaling`). ``--treatments`` picks
-the treatments of both parts, ``--tip-basis`` the cracks' tip basis (default ``"auto"``;
-another is written to ``aggregation_crack_conditioning_BASIS``).
+geometric tip enrichment of the default radius, set on the first crack (tip (0.5, 0.5),
+0.3 rad: ``r_e = 0.262``) and kept as the crack moves; the matrix is the one the solver
+factors, ``Z^T A Z`` of the tip transform (:mod:`xfem_contact.solvers.block_scaling`).
+``--treatments`` picks the treatments of both parts, ``--tip-basis`` the cracks' tip
+basis (default ``"auto"``; another is written to
+``aggregation_crack_conditioning_BASIS``), ``--tip-radius none`` the topological tip
+enrichment (the tip cells' nodes) instead of the zone.
 
 Condition numbers: the extreme eigenvalues of the symmetric scaled matrix (dense below
 1500 unknowns, else SLEPc: Krylov-Schur, shift-and-invert at 0 with an LU for the least
@@ -43,7 +46,7 @@ its rate and the condition number of the matrix the solver factors (tip-transfor
 
 Run: ``python bench/aggregation.py [--parts conditioning crack_conditioning accuracy
 crack] [--circles 30] [--sizes 8 16 32] [--treatments none "aggregation 0.25"]
-[--tip-basis plain] [--dense-below 0] [--name NAME]``; writes
+[--tip-basis plain] [--tip-radius none] [--dense-below 0] [--name NAME]``; writes
 ``bench/results/aggregation.{json,md}`` (conditioning; ``NAME.{json,md}`` with
 ``--name``),
 ``bench/results/aggregation_crack_conditioning.{json,md}``,
@@ -170,9 +173,12 @@ def crack_levelsets(tip, angle):
     return phi, psi
 
 
-def free_crack(mesh, tip, angle, degree, ghost_penalty, aggregation, tip_basis="auto") -> Problem:
-    """A crack with free lips in the unit square, its boundary clamped, topological tip
-    enrichment (the tip cell's nodes), the tip basis ``tip_basis``."""
+def free_crack(
+    mesh, tip, angle, degree, ghost_penalty, aggregation, tip_basis="auto", tip_radius="auto"
+) -> Problem:
+    """A crack with free lips in the unit square, its boundary clamped, geometric tip
+    enrichment of the default radius (of this crack; kept by ``update_interface``) or
+    ``tip_radius`` (None: topological), the tip basis ``tip_basis``."""
     phi, psi = crack_levelsets(tip, angle)
     cut = CutMesh(mesh, phi, degree=degree, tangent=psi)
     problem = Problem(
@@ -183,6 +189,7 @@ def free_crack(mesh, tip, angle, degree, ghost_penalty, aggregation, tip_basis="
         ghost_penalty=ghost_penalty,
         aggregation=aggregation,
         tip_basis=tip_basis,
+        tip_radius=tip_radius,
     )
     zero = lambda x: np.zeros((2, x.shape[1]))  # noqa: E731
     on_boundary = lambda x: (  # noqa: E731
@@ -341,6 +348,12 @@ def main() -> None:
         help="the cracks' tip basis (crack_conditioning; 'shifted' refuses aggregation)",
     )
     parser.add_argument(
+        "--tip-radius",
+        default="auto",
+        choices=["auto", "none"],
+        help="the cracks' tip enrichment: the default zone, or the tip cells' nodes (none)",
+    )
+    parser.add_argument(
         "--dense-below",
         type=int,
         default=1500,
@@ -381,7 +394,14 @@ def conditioning(args, kind: str = "interface") -> None:
                     )
                 else:
                     problem = free_crack(
-                        mesh, (0.5, 0.5), 0.3, degree, ghost_penalty, aggregation, args.tip_basis
+                        mesh,
+                        (0.5, 0.5),
+                        0.3,
+                        degree,
+                        ghost_penalty,
+                        aggregation,
+                        args.tip_basis,
+                        None if args.tip_radius == "none" else "auto",
                     )
                 for a, b, c in samples:
                     if kind == "interface":
@@ -427,6 +447,8 @@ def conditioning(args, kind: str = "interface") -> None:
     name = "aggregation" if kind == "interface" else "aggregation_crack_conditioning"
     if kind == "crack" and args.tip_basis != "auto":
         name += f"_{args.tip_basis}"
+    if kind == "crack" and args.tip_radius != "auto":
+        name += "_topological"
     name = args.name or name
     (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
     (RESULTS / f"{name}.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))

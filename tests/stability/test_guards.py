@@ -1,12 +1,14 @@
 """Each stability test fails with the guard it checks switched off.
 
 Guards: the ghost penalty (cut fractions), cell aggregation (cut fractions without the
-ghost penalty; the stabilised pair's inf-sup constant), the harmonic-mean augmentation
+ghost penalty; the stabilised pair's inf-sup constant; a crack's slivers next to its
+tip), the harmonic-mean augmentation
 (stiffness contrast), the Coulomb clamp (friction cone), the objective bulk (a large
 rotation in one step or ten). The LBB check carries its own counter-test (``lbb="none"``).
 Marked ``guards``: ``pytest -m guards`` runs these alone.
 """
 
+import dolfinx.la
 import pytest
 import test_aggregation
 import test_cuts
@@ -15,6 +17,7 @@ import test_inf_sup
 import test_materials
 import test_rotation
 
+import xfem_contact.fem.aggregation as aggregation_module
 import xfem_contact.mechanics.problem as problem_module
 from xfem_contact.mechanics.bulk import SmallStrain
 from xfem_contact.mechanics.laws import contact
@@ -45,6 +48,22 @@ def without_aggregation_in_the_inf_sup_test(monkeypatch):
     return test_inf_sup.test_aggregation_keeps_the_stabilised_constant_bounded
 
 
+def without_aggregation_next_to_a_tip(monkeypatch):
+    eligible = aggregation_module._eligible_cells
+
+    def away_from_tied_dofs(space):  # cells holding a tied dof never badly cut
+        cells = eligible(space)
+        tied = dolfinx.la.vector(space.W.dofmap.index_map, space.W.dofmap.index_map_bs)
+        tied.array[space.ties.ravel()] = 1.0
+        tied.scatter_forward()
+        for field in (0, 1):
+            cells &= ~(tied.array[space.W.sub(field).dofmap.list[: cells.size]] > 0).any(axis=1)
+        return cells
+
+    monkeypatch.setattr(aggregation_module, "_eligible_cells", away_from_tied_dofs)
+    return lambda: test_aggregation.test_a_sliver_next_to_a_crack_tip_is_aggregated("triangle")
+
+
 def with_arithmetic_mean_augmentation(monkeypatch):
     monkeypatch.setattr(
         contact.ContactLaw,
@@ -70,6 +89,7 @@ GUARDS = {
     "ghost penalty": without_ghost_penalty,
     "cell aggregation": without_aggregation,
     "cell aggregation (inf-sup)": without_aggregation_in_the_inf_sup_test,
+    "cell aggregation next to a crack tip": without_aggregation_next_to_a_tip,
     "harmonic-mean augmentation": with_arithmetic_mean_augmentation,
     "Coulomb clamp": without_coulomb_clamp,
     "objective bulk": with_small_strain_bulk,

@@ -27,11 +27,13 @@ interface cells are all badly cut takes a root's multiplier polynomial, the root
 through the cells that carry the interface. Multiplier dofs that a law's multiplier
 prolongation (the LBB restriction) already replaces stay its own.
 
-A crack's cells are aggregated only where the crack crosses them: its tip cells, the
-cells cut by its extension ahead of a tip and the cells holding a tied dof (a node whose
-support the crack does not cut completely) are never badly cut, and tied dofs are never
-constrained. The branch unknowns and the ramp are unchanged: in the tip zone only the
-side fields of badly cut cells are extended.
+A crack's cells are aggregated only where the crack crosses them: its tip cells and the
+cells cut by its extension ahead of a tip are never badly cut (their nodes are tied: one
+unknown for both sides, whatever a side's share), and tied dofs are never constrained.
+A crossed cell next to a tip cell is aggregated like any other, its untied dofs extended
+and its tied ones kept: its sliver on one side leaves that side's untied dofs with
+nothing else in their support. The branch unknowns and the ramp are unchanged: in the
+tip zone only the side fields of badly cut cells are extended.
 
 All arrays here are process-local unless stated; the functions that gather are
 collective. The cells and roots are gathered on every process (interface-sized data).
@@ -173,21 +175,12 @@ def aggregate(space: EnrichedSpace, threshold: float, active: npt.NDArray[np.boo
 
 def _eligible_cells(space: EnrichedSpace) -> np.ndarray:
     """Per owned cell: whether it may be badly cut (a cut cell; with a crack, one it
-    crosses none of whose dofs is tied). Collective."""
+    crosses, with or without tied dofs). Not collective."""
     cut = space.cut
-    n = cut.cell_sides.size
-    eligible = np.zeros(n, dtype=bool)
+    eligible = np.zeros(cut.cell_sides.size, dtype=bool)
     eligible[cut.cut_cells] = True
-    if cut.crack is None:
-        return eligible
-    eligible[cut.cut_cells[cut.crack.kind != CROSSED]] = False
-    imap = space.W.dofmap.index_map
-    tied = dolfinx.la.vector(imap, space.W.dofmap.index_map_bs)
-    tied.array[space.ties.ravel()] = 1.0
-    tied.scatter_forward()
-    near_tip = tied.array > 0
-    for field in (0, 1):
-        eligible &= ~near_tip[space.W.sub(field).dofmap.list[:n]].any(axis=1)
+    if cut.crack is not None:
+        eligible[cut.cut_cells[cut.crack.kind != CROSSED]] = False
     return eligible
 
 
@@ -265,7 +258,9 @@ def _field_aggregation(space, field, owned_codes, active) -> Aggregation:
     dofmap = W.sub(field).dofmap.list
     degree = _field_degree(space, field)
     element = basix.ufl.element("Lagrange", mesh.basix_cell(), degree).basix_element
-    nodes = cut.maps.push_forward_lattice(bad, element.points).reshape(bad.size, -1, gdim)
+    # (cells, nodes, gdim), also for a process without badly cut cells
+    lattice = cut.maps.push_forward_lattice(bad, element.points)
+    nodes = lattice.reshape(bad.size, element.points.shape[0], gdim)
     bs = dofmap.shape[1] // element.dim  # the field's components
     mine = candidate[dofmap[bad].ravel()]
     local_dof = dofmap[bad].ravel()[mine]
