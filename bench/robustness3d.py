@@ -18,7 +18,8 @@ the whole error is that of the cut rules' quadrature, 1e-6 to 1e-5, whose spread
 about its median says nothing a user would act on.
 
 Run: ``python bench/robustness3d.py [--count 100] [--n 4] [--degree 2] [--cell
-tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--aggregation 0.15] [--write]
+tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--aggregation 0.15]
+[--stabilization-length cut] [--write]
 [--name NAME]``;
 prints one row per run, the iteration histogram and the failures per law; ``--write``
 writes ``bench/results/robustness3d.{json,md}`` (``robustness3d_hexahedron.*`` on
@@ -101,12 +102,13 @@ def run(
     degree: int,
     cell: str = "tetrahedron",
     aggregation: float | None = None,
+    stabilization_length: str = "cell",
 ) -> dict:
     """One solve: its Newton iterations, convergence, pressure error, NaN and the
     warnings or the error it raised; ``aggregation``: the problem's cell aggregation
-    threshold (None: off)."""
+    threshold (None: off); ``stabilization_length``: the laws' (``"cell"`` or ``"cut"``)."""
     name, options, stress = LAWS[law]
-    options = options | {"aggregation": aggregation}
+    options = options | {"aggregation": aggregation, "stabilization_length": stabilization_length}
     levelset, normals = quadric(placement)
     row = {"law": law, "shape": placement["shape"], "iterations": None, "error": None}
     start = time.perf_counter()
@@ -254,6 +256,12 @@ def main() -> None:
     parser.add_argument(
         "--aggregation", type=float, default=None, help="cell aggregation threshold (default: off)"
     )
+    parser.add_argument(
+        "--stabilization-length",
+        choices=["cell", "cut"],
+        default="cell",
+        help="length of the Barbosa-Hughes scale (the laws' stabilization_length)",
+    )
     parser.add_argument("--write", action="store_true", help="write bench/results/")
     parser.add_argument(
         "--render", action="store_true", help="rewrite the .md from the .json run before"
@@ -279,7 +287,15 @@ def main() -> None:
         if index < done or (args.placements and index not in args.placements):
             continue
         for law in args.laws:
-            row = run(placement, law, args.n, args.degree, args.cell, args.aggregation)
+            row = run(
+                placement,
+                law,
+                args.n,
+                args.degree,
+                args.cell,
+                args.aggregation,
+                args.stabilization_length,
+            )
             row |= {"index": index}
             rows.append(row)
             error = "-" if row["error"] is None else f"{row['error']:.2e}"
