@@ -33,8 +33,8 @@ SIMPLICES = ("triangle", "tetrahedron")
 #: Eigenvalues of a side's mass matrix below this share of its largest are raised to
 #: it (a degenerate side: a tiny trace length, never a division by zero)
 REGULARIZATION = 1e-10
-#: Points per chunk of the per-cell mass matrices (bounds the memory of the outer
-#: products: ``POINTS * dim(S)^2`` floats)
+#: Points per chunk of the per-cell mass matrices (bounds the memory of the monomials'
+#: values: ``POINTS`` times the number of distinct products of two monomials of ``S``)
 POINTS = 20_000
 
 
@@ -85,13 +85,13 @@ def trace_lengths(
     )
     spread = np.sqrt(np.maximum(spread / mass[:, None], 1e-24))
 
-    def basis(rules: RuleSet) -> npt.NDArray[np.float64]:
+    def masses(rules: RuleSet, weights: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         r = rules.point_rows
         X = (rules.points - centre[r]) / spread[r]
-        return np.prod(X[:, None, :] ** exponents[None, :, :], axis=2)
+        return _cell_masses(rules, X, weights, exponents)
 
-    M_side = _cell_masses(side, basis(side), w_side)
-    M_gamma = _cell_masses(interface, basis(interface), interface.weights * interface_det)
+    M_side = masses(side, w_side)
+    M_gamma = masses(interface, interface.weights * interface_det)
     lengths = np.zeros(nrows)
     present = (side.sums(w_side) > 0) & (interface.sums(interface.weights) > 0)
     Ms, Mg = M_side[present], M_gamma[present]
@@ -105,21 +105,37 @@ def trace_lengths(
 
 
 def _cell_masses(
-    rules: RuleSet, values: npt.NDArray[np.float64], weights: npt.NDArray[np.float64]
+    rules: RuleSet,
+    X: npt.NDArray[np.float64],
+    weights: npt.NDArray[np.float64],
+    exponents: npt.NDArray[np.int64],
 ) -> npt.NDArray[np.float64]:
-    """Per rule, ``sum_q w_q phi(x_q) phi(x_q)^T``, shape ``(nrows, m, m)`` (``values``
-    ``(npoints, m)``), accumulated :data:`POINTS` points at a time."""
-    m = values.shape[1]
-    out = np.zeros((rules.num_rules, m, m))
+    """Per rule, the mass matrix ``sum_q w_q phi_i(X_q) phi_j(X_q)`` of the monomials
+    ``phi_i = X^exponents[i]``, shape ``(nrows, m, m)``, from the moments of the
+    distinct products ``X^(e_i + e_j)``, :data:`POINTS` points at a time."""
+    m, tdim = exponents.shape
+    sums = (exponents[:, None, :] + exponents[None, :, :]).reshape(-1, tdim)
+    products, entry = np.unique(sums, axis=0, return_inverse=True)
+    moments = np.zeros((rules.num_rules, len(products)))
     rows = rules.point_rows
+    top = int(products.max(initial=0))
     for start in range(0, rows.size, POINTS):
         part = slice(start, start + POINTS)
-        v, r = values[part], rows[part]
+        x, r = X[part].T, rows[part]
+        powers = [np.ones_like(x), np.ascontiguousarray(x)]  # x^e, (tdim, npoints)
+        for _ in range(2, top + 1):
+            powers.append(powers[-1] * powers[1])
+        values = np.empty((len(products), x.shape[1]))
+        for k, exponent in enumerate(products):
+            values[k] = weights[part]
+            for axis, e in enumerate(exponent):
+                if e:
+                    values[k] *= powers[e][axis]
         # the points of a rule are consecutive: sum each run of equal rows
         first = np.flatnonzero(np.r_[True, r[1:] != r[:-1]])
-        outer = weights[part, None, None] * v[:, :, None] * v[:, None, :]
-        out[r[first]] += np.add.reduceat(outer, first, axis=0)
-    return out
+        if first.size:
+            moments[r[first]] += np.add.reduceat(values, first, axis=1).T
+    return moments[:, entry.ravel()].reshape(-1, m, m)
 
 
 def side_trace_lengths(cut: CutMesh, name: str | None, degree: int) -> dict[int, np.ndarray]:
@@ -129,10 +145,21 @@ def side_trace_lengths(cut: CutMesh, name: str | None, degree: int) -> dict[int,
     interface = cut.interface_rules_of(name)
     cells = cut.cut_cells
 
-    def det(rules: RuleSet) -> npt.NDArray[np.float64]:
-        return np.abs(np.linalg.det(cut.maps.jacobian(cells[rules.point_rows], rules.points)))
-
     cell_name = cut.mesh.topology.cell_name()
+    if cut.maps.coordinate_element.degree == 1 and cell_name in SIMPLICES:
+        # affine cells: one Jacobian a cell
+        origin = np.zeros((cells.size, cut.mesh.topology.dim))
+        per_cell = np.abs(np.linalg.det(cut.maps.jacobian(cells, origin)))
+
+        def det(rules: RuleSet) -> npt.NDArray[np.float64]:
+            return per_cell[rules.point_rows]
+
+    else:
+
+        def det(rules: RuleSet) -> npt.NDArray[np.float64]:
+            J = cut.maps.jacobian(cells[rules.point_rows], rules.points)
+            return np.abs(np.linalg.det(J))
+
     interface_det = det(interface)
     out = {}
     for s, slot in ((-1, SIDE_MINUS), (1, SIDE_PLUS)):
