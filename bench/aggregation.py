@@ -36,7 +36,8 @@ Part ``accuracy``: the contact pressure's relative L2 error of paper case 2 (sti
 P2 on quadrilaterals and triangles, n = 10, 20, 40) and case 3 (the annulus, alpha = 0,
 P2 on curved Q2 cells, 4 x 16, 8 x 32, 16 x 64) with the default treatment (ghost
 penalty 0.01), none (no ghost penalty, the dofs of empty support dropped), aggregation
-(0.25, 0.15) on top of the ghost penalty, and aggregation alone.
+(0.25, 0.15) on top of the ghost penalty, aggregation alone, and the Barbosa-Hughes scale
+of the cut (``stabilization_length="cut"``) with the ghost penalty.
 
 Part ``crack``: the Williams crack on Q2 quadrilaterals (geometric tip enrichment,
 r_e = 0.3), n = 32, 64, 128, without and with ``aggregation=0.25`` (the default tip
@@ -263,6 +264,7 @@ ACCURACY_TREATMENTS = {
     "ghost penalty 0.01 + aggregation 0.25": {"aggregation": 0.25},
     "ghost penalty 0.01 + aggregation 0.15": {"aggregation": 0.15},
     "aggregation 0.25 alone": {"aggregation": 0.25, "ghost_penalty": 0.0},
+    "ghost penalty 0.01, stabilization length 'cut'": {"stabilization_length": "cut"},
 }
 
 

@@ -18,7 +18,8 @@ The studies (``--study``):
   through a node to 1e-6 h).
 
 The treatments (``--treatments``): none, restriction, stabilized; stabilized with the
-ghost penalty raised to the stabilisation's weight (0.1) or with cell aggregation.
+ghost penalty raised to the stabilisation's weight (0.1), with cell aggregation, or with
+the scale of the cut (``stabilization_length="cut"``).
 Prints, per element, treatment and n, the least and median beta, the count of
 indefinite pairs (beta^2 < 0; without a treatment, round-off of a zero eigenvalue: a
 spurious multiplier), the count of samples whose displacement block has a negative
@@ -86,11 +87,12 @@ DEFAULT_ELEMENTS = {
 }
 #: label: (lbb, ghost penalty, cell aggregation; None: the default)
 TREATMENTS = {
-    "none": ("none", None, None),
-    "restriction": ("restriction", None, None),
-    "stabilized": ("stabilized", None, None),
-    "stabilized, ghost 0.1": ("stabilized", 0.1, None),
-    "stabilized, aggregation 0.25": ("stabilized", None, 0.25),
+    "none": ("none", None, None, "cell"),
+    "restriction": ("restriction", None, None, "cell"),
+    "stabilized": ("stabilized", None, None, "cell"),
+    "stabilized, ghost 0.1": ("stabilized", 0.1, None, "cell"),
+    "stabilized, aggregation 0.25": ("stabilized", None, 0.25, "cell"),
+    "stabilized, cut length": ("stabilized", None, None, "cut"),
 }
 #: The treatments of each study's default result (the others: ``--treatments``); a crack
 #: refuses the stabilisation (it squares the tip's singular traction on the lips)
@@ -192,8 +194,8 @@ def sample(
 ) -> tuple[list[InfSup] | None, str]:
     """The :class:`InfSup` of each cut of one mesh and ``""``; or None and the reason the
     problem refuses the treatment."""
-    treatment, ghost_penalty, aggregation = TREATMENTS[lbb]
-    law = Bonded(lbb=treatment, multiplier_degree=multiplier)
+    treatment, ghost_penalty, aggregation, length = TREATMENTS[lbb]
+    law = Bonded(lbb=treatment, multiplier_degree=multiplier, stabilization_length=length)
     out = []
     for cut in CUTS[study](n, cell, degree, count):
         try:

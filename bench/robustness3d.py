@@ -18,13 +18,17 @@ the whole error is that of the cut rules' quadrature, 1e-6 to 1e-5, whose spread
 about its median says nothing a user would act on.
 
 Run: ``python bench/robustness3d.py [--count 100] [--n 4] [--degree 2] [--cell
-tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--aggregation 0.15] [--write]
+tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--aggregation 0.15]
+[--stabilization-length cut] [--inf-sup] [--write]
 [--name NAME]``;
 prints one row per run, the iteration histogram and the failures per law; ``--write``
 writes ``bench/results/robustness3d.{json,md}`` (``robustness3d_hexahedron.*`` on
 hexahedra, ``NAME.*`` with ``--name``),
 ``--render`` rewrites the ``.md`` from the ``.json``, ``--resume`` goes on from it;
-``--placements I J ...`` runs only those (the medians are then theirs).
+``--placements I J ...`` runs only those (the medians are then theirs); ``--inf-sup``
+prints, per placement, the inf-sup constant of the ``bonded`` pair on the same cut
+(:func:`~xfem_contact.mechanics.inf_sup.inf_sup_constant`) and the negative eigenvalues
+of its displacement block (a stabilisation that took more than the bulk energy).
 """
 
 import argparse
@@ -41,6 +45,7 @@ import numpy as np
 from mpi4py import MPI
 
 from xfem_contact.cases.solid import TRIAXIAL, traction_errors, uniform_stress_problem
+from xfem_contact.mechanics.inf_sup import inf_sup_constant
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 #: Per run label: the law, its options and the uniform stress (Pa, principal values)
@@ -101,12 +106,13 @@ def run(
     degree: int,
     cell: str = "tetrahedron",
     aggregation: float | None = None,
+    stabilization_length: str = "cell",
 ) -> dict:
     """One solve: its Newton iterations, convergence, pressure error, NaN and the
     warnings or the error it raised; ``aggregation``: the problem's cell aggregation
-    threshold (None: off)."""
+    threshold (None: off); ``stabilization_length``: the laws' (``"cell"`` or ``"cut"``)."""
     name, options, stress = LAWS[law]
-    options = options | {"aggregation": aggregation}
+    options = options | {"aggregation": aggregation, "stabilization_length": stabilization_length}
     levelset, normals = quadric(placement)
     row = {"law": law, "shape": placement["shape"], "iterations": None, "error": None}
     start = time.perf_counter()
@@ -130,6 +136,20 @@ def run(
     row["warnings"] = sorted({f"{w.category.__name__}: {w.message}"[:200] for w in caught})
     row["seconds"] = time.perf_counter() - start
     return row
+
+
+def bonded_inf_sup(
+    placement: dict, n: int, degree: int, cell: str, aggregation, stabilization_length: str
+) -> str:
+    """The inf-sup constant of the ``bonded`` pair on ``placement``'s cut, in words."""
+    levelset, _ = quadric(placement)
+    options = {"aggregation": aggregation, "stabilization_length": stabilization_length}
+    problem = uniform_stress_problem(n, degree, "bonded", levelset, cell, **options)
+    result = inf_sup_constant(problem)
+    return (
+        f"bonded pair: beta^2 {result.beta_squared:.3g}, negative displacement modes "
+        f"{result.negative_displacement_modes}"
+    )
 
 
 def judge(rows: list[dict]) -> None:
@@ -254,6 +274,15 @@ def main() -> None:
     parser.add_argument(
         "--aggregation", type=float, default=None, help="cell aggregation threshold (default: off)"
     )
+    parser.add_argument(
+        "--stabilization-length",
+        choices=["cell", "cut"],
+        default="cell",
+        help="length of the Barbosa-Hughes scale (the laws' stabilization_length)",
+    )
+    parser.add_argument(
+        "--inf-sup", action="store_true", help="the bonded pair's inf-sup constant too"
+    )
     parser.add_argument("--write", action="store_true", help="write bench/results/")
     parser.add_argument(
         "--render", action="store_true", help="rewrite the .md from the .json run before"
@@ -279,7 +308,15 @@ def main() -> None:
         if index < done or (args.placements and index not in args.placements):
             continue
         for law in args.laws:
-            row = run(placement, law, args.n, args.degree, args.cell, args.aggregation)
+            row = run(
+                placement,
+                law,
+                args.n,
+                args.degree,
+                args.cell,
+                args.aggregation,
+                args.stabilization_length,
+            )
             row |= {"index": index}
             rows.append(row)
             error = "-" if row["error"] is None else f"{row['error']:.2e}"
@@ -287,6 +324,19 @@ def main() -> None:
                 f"#{index} {placement['shape']} {law}: iterations {row['iterations']}, "
                 f"pressure error {error}, {row['seconds']:.1f} s, "
                 f"warnings {len(row['warnings'])}, raised {row['raised']}",
+                flush=True,
+            )
+        if args.inf_sup:
+            print(
+                f"#{index} {placement['shape']} "
+                + bonded_inf_sup(
+                    placement,
+                    args.n,
+                    args.degree,
+                    args.cell,
+                    args.aggregation,
+                    args.stabilization_length,
+                ),
                 flush=True,
             )
         if args.write:  # after each placement: a stopped sweep keeps what it ran

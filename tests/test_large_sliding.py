@@ -282,6 +282,10 @@ def test_objectivity_a_right_angle_gives_the_unturned_pressures():
         (lambda: rotating_annulus_problem(4, 2, 0.1, slave=0), "slave must be"),
         (lambda: rotating_annulus_problem(4, 2, 0.1, pairing="sometimes"), "pairing must be"),
         (lambda: rotating_annulus_problem(4, 2, 0.1, outer="glue"), "outer support"),
+        (
+            lambda: rotating_annulus_problem(4, 2, 0.1, stabilization_length="cut"),
+            "stabilization_length 'cut' is not available in large sliding",
+        ),
     ],
 )
 def test_bad_input_is_one_clear_error(build, message):

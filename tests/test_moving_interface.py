@@ -88,3 +88,12 @@ def test_a_moving_contact_interface_starts_without_spurious_gaps(law, options, m
         report = problem.solve()
         assert report.iterations <= most, (k, report.iterations)
         problem.accept_step()
+
+
+@pytest.mark.mpi
+def test_the_scale_of_the_cut_follows_the_interface():
+    """``stabilization_length="cut"``: the sides' trace lengths are made anew on the new
+    cut, with no compile; the moved problem is the one built there."""
+    moved, _, fresh, _ = moved_and_fresh("sticking", stabilization_length="cut")
+    scale = np.abs(fresh.w.x.array).max()
+    assert np.abs(moved.w.x.array - fresh.w.x.array).max() < 1e-8 * scale

@@ -14,7 +14,9 @@ greedy covering gave 0.47, 0.29, 0.25, slope -0.19 on the last pair, and 0.59, 0
 on P2-P1). The Barbosa-Hughes stabilisation gives 0.36 on most cuts and an
 indefinite pair on some with the default ghost penalty (beta^2 = -16.8 for P2 triangles
 at n = 16 on one of four random circles; 0.13 with the ghost penalty raised to the
-stabilisation's weight): see ``bench/inf_sup.py``.
+stabilisation's weight): see ``bench/inf_sup.py``. The scale of the cut
+(``stabilization_length="cut"``) keeps the displacement block coercive by construction:
+on that circle no negative displacement mode and beta 0.29, 0.27, 0.26 on n = 8, 16, 32.
 """
 
 import xfem_contact  # noqa: F401  (before dolfinx)
@@ -191,13 +193,17 @@ def test_without_lbb_treatment_the_3d_constant_falls():
 INDEFINITE_SPHERE = (0.5322067495985089, 0.46294597531318177, 0.5905703620957422, 0.2387676915746)
 
 
-def sphere_least_eigenvalue(ghost_penalty=None) -> float:
+def sphere_inf_sup(ghost_penalty=None, length: str = "cell") -> InfSup:
     *c, r = INDEFINITE_SPHERE
     mesh = dolfinx.mesh.create_unit_cube(MPI.COMM_WORLD, 4, 4, 4)
     cut = CutMesh(mesh, lambda x: np.sqrt(((x.T - c) ** 2).sum(axis=1)) - r, degree=2)
-    law = Bonded(lbb="stabilized")
+    law = Bonded(lbb="stabilized", stabilization_length=length)
     problem = Problem(cut, 1, Material(100e6, 0.3), law, ghost_penalty=ghost_penalty)
-    return inf_sup_constant(problem).beta_squared
+    return inf_sup_constant(problem)
+
+
+def sphere_least_eigenvalue(ghost_penalty=None) -> float:
+    return sphere_inf_sup(ghost_penalty).beta_squared
 
 
 @pytest.mark.xfail(
@@ -206,6 +212,13 @@ def sphere_least_eigenvalue(ghost_penalty=None) -> float:
 )
 def test_the_3d_stabilisation_is_positive_with_the_defaults():
     assert sphere_least_eigenvalue() > 0.0
+
+
+def test_the_scale_of_the_cut_keeps_the_3d_pair_stable():
+    """``stabilization_length="cut"``: beta = 0.41 and no negative displacement mode on
+    the sphere where the cell's scale is indefinite (the expected failure above)."""
+    result = sphere_inf_sup(length="cut")
+    assert result.beta > FLOOR and result.negative_displacement_modes == 0, result
 
 
 def test_the_3d_stabilisation_is_positive_with_a_ghost_penalty_as_large_as_its_weight():
@@ -219,11 +232,15 @@ def test_the_3d_stabilisation_is_positive_with_a_ghost_penalty_as_large_as_its_w
 INDEFINITE = (0.5897298894274488, 0.4623662904020971, 0.21349896734588636)
 
 
-def indefinite_inf_sup(ghost_penalty=None, aggregation=None) -> InfSup:
+def indefinite_inf_sup(
+    ghost_penalty=None, aggregation=None, length="cell", n=16, comm=MPI.COMM_WORLD
+) -> InfSup:
     cx, cy, r = INDEFINITE
-    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 16, 16, dolfinx.mesh.CellType.triangle)
+    mesh = dolfinx.mesh.create_unit_square(
+        comm, n, n, dolfinx.mesh.CellType.triangle, partitioner=ghosted_partitioner()
+    )
     cut = CutMesh(mesh, lambda x: np.hypot(x[0] - cx, x[1] - cy) - r, degree=2)
-    law = Bonded(lbb="stabilized")
+    law = Bonded(lbb="stabilized", stabilization_length=length)
     problem = Problem(
         cut, 2, Material(100e6, 0.3), law, ghost_penalty=ghost_penalty, aggregation=aggregation
     )
@@ -252,6 +269,29 @@ def test_the_stabilisation_is_positive_with_the_defaults():
     assert least_eigenvalue() > 0.0
 
 
+def test_the_scale_of_the_cut_keeps_the_displacement_block_coercive():
+    """``stabilization_length="cut"`` on the circle where the cell's scale is indefinite
+    (the two tests above): no negative displacement mode, beta = 0.27."""
+    result = indefinite_inf_sup(length="cut")
+    assert result.beta > FLOOR and result.negative_displacement_modes == 0, result
+
+
+def test_the_scale_of_the_cut_keeps_the_constant_bounded():
+    """beta 0.29, 0.27, 0.26 on n = 8, 16, 32 with ``stabilization_length="cut"`` (the
+    cell's scale: 0.267, 0 (indefinite), 0.361)."""
+    values = [indefinite_inf_sup(length="cut", n=n).beta for n in SIZES]
+    assert min(values) > FLOOR, values
+    assert slope(values) >= SLOPE, values
+
+
+@pytest.mark.mpi
+def test_the_scale_of_the_cut_is_the_same_on_one_and_two_ranks():
+    """The sides' trace lengths (DG0, ghosts included) on two ranks."""
+    beta = indefinite_inf_sup(length="cut", n=8).beta
+    beta_self = indefinite_inf_sup(length="cut", n=8, comm=MPI.COMM_SELF).beta
+    assert abs(beta - beta_self) <= 1e-8 * beta_self
+
+
 def test_the_stabilisation_is_positive_with_a_ghost_penalty_as_large_as_its_weight():
     """beta^2 = 0.13 (beta 0.36) with the ghost penalty at the Barbosa-Hughes weight 0.1."""
     assert least_eigenvalue(ghost_penalty=0.1) > 0.1
@@ -271,6 +311,11 @@ def test_the_stabilisation_is_positive_with_cell_aggregation():
     well cut neighbour's polynomial (``aggregation=0.25``): the stress trace on a small
     cut is then that of a whole cell, which the bulk energy controls (-16.8 without)."""
     assert least_eigenvalue(aggregation=0.25) > 0.1
+
+
+def test_an_unknown_stabilization_length_is_refused():
+    with pytest.raises(ValueError, match="Unknown stabilization_length 'facet'"):
+        Bonded(stabilization_length="facet")
 
 
 def test_only_linear_laws_with_a_multiplier():

@@ -24,6 +24,7 @@ def interface_context(
     side_indicator: dolfinx.fem.Function,
     cell_size: dolfinx.fem.Function,
     w_old: dolfinx.fem.Function,
+    degree: int,
     split: Callable = ufl.split,
     ramp: dolfinx.fem.Function | None = None,
     interpolants: dict | None = None,
@@ -38,6 +39,7 @@ def interface_context(
         side_indicator: DG0 side of each cell (-1, 0 cut, +1).
         cell_size: DG0 cell diameters (m).
         w_old: The last accepted state.
+        degree: The displacements' Lagrange degree.
         split: The fields of a Function on ``W`` (the space's ``split``).
         ramp: The ramp of a crack's branch functions (the space's), None without.
         interpolants: The interpolants subtracted from them (the space's), None without.
@@ -59,6 +61,7 @@ def interface_context(
         cut_cells=on_cut_cells,
         field=field,
         w_old=w_old,
+        degree=degree,
         split=split,
         ramp=ramp,
         interpolants=interpolants,

@@ -47,7 +47,7 @@ class ElasticityProblem(_LawFamily):
         law: ``"free"`` (default) or ``"bonded"``.
         options: Keyword-only: :class:`Problem`'s (``ghost_penalty``, ...) and the
             law's (``lbb``, ``multiplier_stabilization``, ``multiplier_extension``,
-            ``multiplier_degree`` for ``bonded``).
+            ``multiplier_degree``, ``stabilization_length`` for ``bonded``).
     """
 
     LAWS = INTERFACE_LAWS
@@ -67,7 +67,7 @@ class ContactProblem(_LawFamily):
         options: Keyword-only: :class:`Problem`'s (``ghost_penalty``, ``kinematics``,
             ``slave``, ``pairing``, ...) and the law's (``friction``, required by
             ``"coulomb"``; ``augmentation``, ``lbb``, ``multiplier_stabilization``,
-            ``multiplier_extension``, ``multiplier_degree``).
+            ``multiplier_extension``, ``multiplier_degree``, ``stabilization_length``).
     """
 
     LAWS = CONTACT_LAWS

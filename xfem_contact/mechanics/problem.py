@@ -171,6 +171,7 @@ class Problem:
                 self.side_indicator,
                 self.cell_size,
                 self.w_old,
+                self.space.degree,
                 self.space.split,
                 self.space.ramp,
                 self.space.interpolants,

@@ -38,6 +38,7 @@ import ufl
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.evaluation import FieldSampler, rule_cells
+from xfem_contact.fem.trace_inverse import side_trace_lengths
 from xfem_contact.geometry.levelset import CellMaps, LevelSet
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.quadrature.rules import RuleSet
@@ -71,6 +72,7 @@ class InterfaceContext:
         cut_cells: 1 on the cut cells of this interface, 0 elsewhere (UFL, cellwise).
         field: Index of the law's multiplier field in the mixed space (None without).
         w_old: The last accepted state (origin of incremental laws' slip).
+        degree: The displacements' Lagrange degree.
         aligned_cells: 1 on the cut cells whose interface piece follows a line of the
             cell's reference coordinates (trace nullity >= 2, see
             :meth:`~xfem_contact.fem.cutmesh.CutMesh.trace_nullity`), DG0; None when
@@ -92,6 +94,7 @@ class InterfaceContext:
     cut_cells: typing.Any
     field: int | None
     w_old: dolfinx.fem.Function
+    degree: int
     aligned_cells: dolfinx.fem.Function | None = None
     split: typing.Callable = ufl.split
     ramp: dolfinx.fem.Function | None = None
@@ -106,6 +109,26 @@ class InterfaceContext:
         if key not in self._cache:
             self._cache[key] = make()
         return self._cache[key]
+
+    def trace_lengths(self) -> dict[int, dolfinx.fem.Function]:
+        """``{-1: l_-, 1: l_+}``: each side's trace length on the interface's cut cells
+        (m, DG0 on :attr:`cell_size`'s space, 0 elsewhere; see
+        :mod:`xfem_contact.fem.trace_inverse`): ``int_Gamma_T p^2 ds <= int_T_s p^2 dx /
+        l_s`` for the strains ``p`` of a side. Made once per context, that is per cut.
+        Collective."""
+
+        def make():
+            V0 = self.cell_size.function_space
+            cells = V0.dofmap.list[self.cut.cut_cells, 0]
+            out = {}
+            for side, lengths in side_trace_lengths(self.cut, self.name, self.degree).items():
+                f = dolfinx.fem.Function(V0, name=f"trace_length_{side:+d}")
+                f.x.array[cells] = lengths
+                f.x.scatter_forward()
+                out[side] = f
+            return out
+
+        return self.once("trace_lengths", make)
 
     @property
     def gdim(self) -> int:

@@ -33,6 +33,10 @@ from xfem_contact.mechanics.lbb_space import vital_vertex_prolongation
 from xfem_contact.mechanics.parameters import Parameter, constant
 
 LBB_OPTIONS = ("stabilized", "restriction", "none")
+#: The lengths the Barbosa-Hughes scale may take (see ``MultiplierLaw.stabilization_scale``)
+STABILIZATION_LENGTHS = ("cell", "cut")
+#: The default weight ``gamma`` of the Barbosa-Hughes term with each length
+STABILIZATION_WEIGHTS = {"cell": 0.1, "cut": 0.5}
 #: Lagrange degrees of a multiplier field
 MULTIPLIER_DEGREES = (1, 2)
 #: Weight of the normal-gradient term on cells where the interface follows a reference
@@ -46,29 +50,40 @@ class MultiplierLaw(InterfaceLaw):
     Args:
         lbb: ``"stabilized"``, ``"restriction"`` or ``"none"``.
         multiplier_stabilization: Weight ``gamma`` of the Barbosa-Hughes term
-            (used with ``lbb="stabilized"``); a Constant of the forms.
+            (used with ``lbb="stabilized"``); a Constant of the forms. Default (None):
+            that of :data:`STABILIZATION_WEIGHTS` for ``stabilization_length``.
         multiplier_extension: Weight of the normal-gradient term (see
             :meth:`extension_form`; not with ``lbb="none"``); a Constant of the forms.
         multiplier_degree: Lagrange degree of the multiplier on the cut cells (one of
             :data:`MULTIPLIER_DEGREES`): 1 on their vertices, 2 on their vertices and
             edge nodes (with ``lbb="restriction"`` the vital nodes of
             :func:`~xfem_contact.mechanics.lbb_space.vital_vertex_prolongation`).
+        stabilization_length: The length of the Barbosa-Hughes scale (one of
+            :data:`STABILIZATION_LENGTHS`): ``"cell"`` the cell's diameter, ``"cut"`` the
+            sides' trace lengths in each cut cell (see :meth:`stabilization_scale`).
     """
 
     multiplier_stabilization = Parameter(minimum=0.0)
     multiplier_extension = Parameter(minimum=0.0)
     lbb = FixedAtConstruction()
     multiplier_degree = FixedAtConstruction()
+    stabilization_length = FixedAtConstruction()
 
     def __init__(
         self,
         lbb: str = DEFAULT.lbb,
-        multiplier_stabilization: float = DEFAULT.multiplier_stabilization,
+        multiplier_stabilization: float | None = DEFAULT.multiplier_stabilization,
         multiplier_extension: float = DEFAULT.multiplier_extension,
         multiplier_degree: int = DEFAULT.multiplier_degree,
+        stabilization_length: str = DEFAULT.stabilization_length,
     ):
         if lbb not in LBB_OPTIONS:
             raise ValueError(f"Unknown LBB treatment {lbb!r}; valid: {LBB_OPTIONS}")
+        if stabilization_length not in STABILIZATION_LENGTHS:
+            raise ValueError(
+                f"Unknown stabilization_length {stabilization_length!r}; valid: "
+                f"{STABILIZATION_LENGTHS}"
+            )
         integer = isinstance(multiplier_degree, numbers.Integral)
         if (
             not integer
@@ -80,6 +95,9 @@ class MultiplierLaw(InterfaceLaw):
             )
         self.lbb = lbb
         self.multiplier_degree = int(multiplier_degree)
+        self.stabilization_length = stabilization_length
+        if multiplier_stabilization is None:
+            multiplier_stabilization = STABILIZATION_WEIGHTS[stabilization_length]
         self.multiplier_stabilization = multiplier_stabilization
         self.multiplier_extension = multiplier_extension
 
@@ -94,7 +112,11 @@ class MultiplierLaw(InterfaceLaw):
         return self.lbb != "none"
 
     def describe(self) -> dict:
-        return super().describe() | {"lbb": self.lbb, "multiplier_degree": self.multiplier_degree}
+        return super().describe() | {
+            "lbb": self.lbb,
+            "multiplier_degree": self.multiplier_degree,
+            "stabilization_length": self.stabilization_length,
+        }
 
     def prolongation(self, ctx: InterfaceContext, space):
         if self.lbb != "restriction":
@@ -103,12 +125,34 @@ class MultiplierLaw(InterfaceLaw):
 
     # -- LBB terms ----------------------------------------------------------------------
     @staticmethod
-    def traction_weights(ctx: InterfaceContext) -> tuple:
-        """Weights ``(w_-, w_+)`` of the sides in the interface traction average:
-        ``w_- = mu_+ / (mu_- + mu_+)``, ``w_+ = mu_- / (mu_- + mu_+)`` (1/2 each for
-        one material). The softer side weighs more, as in weighted Nitsche methods: with
-        the plain mean a much stiffer inclusion's contact pressure oscillates (docs'
-        mechanics page)."""
+    def side_compliances(ctx: InterfaceContext) -> dict:
+        """Per side ``s``, ``c_s = l_s / (2 mu_s + lambda_s)`` (m/Pa, UFL, cellwise):
+        the side's trace length (:meth:`InterfaceContext.trace_lengths`) over its
+        P-wave modulus. ``int_Gamma_T |sigma_s n|^2 ds <= a_T_s(u, u) / c_s`` on every
+        cut cell ``T`` (``a_T_s`` the side's elastic energy in ``T``): ``|sigma n|^2 <=
+        (2 mu + lambda) sigma : eps`` pointwise, with the plane-stress ``lambda`` in
+        plane stress."""
+        lengths = ctx.trace_lengths()
+        m = ctx.materials
+        return {s: lengths[s] / (2.0 * m[s].ufl_mu + m[s].ufl_lmbda) for s in (-1, 1)}
+
+    def traction_weights(self, ctx: InterfaceContext) -> tuple:
+        """Weights ``(w_-, w_+)`` of the sides in the interface traction average (UFL).
+
+        ``stabilization_length="cell"``: ``w_- = mu_+ / (mu_- + mu_+)``, ``w_+ = mu_- /
+        (mu_- + mu_+)`` (1/2 each for one material): the softer side weighs more, as in
+        weighted Nitsche methods (with the plain mean a much stiffer inclusion's
+        contact pressure oscillates: docs' mechanics page).
+
+        ``"cut"``: ``w_s = c_s / (c_- + c_+)`` per cut cell (:meth:`side_compliances`):
+        the side with the larger share of the cell and the softer side weigh more (the
+        volume and stiffness weights of Annavarapu, Hautefeuille and Dolbow 2012); a
+        side that holds a sliver of the cell weighs nothing.
+        """
+        if self.stabilization_length == "cut":
+            c = self.side_compliances(ctx)
+            total = c[-1] + c[1]
+            return c[-1] / total, c[1] / total
         mu_minus, mu_plus = ctx.materials[-1].ufl_mu, ctx.materials[1].ufl_mu
         return mu_plus / (mu_minus + mu_plus), mu_minus / (mu_minus + mu_plus)
 
@@ -121,12 +165,26 @@ class MultiplierLaw(InterfaceLaw):
         return stress * ctx.normal
 
     def stabilization_scale(self, ctx: InterfaceContext) -> ufl.core.expr.Expr:
-        """``gamma h / (4 sum_s w_s^2 mu_s)`` (m/Pa) of the multiplier stabilisation
-        (UFL): ``gamma h / (2 mu)`` for one material; for two, the shear modulus the
-        weighted traction average sees (see :meth:`traction_weights`)."""
+        """The scale ``s`` (m/Pa, UFL) of the multiplier stabilisation.
+
+        ``stabilization_length="cell"``: ``gamma h / (4 sum_s w_s^2 mu_s)`` (``gamma h /
+        (2 mu)`` for one material; ``h`` the cell's diameter, ``w_s`` of
+        :meth:`traction_weights`).
+
+        ``"cut"``: ``gamma (c_- + c_+)`` per cut cell (:meth:`side_compliances`). With
+        the weights ``w_s = c_s / (c_- + c_+)`` it bounds what the displacement block
+        loses, ``s int_Gamma_T |t(u)|^2 ds <= gamma a_T(u, u)`` on every cut cell ``T``:
+        the block keeps ``(1 - gamma)`` of the elastic energy for ``gamma < 1`` however
+        the interface cuts, and ``s`` stays at least ``gamma`` times the larger side's
+        compliance (docs' stability page).
+        """
+        gamma = constant(self, "multiplier_stabilization")
+        if self.stabilization_length == "cut":
+            c = self.side_compliances(ctx)
+            return gamma * (c[-1] + c[1])
         w_minus, w_plus = self.traction_weights(ctx)
         shear = w_minus**2 * ctx.materials[-1].ufl_mu + w_plus**2 * ctx.materials[1].ufl_mu
-        return constant(self, "multiplier_stabilization") * ctx.cell_size / (4.0 * shear)
+        return gamma * ctx.cell_size / (4.0 * shear)
 
     def stabilization_form(self, ctx: InterfaceContext, lam, mu, u: Fields, v: Fields):
         """Barbosa-Hughes term ``s int (lambda - t(u)).(mu - t(v))`` (``s`` the

@@ -51,9 +51,10 @@ class SlidingContact(ContactLaw):
             feet of its points cross master-piece ends, a Gauss rule per sub-segment
             (:mod:`~xfem_contact.mechanics.sliding.segments`); False: the interface
             rule's points. An attribute, settable between solves.
-        augmentation, lbb, multiplier_stabilization, multiplier_extension, multiplier_degree:
-            As for :class:`~xfem_contact.mechanics.laws.contact.Frictionless` (``lbb``:
-            ``"stabilized"`` or ``"none"``).
+        augmentation, lbb, multiplier_stabilization, multiplier_extension, multiplier_degree,
+            stabilization_length: As for
+            :class:`~xfem_contact.mechanics.laws.contact.Frictionless` (``lbb``:
+            ``"stabilized"`` or ``"none"``; ``stabilization_length``: ``"cell"`` only).
     """
 
     #: Large sliding
@@ -74,6 +75,11 @@ class SlidingContact(ContactLaw):
         if self.lbb not in SLIDING_LBB:
             raise ValueError(
                 f"lbb {self.lbb!r} is not available in large sliding; valid: {SLIDING_LBB}"
+            )
+        if self.stabilization_length != "cell":
+            raise ValueError(
+                f"stabilization_length {self.stabilization_length!r} is not available in "
+                "large sliding (its scale is the slave cell's); valid: ('cell',)"
             )
         if slave not in (-1, 1):
             raise ValueError(f"slave must be the side -1 or +1, got {slave!r}")

@@ -1,0 +1,76 @@
+"""The trace length of a cut cell's side (:mod:`xfem_contact.fem.trace_inverse`) against
+exact constants: ``|T_s| / |Gamma_T|`` for constant strains (P1 displacements), and the
+sharp trace inverse constant of linear polynomials on a triangle's edge (Warburton and
+Hesthaven 2003: ``int_F p^2 <= (k + 1)(k + d) / d |F| / |T| int_T p^2``, equality for
+some ``p``; ``k = 1``, ``d = 2``: 3) for P2 displacements, on a corner cut that leaves a
+small triangle similar to the cell."""
+
+import xfem_contact  # noqa: F401  (before dolfinx)
+
+# isort: split
+import dolfinx.mesh
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from xfem_contact.fem.cutmesh import CutMesh
+from xfem_contact.fem.trace_inverse import side_trace_lengths, strain_exponents
+
+#: The corner cut: the line x + y = T through the cell (0, 0), (1, 0), (0, 1) of a
+#: 1 x 1 mesh of two right triangles (the other cell is not cut)
+T = 0.05
+
+
+def corner_cut(cell: str = "triangle") -> CutMesh:
+    mesh = dolfinx.mesh.create_unit_square(
+        MPI.COMM_SELF, 1, 1, dolfinx.mesh.CellType[cell], diagonal=dolfinx.mesh.DiagonalType.left
+    )
+    return CutMesh(mesh, lambda x: x[0] + x[1] - T, degree=1)
+
+
+def test_constant_strains_give_the_side_area_over_the_interface_length():
+    cut = corner_cut()
+    assert cut.cut_cells.size == 1
+    lengths = side_trace_lengths(cut, None, 1)
+    gamma = T * np.sqrt(2.0)
+    small, large = T**2 / 2, 0.5 - T**2 / 2
+    assert lengths[-1][0] == pytest.approx(small / gamma, rel=1e-12)
+    assert lengths[1][0] == pytest.approx(large / gamma, rel=1e-12)
+
+
+def test_linear_strains_give_the_sharp_trace_inverse_constant():
+    """The small side is the triangle (0, 0), (T, 0), (0, T) and the interface its
+    hypotenuse: ``l_- = |T_-| / (3 |Gamma|)``."""
+    lengths = side_trace_lengths(corner_cut(), None, 2)
+    assert lengths[-1][0] == pytest.approx(T**2 / 2 / (3 * T * np.sqrt(2.0)), rel=1e-10)
+
+
+def test_the_trace_length_vanishes_with_the_share_of_the_side():
+    """The small side's length scales like ``T`` (its share like ``T^2``), the large
+    side's does not."""
+    lengths = side_trace_lengths(corner_cut("quadrilateral"), None, 2)
+    assert lengths[-1][0] < 0.1 * T and lengths[1][0] > 0.1
+
+
+@pytest.mark.parametrize(
+    ("cell", "degree", "tdim", "size"),
+    [
+        ("triangle", 1, 2, 1),
+        ("triangle", 2, 2, 3),
+        ("tetrahedron", 2, 3, 4),
+        ("quadrilateral", 1, 2, 3),
+        ("quadrilateral", 2, 2, 8),
+        ("hexahedron", 1, 3, 7),
+        ("hexahedron", 2, 3, 26),
+    ],
+)
+def test_the_strain_spaces(cell, degree, tdim, size):
+    """``P_(k-1)`` on simplices, ``Q_k`` without its top monomial on tensor cells (the
+    span of ``Q_k``'s partial derivatives)."""
+    exponents = strain_exponents(cell, degree, tdim)
+    assert exponents.shape == (size, tdim)
+
+
+def test_a_degree_below_one_is_refused():
+    with pytest.raises(ValueError, match="degree must be at least 1"):
+        strain_exponents("triangle", 0, 2)
