@@ -78,6 +78,7 @@ from xfem_contact.quadrature.saye import (
     _pieces,
     _subdivide,
     _tensor_rule,
+    certified_boxes,
     check_parameters,
 )
 from xfem_contact.quadrature.saye_axes import (
@@ -111,6 +112,7 @@ def truncated_saye_points(
     min_depth: int = 0,
     raise_tolerance: float | None = RAISE_TOLERANCE,
     exact: ExactLevelSet | None = None,
+    margin: np.ndarray | None = None,
 ) -> tuple[SayePoints, np.ndarray]:
     """Saye's rules on the reference tetrahedron of P2 polynomials (see the module).
 
@@ -132,6 +134,11 @@ def truncated_saye_points(
             the height intervals its signs and the interface's area vectors its gradient
             (:func:`~xfem_contact.geometry.exact_lines.central_gradient`). ``None``:
             ``C``'s zero set.
+        margin: Per cell ``(ncells,)``, a bound of ``|exact - psi|`` on it
+            (:func:`~xfem_contact.geometry.exact_margin.exact_margin`): above
+            ``max_depth`` a box lies on one side only when ``psi``'s Bernstein
+            coefficients are all ``< -margin`` or all ``>= margin`` (else its rules look
+            for ``exact``'s roots). ``None``: 0.
 
     Returns:
         The points of the resolved cells (a :class:`~xfem_contact.quadrature.saye.SayePoints`;
@@ -155,9 +162,8 @@ def truncated_saye_points(
         if cell.size == 0:
             break
         B = bernstein(C[cell], lo, hi)
-        flat = B.reshape(cell.size, -1)
         truncated = hi.sum(axis=1) > 1.0
-        sides = {"minus": (flat < 0).all(axis=1), "plus": (flat >= 0).all(axis=1)}
+        sides = certified_boxes(B, None if depth == max_depth else margin, cell)
         for side, whole in sides.items():
             plain = whole & ~truncated
             parts[side].append(_tensor_rule(cell[plain], lo[plain], hi[plain], gauss))
