@@ -32,12 +32,16 @@ the tensor machinery of :mod:`xfem_contact.geometry.tensor_levelset` applies unc
    :data:`RAISE_TOLERANCE` (reference units) between the two gets ``2 order`` points.
    These are the boxes near branch points of the roots (high curvature of the zero set
    in the cell, shallow slopes), where Gauss rules converge slowly; elsewhere the rules
-   keep ``order`` points.
+   keep ``order`` points. A raised box whose rules still move by more than
+   ``raise_tolerance`` from ``order`` to ``2 order`` points is subdivided (above
+   ``max_depth``).
 
 Given the level set that ``psi`` interpolates as a function (``exact``), the boxes and
-axes stay ``psi``'s, but the breakpoints of every line (the slanted face's included) are
-the function's roots near ``psi``'s, the sides of the height intervals its signs and the
-area vectors its gradient, as in :mod:`xfem_contact.quadrature.saye`.
+axes stay ``psi``'s (a box lies on one side only when ``psi``'s Bernstein coefficients
+keep their sign by the cell's ``margin``, a bound of ``|exact - psi|``), but the
+breakpoints of every line (the slanted face's included) are the function's roots near
+``psi``'s, the sides of the height intervals its signs and the area vectors its
+gradient, as in :mod:`xfem_contact.quadrature.saye`.
 
 Every breakpoint is a root of ``psi`` restricted to a straight line, every interval end
 an affine function of the outer coordinates: for a planar ``psi`` the rules integrate
@@ -189,12 +193,17 @@ def truncated_saye_points(
                 reduced.append(cell[fallback])
                 lone = [PAIRS.index((k, (k + 1) % 3)) for k in range(3)]
                 pair = np.where(fallback, np.take(lone, np.maximum(height, 0)), pair)
+        unsettled = []
         for index, (k3, k2) in enumerate(PAIRS):
-            group = pair == index
-            if group.any():
+            group = np.flatnonzero(pair == index)
+            if group.size:
                 box = (cell[group], lo[group], hi[group], k3, k2)
-                _raised_rules(C, box, order, parts, raise_tolerance, exact)
+                split = depth < max_depth
+                moving = _raised_rules(C, box, order, parts, raise_tolerance, exact, split)
+                unsettled.append(group[moving])
         subdivided = pair < 0
+        if unsettled:
+            subdivided[np.concatenate(unsettled)] = True
         if depth == max_depth:
             unresolved.append(cell[subdivided])
             break
@@ -220,16 +229,19 @@ def _gauss(order: int) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (gx + 1.0), 0.5 * gw
 
 
-def _raised_rules(C, box, order, parts, tolerance, exact):
+def _raised_rules(C, box, order, parts, tolerance, exact, split):
     """Nested rules of the cut truncated boxes ``box = (cell, lo, hi, k3, k2)`` with
     ``order`` points per interval, and ``2 order`` in the boxes whose rules move by more
     than ``tolerance`` from ``max(1, order - 1)`` points (see :func:`truncated_saye_points`),
-    appended to ``parts``."""
+    appended to ``parts``. With ``split``, a raised box whose rules still move by more
+    than ``tolerance`` from ``order`` to ``2 order`` points (Gauss rules converging
+    slowly: a branch point of the roots in or near the box) gets no rules; the mask
+    ``(m,)`` of those boxes is returned (to be subdivided)."""
     cell, lo, hi, k3, k2 = box
     low = max(1, order - 1)
     if tolerance is None or low == order:
         _clipped_rules(C, cell, lo, hi, k3, k2, _gauss(order), parts, None, exact)
-        return
+        return np.zeros(cell.size, dtype=bool)
     m = cell.size
     local = np.arange(m)
     Cb = C[cell]
@@ -240,6 +252,7 @@ def _raised_rules(C, box, order, parts, tolerance, exact):
     moved = np.zeros(m, dtype=bool)
     for measure in (_box_areas, _box_volumes):
         moved |= np.abs(measure(found, m) - measure(coarse, m)) > tolerance
+    unsettled = np.zeros(m, dtype=bool)
     if moved.any():
         raised = np.flatnonzero(moved)
         fine = {"minus": [], "plus": [], "interface": []}
@@ -248,12 +261,21 @@ def _raised_rules(C, box, order, parts, tolerance, exact):
             Cb[raised], local[: raised.size], lo[raised], hi[raised], k3, k2,
             _gauss(2 * order), fine, None, on_raised,
         )  # fmt: skip
+        if split:
+            r = raised.size
+            for measure in (_box_areas, _box_volumes):
+                change = np.abs(measure(fine, r) - measure(found, m)[raised])
+                unsettled[raised] |= change > tolerance
+        keep_fine = ~unsettled[raised]
         for side, pieces in fine.items():
-            parts[side].extend((cell[raised[p[0]]], *p[1:]) for p in pieces)
+            for rows, *columns in pieces:
+                keep = keep_fine[rows]
+                parts[side].append((cell[raised[rows[keep]]], *(c[keep] for c in columns)))
     for side, pieces in found.items():
         for rows, *columns in pieces:
             keep = ~moved[rows]
             parts[side].append((cell[rows[keep]], *(c[keep] for c in columns)))
+    return unsettled
 
 
 def _box_areas(parts, m):
