@@ -225,18 +225,23 @@ def sphere_p2_tets(
     rules."""
     vertices, J, detJ, nodes = tet_geometry(n, PERTURB, 2)
     phi = SHAPES[shape][0](nodes, centre)
+
+    def on_cells(cells):
+        """The level set at reference points of ``cells``, as ``(rows, X) -> (m,)``."""
+
+        def exact(rows, X):
+            x = vertices[cells[rows], 0] + np.einsum("mij,mj->mi", J[cells[rows]], X)
+            return SHAPES[shape][0](x, centre)
+
+        return exact
+
     start = time.process_time()
-    side = classify_p2_tets(phi)
+    side = classify_p2_tets(phi, on_cells(np.arange(phi.shape[0])) if callable_ else None)
     cut = np.flatnonzero(side == 0)
     volume = detJ[side == -1].sum() / 6.0
     area, points = 0.0, 0
     for first in range(0, cut.size, CHUNK):
         cells = cut[first : first + CHUNK]
-
-        def exact(rows, X, cells=cells):
-            x = vertices[cells[rows], 0] + np.einsum("mij,mj->mi", J[cells[rows]], X)
-            return SHAPES[shape][0](x, centre)
-
         rules = p2_tet_cut_rules(
             phi[cells],
             order or ORDER,
@@ -244,7 +249,7 @@ def sphere_p2_tets(
             frame=FRAME,
             raise_tolerance=RAISE_TOLERANCE,
             jacobian=lambda rows, X, cells=cells: J[cells[rows]],
-            exact=exact if callable_ else None,
+            exact=on_cells(cells) if callable_ else None,
         )
         volume += (rules.minus.weights * detJ[cells[rules.minus.point_rows]]).sum()
         area += (rules.interface.weights * detJ[cells[rules.interface.point_rows]]).sum()

@@ -180,3 +180,80 @@ def box_vertices(lo, hi) -> np.ndarray:
         ],
         dtype=float,
     )
+
+
+def sphere_area_in_polytope(
+    centre: np.ndarray, radius: float, planes: list[tuple[np.ndarray, float]]
+) -> float:
+    """Area of the sphere inside the convex polytope ``g.x + c0 <= 0`` (``planes``), by
+    Gauss-Bonnet on the unit sphere, for pieces that are disks bounded by arcs of the
+    circles where the planes meet the sphere: ``R^2 (2 pi L + sum_i t_i dpsi_i - sum_v
+    theta_v)``, where ``L`` is the number of boundary loops (pieces), a boundary arc on
+    the circle ``n_i.u = t_i`` turns by ``dpsi_i`` about ``n_i`` (its geodesic curvature
+    integrates to ``-t_i dpsi_i``) and ``theta_v`` are the exterior angles at the
+    corners."""
+    normals, levels = [], []
+    for g, c0 in planes:  # n.u <= t for unit vectors u = (x - centre) / R
+        norm = np.linalg.norm(g)
+        normals.append(g / norm)
+        levels.append(-(c0 + g @ centre) / (norm * radius))
+    normals, levels = np.array(normals), np.array(levels)
+    if (levels <= -1.0).any():
+        return 0.0
+    if (levels >= 1.0).all():
+        return 4.0 * math.pi * radius**2
+
+    def inside(u, skip=()):
+        keep = [i for i in range(len(levels)) if i not in skip]
+        return bool((normals[keep] @ u <= levels[keep] + 1e-12).all())
+
+    corners = []  # (u, i, j): on circles i and j
+    for i, j in itertools.combinations(range(len(levels)), 2):
+        line = np.cross(normals[i], normals[j])
+        if line @ line < 1e-24:  # parallel planes
+            continue
+        A = np.array([normals[i], normals[j], line])
+        p = np.linalg.solve(A, [levels[i], levels[j], 0.0])
+        s2 = (1.0 - p @ p) / (line @ line)
+        if s2 <= 0:
+            continue
+        for s in (math.sqrt(s2), -math.sqrt(s2)):
+            u = p + s * line
+            if inside(u, (i, j)):
+                corners.append((u, i, j))
+    parent = list(range(len(corners)))  # corners joined by arcs: one set per loop
+
+    def root(k):
+        while parent[k] != k:
+            k = parent[k]
+        return k
+
+    area, loops = 0.0, 0
+    for i, (n, t) in enumerate(zip(normals, levels, strict=True)):
+        if abs(t) >= 1.0:
+            continue
+        e1 = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(n, e1)
+        on = sorted(
+            (math.atan2(u @ e2, u @ e1), k) for k, (u, a, b) in enumerate(corners) if i in (a, b)
+        )
+        if not on:
+            on = [(0.0, None)]
+        ends = [*on, (on[0][0] + 2.0 * math.pi, on[0][1])]
+        for (a, ka), (b, kb) in itertools.pairwise(ends):
+            mid = 0.5 * (a + b)
+            u = t * n + math.sqrt(1.0 - t * t) * (math.cos(mid) * e1 + math.sin(mid) * e2)
+            if inside(u, (i,)) and b > a:
+                area += t * (b - a)
+                if ka is None:  # a whole circle: a loop of its own
+                    loops += 1
+                else:
+                    parent[root(ka)] = root(kb)
+    loops += len({root(k) for k in range(len(corners))})
+    area += 2.0 * math.pi * loops
+    for u, i, j in corners:  # exterior angle: between the inward normals in the tangent plane
+        m = [-(normals[k] - (normals[k] @ u) * u) for k in (i, j)]
+        m = [v / np.linalg.norm(v) for v in m]
+        area -= math.acos(float(np.clip(m[0] @ m[1], -1.0, 1.0)))
+    return radius**2 * area

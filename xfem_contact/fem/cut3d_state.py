@@ -59,7 +59,8 @@ def cut_state_3d(
     phi = interpolate_named(mesh, levelset, degree, names, previous)
     maps = CellMaps(mesh, phi)
     owned = np.arange(mesh.topology.index_map(tdim).size_local, dtype=np.int32)
-    side = _collective(mesh, lambda: classify_3d(cell, degree, maps.nodal_values(owned)))
+    on_owned = maps.exact(owned) if exact_zero_set else None  # None for a Function too
+    side = _collective(mesh, lambda: classify_3d(cell, degree, maps.nodal_values(owned), on_owned))
     cut_cells = owned[side == 0]
     cut_time, timer = seconds(timer), phase("cut rules")
 

@@ -35,6 +35,7 @@ import numpy.typing as npt
 
 from xfem_contact.geometry.cut_topology import nodal_values
 from xfem_contact.geometry.exact_lines import ExactLevelSet
+from xfem_contact.geometry.exact_margin import exact_margin
 from xfem_contact.geometry.tensor_levelset import coefficients
 from xfem_contact.quadrature.rules import RuleSet
 from xfem_contact.quadrature.saye import MAX_DEPTH, CutRules, certified_sides, saye_points
@@ -125,12 +126,22 @@ def _cube_coefficients(phi: npt.ArrayLike) -> np.ndarray:
     return coefficients(values, 2)
 
 
-def classify_p2_tets(phi: npt.ArrayLike) -> npt.NDArray[np.int8]:
+def classify_p2_tets(
+    phi: npt.ArrayLike, exact: ExactLevelSet | None = None
+) -> npt.NDArray[np.int8]:
     """Side of each tetrahedron certified by its own Bernstein coefficients, else by those
     on its four hexahedra: -1, +1, or 0 (possibly cut).
 
     Args:
         phi: P2 nodal values, shape ``(ncells, 10)`` (Basix order).
+        exact: ``(rows, X) -> (m,)``: the level set that ``phi`` interpolates (see
+            :func:`p2_tet_cut_rules`). A cell near its zero set, whose Bernstein
+            coefficients' least magnitude is at most their spread (``|phi|`` small against
+            ``h |grad phi|``), is certified only with the margin of
+            :func:`~xfem_contact.geometry.exact_margin.exact_margin`: coefficients all
+            ``< -margin`` or all ``>= margin``, else 0. Farther cells keep the
+            interpolant's certificate (there the margin, of order ``h^3``, is below it).
+            ``None``: the interpolant's sides.
 
     Returns:
         ``int8`` array of shape ``(ncells,)``.
@@ -141,6 +152,12 @@ def classify_p2_tets(phi: npt.ArrayLike) -> npt.NDArray[np.int8]:
     rest = np.flatnonzero(side == 0)
     sides = certified_sides(_cube_coefficients(phi[rest])).reshape(-1, 4)
     side[rest] = np.where((sides == -1).all(axis=1), -1, np.where((sides == 1).all(axis=1), 1, 0))
+    if exact is not None:  # the tetrahedron's coefficients with the margin decide
+        low, high = B.min(axis=1), B.max(axis=1)
+        near = np.flatnonzero((side != 0) & (np.minimum(np.abs(low), np.abs(high)) <= high - low))
+        margin = exact_margin(phi[near], lambda rows, X: exact(near[rows], X))
+        certain = (high[near] < -margin) | (low[near] >= margin)
+        side[near[~certain]] = 0
     return side
 
 
@@ -198,8 +215,11 @@ def p2_tet_cut_rules(
         exact: ``(rows, X) -> (m,)``: the level set that ``phi`` interpolates, at points
             ``X`` ``(m, 3)`` of the reference tetrahedron of cells ``rows``; the rules
             then follow its zero set (as
-            :func:`~xfem_contact.quadrature.saye.hex_cut_rules`'s) in either frame;
-            ``None``: ``phi``'s.
+            :func:`~xfem_contact.quadrature.saye.hex_cut_rules`'s) in either frame, and
+            a box lies on one side only when ``phi``'s Bernstein coefficients there keep
+            their sign with the margin of
+            :func:`~xfem_contact.geometry.exact_margin.exact_margin` (a thin lens of the
+            exact zero set that the interpolant misses is found); ``None``: ``phi``'s.
 
     Returns:
         A :class:`~xfem_contact.quadrature.saye.CutRules`: points in the reference
@@ -225,6 +245,8 @@ def p2_tet_cut_rules(
         found: dict[str, list[tuple[np.ndarray, ...]]] = {side: [] for side in merged}
         size = chunk.shape[0]
         rest = np.arange(size)
+        on_chunk = None if exact is None else _from_row(exact, start)
+        margin = None if exact is None else exact_margin(chunk, on_chunk)
         if frame == "tetrahedron":
             points, rest = truncated_saye_points(
                 _tet_coefficients(chunk),
@@ -232,7 +254,8 @@ def p2_tet_cut_rules(
                 max_depth=max_depth,
                 min_depth=min_depth,
                 raise_tolerance=raise_tolerance,
-                exact=None if exact is None else _from_row(exact, start),
+                exact=on_chunk,
+                margin=margin,
             )
             reduced.append(points.reduced + start)
             if rest.size == 0:  # points sorted by row, vectors as (N, 3): nothing to merge
@@ -255,6 +278,7 @@ def p2_tet_cut_rules(
                 first=start,
                 names=rest,
                 exact=None if exact is None else _on_cube(exact, k, start),
+                margin=None if margin is None else margin[rest],
             )
             for side in ("minus", "plus"):
                 rows, U, w = getattr(points, side)

@@ -48,7 +48,9 @@ def saye_order(quadrature_degree: int) -> int:
     return max(1, math.ceil((quadrature_degree + 1) / 2))
 
 
-def classify_3d(cell: str, degree: int, phi: npt.ArrayLike) -> npt.NDArray[np.int8]:
+def classify_3d(
+    cell: str, degree: int, phi: npt.ArrayLike, exact: ExactLevelSet | None = None
+) -> npt.NDArray[np.int8]:
     """Side of every cell: -1, +1, or 0 when it may be cut (then :func:`cut_rules_3d`
     decides; a cell certified on one side is never cut).
 
@@ -56,6 +58,11 @@ def classify_3d(cell: str, degree: int, phi: npt.ArrayLike) -> npt.NDArray[np.in
         cell: ``"tetrahedron"`` or ``"hexahedron"``.
         degree: Level-set degree, 1 or 2.
         phi: Nodal values, shape ``(ncells, ndofs)`` (Basix ``gll_warped`` order).
+        exact: For P2 tetrahedra, the level set that ``phi`` interpolates, as in
+            :func:`cut_rules_3d`: cells near its zero set are certified with a bound of
+            its distance from the interpolant
+            (:func:`~xfem_contact.quadrature.curved_tet_rules.classify_p2_tets`). Ignored
+            for the other kinds and degrees.
 
     Returns:
         ``int8`` array of shape ``(ncells,)``.
@@ -63,7 +70,7 @@ def classify_3d(cell: str, degree: int, phi: npt.ArrayLike) -> npt.NDArray[np.in
     _check(cell, degree)
     if cell == "hexahedron":
         return classify_hexes(phi, degree)
-    return classify_tets(phi) if degree == 1 else classify_p2_tets(phi)
+    return classify_tets(phi) if degree == 1 else classify_p2_tets(phi, exact)
 
 
 def cut_rules_3d(

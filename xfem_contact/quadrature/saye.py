@@ -80,6 +80,7 @@ __all__ = [
     "MIN_SLOPE",
     "CutRules",
     "SayePoints",
+    "certified_boxes",
     "certified_sides",
     "check_parameters",
     "classify_hexes",
@@ -224,6 +225,7 @@ def saye_points(
     first: int = 0,
     exact: ExactLevelSet | None = None,
     names: npt.ArrayLike | None = None,
+    margin: np.ndarray | None = None,
 ) -> SayePoints:
     """Saye's rules (see the module) of polynomials on the unit cube.
 
@@ -243,6 +245,9 @@ def saye_points(
             (see :func:`hex_cut_rules`); ``None``: the polynomials'.
         names: Per row of ``C``, its number in error messages (added to ``first``);
             ``None``: the row itself.
+        margin: Per row ``(ncells,)``, a bound of ``|exact - psi|`` on the cube: above
+            ``max_depth`` a box lies on one side only when its Bernstein coefficients are
+            all ``< -margin`` or all ``>= margin`` (:func:`certified_boxes`). ``None``: 0.
 
     Returns:
         A :class:`SayePoints`.
@@ -262,10 +267,10 @@ def saye_points(
         if cell.size == 0:
             break
         B = bernstein(C[cell], lo, hi)
-        flat = B.reshape(cell.size, -1)
-        for side, whole in (("minus", (flat < 0).all(axis=1)), ("plus", (flat >= 0).all(axis=1))):
+        sides = certified_boxes(B, None if depth == max_depth else margin, cell)
+        for side, whole in sides.items():
             parts[side].append(_tensor_rule(cell[whole], lo[whole], hi[whole], gauss))
-        rest = ~((flat < 0).all(axis=1) | (flat >= 0).all(axis=1))
+        rest = ~(sides["minus"] | sides["plus"])
         cell, lo, hi, B = cell[rest], lo[rest], hi[rest], B[rest]
         if cell.size == 0:
             break
@@ -300,6 +305,20 @@ def saye_points(
         tuple(_gather(parts["interface"], (1, 3, 1, 3))),
         np.unique(np.concatenate(reduced)).astype(np.int64) if reduced else np.zeros(0, np.int64),
     )
+
+
+def certified_boxes(
+    B: np.ndarray, margin: np.ndarray | None, cell: np.ndarray
+) -> dict[str, np.ndarray]:
+    """Boxes on one side, ``{"minus": (m,) bool, "plus": (m,) bool}``, by the Bernstein
+    coefficients ``B`` ``(m, ...)`` of the polynomial on them: all ``< -margin[cell]``
+    (side -1) or all ``>= margin[cell]`` (side +1); ``margin`` ``None``: 0 (the polynomial's
+    own sides). A box of neither may be cut."""
+    flat = B.reshape(B.shape[0], -1)
+    if margin is None:
+        return {"minus": (flat < 0).all(axis=1), "plus": (flat >= 0).all(axis=1)}
+    m = margin[cell][:, None]
+    return {"minus": (flat < -m).all(axis=1), "plus": (flat >= m).all(axis=1)}
 
 
 def check_parameters(order: int, max_depth: int, min_depth: int) -> None:

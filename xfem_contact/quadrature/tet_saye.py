@@ -32,12 +32,16 @@ the tensor machinery of :mod:`xfem_contact.geometry.tensor_levelset` applies unc
    :data:`RAISE_TOLERANCE` (reference units) between the two gets ``2 order`` points.
    These are the boxes near branch points of the roots (high curvature of the zero set
    in the cell, shallow slopes), where Gauss rules converge slowly; elsewhere the rules
-   keep ``order`` points.
+   keep ``order`` points. A raised box whose rules still move by more than
+   ``raise_tolerance`` from ``order`` to ``2 order`` points is subdivided (above
+   ``max_depth``).
 
 Given the level set that ``psi`` interpolates as a function (``exact``), the boxes and
-axes stay ``psi``'s, but the breakpoints of every line (the slanted face's included) are
-the function's roots near ``psi``'s, the sides of the height intervals its signs and the
-area vectors its gradient, as in :mod:`xfem_contact.quadrature.saye`.
+axes stay ``psi``'s (a box lies on one side only when ``psi``'s Bernstein coefficients
+keep their sign by the cell's ``margin``, a bound of ``|exact - psi|``), but the
+breakpoints of every line (the slanted face's included) are the function's roots near
+``psi``'s, the sides of the height intervals its signs and the area vectors its
+gradient, as in :mod:`xfem_contact.quadrature.saye`.
 
 Every breakpoint is a root of ``psi`` restricted to a straight line, every interval end
 an affine function of the outer coordinates: for a planar ``psi`` the rules integrate
@@ -45,7 +49,8 @@ polynomials of degree ``2 order - 1`` per direction exactly, and for a curved on
 error falls with the curvature of ``psi`` in the cell (the mesh size times the
 interface's curvature), not only with ``order``. All weights are positive. A box
 with axes is still subdivided while a slope its roots depend on is small against the
-second derivatives of ``psi`` times the box size (:data:`CURVED`). At ``max_depth`` a box
+second derivatives of ``psi`` times the box size
+(:data:`~xfem_contact.quadrature.tet_saye_axes.CURVED`). At ``max_depth`` a box
 without a valid pair uses the best monotone height axis alone (the cell is reported
 ``reduced``); a cell with a box that has none is reported unresolved (the caller
 integrates it otherwise).
@@ -78,22 +83,19 @@ from xfem_contact.quadrature.saye import (
     _pieces,
     _subdivide,
     _tensor_rule,
+    certified_boxes,
     check_parameters,
 )
-from xfem_contact.quadrature.saye_axes import (
-    PAIRS,
-    SCORE_TOLERANCE,
-    choose_axes,
-    first_best,
-    mean_slopes,
-)
+from xfem_contact.quadrature.saye_axes import PAIRS
+from xfem_contact.quadrature.tet_saye_axes import CURVED_DEPTH, curved_boxes, truncated_axes
 
 __all__ = ["MIN_SLOPE", "RAISE_TOLERANCE", "truncated_saye_points"]
 
 MIN_SLOPE = 0.2
 """Boxes inside the tetrahedron whose best pair of axes scores below this are subdivided,
 as Saye's boxes of the unit cube by :data:`xfem_contact.quadrature.saye.MIN_SLOPE`; lower
-here, where the boxes are those of a sixth of a cube and :data:`CURVED` subdivides the
+here, where the boxes are those of a sixth of a cube and
+:data:`~xfem_contact.quadrature.tet_saye_axes.CURVED` subdivides the
 curved ones too."""
 
 
@@ -111,6 +113,7 @@ def truncated_saye_points(
     min_depth: int = 0,
     raise_tolerance: float | None = RAISE_TOLERANCE,
     exact: ExactLevelSet | None = None,
+    margin: np.ndarray | None = None,
 ) -> tuple[SayePoints, np.ndarray]:
     """Saye's rules on the reference tetrahedron of P2 polynomials (see the module).
 
@@ -132,6 +135,11 @@ def truncated_saye_points(
             the height intervals its signs and the interface's area vectors its gradient
             (:func:`~xfem_contact.geometry.exact_lines.central_gradient`). ``None``:
             ``C``'s zero set.
+        margin: Per cell ``(ncells,)``, a bound of ``|exact - psi|`` on it
+            (:func:`~xfem_contact.geometry.exact_margin.exact_margin`): above
+            ``max_depth`` a box lies on one side only when ``psi``'s Bernstein
+            coefficients are all ``< -margin`` or all ``>= margin`` (else its rules look
+            for ``exact``'s roots). ``None``: 0.
 
     Returns:
         The points of the resolved cells (a :class:`~xfem_contact.quadrature.saye.SayePoints`;
@@ -155,9 +163,8 @@ def truncated_saye_points(
         if cell.size == 0:
             break
         B = bernstein(C[cell], lo, hi)
-        flat = B.reshape(cell.size, -1)
         truncated = hi.sum(axis=1) > 1.0
-        sides = {"minus": (flat < 0).all(axis=1), "plus": (flat >= 0).all(axis=1)}
+        sides = certified_boxes(B, None if depth == max_depth else margin, cell)
         for side, whole in sides.items():
             plain = whole & ~truncated
             parts[side].append(_tensor_rule(cell[plain], lo[plain], hi[plain], gauss))
@@ -172,23 +179,28 @@ def truncated_saye_points(
             pair = np.full(cell.size, -1)
         else:
             DB = [bernstein(derivative(C[cell], k), lo, hi) for k in range(3)]
-            pair, height, score = _truncated_axes(C[cell], lo, hi, B, DB)
+            pair, height, score = truncated_axes(C[cell], lo, hi, B, DB)
             if depth < max_depth:  # shallow slopes: steep roots, slow rules; subdivide
                 shallow = (score < MIN_SLOPE) & (hi.sum(axis=1) <= 1.0)  # boxes of Saye's own
                 pair = np.where(shallow, -1, pair)
             if depth < min(max_depth, CURVED_DEPTH):
-                pair = np.where(_curved(C[cell], lo, hi, B, DB, pair), -1, pair)
+                pair = np.where(curved_boxes(C[cell], lo, hi, B, DB, pair), -1, pair)
             if depth == max_depth:  # the best monotone height axis alone, as Saye's
                 fallback = (pair < 0) & (height >= 0)
                 reduced.append(cell[fallback])
                 lone = [PAIRS.index((k, (k + 1) % 3)) for k in range(3)]
                 pair = np.where(fallback, np.take(lone, np.maximum(height, 0)), pair)
+        unsettled = []
         for index, (k3, k2) in enumerate(PAIRS):
-            group = pair == index
-            if group.any():
+            group = np.flatnonzero(pair == index)
+            if group.size:
                 box = (cell[group], lo[group], hi[group], k3, k2)
-                _raised_rules(C, box, order, parts, raise_tolerance, exact)
+                split = depth < max_depth
+                moving = _raised_rules(C, box, order, parts, raise_tolerance, exact, split)
+                unsettled.append(group[moving])
         subdivided = pair < 0
+        if unsettled:
+            subdivided[np.concatenate(unsettled)] = True
         if depth == max_depth:
             unresolved.append(cell[subdivided])
             break
@@ -214,16 +226,19 @@ def _gauss(order: int) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (gx + 1.0), 0.5 * gw
 
 
-def _raised_rules(C, box, order, parts, tolerance, exact):
+def _raised_rules(C, box, order, parts, tolerance, exact, split):
     """Nested rules of the cut truncated boxes ``box = (cell, lo, hi, k3, k2)`` with
     ``order`` points per interval, and ``2 order`` in the boxes whose rules move by more
     than ``tolerance`` from ``max(1, order - 1)`` points (see :func:`truncated_saye_points`),
-    appended to ``parts``."""
+    appended to ``parts``. With ``split``, a raised box whose rules still move by more
+    than ``tolerance`` from ``order`` to ``2 order`` points (Gauss rules converging
+    slowly: a branch point of the roots in or near the box) gets no rules; the mask
+    ``(m,)`` of those boxes is returned (to be subdivided)."""
     cell, lo, hi, k3, k2 = box
     low = max(1, order - 1)
     if tolerance is None or low == order:
         _clipped_rules(C, cell, lo, hi, k3, k2, _gauss(order), parts, None, exact)
-        return
+        return np.zeros(cell.size, dtype=bool)
     m = cell.size
     local = np.arange(m)
     Cb = C[cell]
@@ -234,6 +249,7 @@ def _raised_rules(C, box, order, parts, tolerance, exact):
     moved = np.zeros(m, dtype=bool)
     for measure in (_box_areas, _box_volumes):
         moved |= np.abs(measure(found, m) - measure(coarse, m)) > tolerance
+    unsettled = np.zeros(m, dtype=bool)
     if moved.any():
         raised = np.flatnonzero(moved)
         fine = {"minus": [], "plus": [], "interface": []}
@@ -242,12 +258,21 @@ def _raised_rules(C, box, order, parts, tolerance, exact):
             Cb[raised], local[: raised.size], lo[raised], hi[raised], k3, k2,
             _gauss(2 * order), fine, None, on_raised,
         )  # fmt: skip
+        if split:
+            r = raised.size
+            for measure in (_box_areas, _box_volumes):
+                change = np.abs(measure(fine, r) - measure(found, m)[raised])
+                unsettled[raised] |= change > tolerance
+        keep_fine = ~unsettled[raised]
         for side, pieces in fine.items():
-            parts[side].extend((cell[raised[p[0]]], *p[1:]) for p in pieces)
+            for rows, *columns in pieces:
+                keep = keep_fine[rows]
+                parts[side].append((cell[raised[rows[keep]]], *(c[keep] for c in columns)))
     for side, pieces in found.items():
         for rows, *columns in pieces:
             keep = ~moved[rows]
             parts[side].append((cell[rows[keep]], *(c[keep] for c in columns)))
+    return unsettled
 
 
 def _box_areas(parts, m):
@@ -264,99 +289,6 @@ def _box_volumes(parts, m):
     for rows, _, w in parts["minus"]:
         volumes += np.bincount(rows, w, minlength=m)
     return volumes
-
-
-def _truncated_axes(C, lo, hi, B, DB):
-    """Index into ``PAIRS`` of the best valid ``(k3, k2)`` per box (-1: none) and the best
-    monotone height axis alone (-1: none), and the pair's score (``-inf``: none). The pair
-    is Saye's for a box inside the half-space, else the same criteria on the faces the truncated box
-    has (bottom ``x_k3 = lo``, top ``x_k3 = hi`` where it meets the half-space, the
-    slanted face along ``e_k2 - e_k3``) with the slanted face's margin in the score, and
-    near-ties broken as Saye's (:func:`~xfem_contact.quadrature.saye_axes.first_best`). ``B``,
-    ``DB``: Bernstein coefficients of ``psi`` and of its three derivatives on the boxes."""
-    pair, height, chosen = choose_axes(C, lo, hi, B)
-    reaching = np.flatnonzero(hi.sum(axis=1) > 1.0)
-    if reaching.size == 0:
-        return pair, height, chosen
-    lo, hi, B = lo[reaching], hi[reaching], B[reaching]
-    DB = [d[reaching] for d in DB]
-    m = reaching.size
-    scores = np.full((len(PAIRS), m), -np.inf)  # -inf: not valid
-    for index, (k3, k2) in enumerate(PAIRS):
-        k1 = 3 - k3 - k2
-        valid, pair_score = _certain(DB[k3]), _margin(DB[k3], DB)
-        top_inside = lo[:, k1] + lo[:, k2] + hi[:, k3] < 1.0
-        for end, present in ((0, np.ones(m, bool)), (B.shape[1] - 1, top_inside)):
-            face = np.take(B, end, axis=k3 + 1)
-            slope = [np.take(DB[k], end, axis=k3 + 1) for k in (k2, k1)]
-            definite = _certain(face) | (face.reshape(m, -1) == 0).all(axis=1)
-            valid &= ~present | definite | _certain(slope[0])
-            face_score = np.where(definite | ~present, np.inf, _margin(slope[0], slope))
-            pair_score = np.minimum(pair_score, face_score)
-        along, across = DB[k2] - DB[k3], DB[k1] - DB[k3]  # Bernstein forms are linear
-        valid &= _certain(along)
-        pair_score = np.minimum(pair_score, _margin(along, [along, across]))
-        # a score within SCORE_TOLERANCE of 0 is a certificate by round-off only: not valid
-        scores[index] = np.where(valid & (pair_score > SCORE_TOLERANCE), pair_score, -np.inf)
-    mean = mean_slopes(DB)
-    best = first_best(scores, np.array([mean[k3] for k3, _ in PAIRS]))
-    pair, chosen = pair.copy(), chosen.copy()
-    pair[reaching] = best
-    chosen[reaching] = np.where(best >= 0, scores[np.maximum(best, 0), np.arange(m)], -np.inf)
-    return pair, height, chosen
-
-
-CURVED = 4.0
-"""Largest ``|d2 psi| size / min |d psi / d x_k3|`` of a box with axes: a box above it is
-subdivided (the roots of its height lines have branch points too close for the rule)."""
-
-
-CURVED_DEPTH = 3
-"""Box levels subdivided by :data:`CURVED` (boxes of ``1 / 8`` of the cube at most: a
-slope that vanishes on the interface itself, such as a face function's where the
-interface touches the face, is not resolved by subdivision)."""
-
-
-def _curved(C, lo, hi, B, DB, pair):
-    """Boxes with axes where a slope the roots depend on (of ``psi`` along ``k3``; along
-    ``k2`` on each face with zeros and along the slanted face) is small against ``psi``'s
-    second derivatives times the box size (see :data:`CURVED`), ``(m,)`` bool; ``B``,
-    ``DB`` as in :func:`_truncated_axes`."""
-    m = C.shape[0]
-    second = np.zeros(m)
-    for a in range(3):
-        for b in range(a, 3):
-            second = np.maximum(second, np.abs(derivative(derivative(C, a), b)[:, 0, 0, 0]))
-    slope = np.full(m, np.inf)
-    for index, (k3, k2) in enumerate(PAIRS):
-        group = np.flatnonzero(pair == index)
-        if group.size == 0:
-            continue
-        least = np.abs(DB[k3][group]).reshape(group.size, -1).min(axis=1)
-        for end in (0, B.shape[1] - 1):
-            face = np.take(B[group], end, axis=k3 + 1).reshape(group.size, -1)
-            crossed = ~((face > 0).all(axis=1) | (face < 0).all(axis=1))
-            face_slope = np.abs(np.take(DB[k2][group], end, axis=k3 + 1))
-            face_slope = face_slope.reshape(group.size, -1).min(axis=1)
-            least = np.where(crossed, np.minimum(least, face_slope), least)
-        along = np.abs(DB[k2][group] - DB[k3][group]).reshape(group.size, -1).min(axis=1)
-        reaching = hi[group].sum(axis=1) > 1.0
-        slope[group] = np.where(reaching, np.minimum(least, along), least)
-    size = (hi - lo).max(axis=1)
-    return (pair >= 0) & (second * size > CURVED * slope)
-
-
-def _certain(B):
-    """Bernstein coefficients ``(m, ...)`` of one strict sign."""
-    flat = B.reshape(B.shape[0], -1)
-    return (flat > 0).all(axis=1) | (flat < 0).all(axis=1)
-
-
-def _margin(slope, slopes):
-    """Least ``|slope|`` relative to the largest of ``slopes`` (Bernstein bounds), ``(m,)``."""
-    m = slope.shape[0]
-    steepest = np.maximum.reduce([np.abs(s).reshape(m, -1).max(axis=1) for s in slopes])
-    return np.abs(slope).reshape(m, -1).min(axis=1) / np.where(steepest > 0, steepest, 1.0)
 
 
 def _slanted_line(C, P0, a, b):
