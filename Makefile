@@ -71,6 +71,7 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/crack_convergence.py --no-progress
 	$(PY) bench/inf_sup.py --elements P1-P1
 	$(PY) bench/inf_sup.py --elements P2-P1
+	$(PY) bench/inf_sup.py --circles 50 --sizes 8 16 32 64 --cells quadrilateral --elements P2-P1 --name inf_sup_P2-P1_quadrilateral
 	$(PY) bench/inf_sup.py --elements P2-P2 --sizes 8 16 32 --circles 12 --treatments none restriction stabilized "stabilized, ghost 0.1" --name inf_sup_P2-P2
 	$(PY) bench/inf_sup.py --circles 12 --treatments "stabilized, ghost 0.1" --name inf_sup_P1-P1_P2-P1_stabilized_ghost_0.1
 	$(PY) bench/inf_sup.py --circles 12 --treatments "stabilized, aggregation 0.25" --name inf_sup_P1-P1_P2-P1_stabilized_aggregation_0.25
