@@ -71,11 +71,14 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/crack_convergence.py --no-progress
 	$(PY) bench/inf_sup.py --elements P1-P1
 	$(PY) bench/inf_sup.py --elements P2-P1
+	$(PY) bench/inf_sup.py --circles 50 --sizes 8 16 32 64 --cells quadrilateral --elements P2-P1 --name inf_sup_P2-P1_quadrilateral
 	$(PY) bench/inf_sup.py --elements P2-P2 --sizes 8 16 32 --circles 12 --treatments none restriction stabilized "stabilized, ghost 0.1" --name inf_sup_P2-P2
 	$(PY) bench/inf_sup.py --circles 12 --treatments "stabilized, ghost 0.1" --name inf_sup_P1-P1_P2-P1_stabilized_ghost_0.1
 	$(PY) bench/inf_sup.py --circles 12 --treatments "stabilized, aggregation 0.25" --name inf_sup_P1-P1_P2-P1_stabilized_aggregation_0.25
 	$(PY) bench/inf_sup.py --study crack
 	$(PY) bench/inf_sup.py --study 3d --sizes 4 8 12
+	$(PY) bench/inf_sup.py --study 3d --cells hexahedron --elements P2-P1 --treatments restriction --sizes 4 8 --name inf_sup_3d_hexahedron_P2-P1_restriction_4_8
+	$(PY) bench/inf_sup.py --study 3d --cells hexahedron --elements P2-P1 --treatments stabilized --sizes 4 8 12 --name inf_sup_3d_hexahedron_P2-P1_stabilized_4_8_12
 	$(PY) bench/inf_sup.py --study 3d --cells tetrahedron --elements P2-P1 --treatments restriction --sizes 6 8 10 12 --name inf_sup_3d_tetrahedron_P2-P1_restriction_6_8_10_12
 	$(PY) bench/sphere_unstructured.py
 	$(PY) bench/inf_sup.py --study 3d --sizes 4 8 --spheres 12 --cells tetrahedron --treatments stabilized --name inf_sup_3d_spheres
