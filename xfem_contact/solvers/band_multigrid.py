@@ -40,6 +40,7 @@ METIS (the row ``band_3d``).
 from __future__ import annotations
 
 import numpy as np
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from xfem_contact.solvers.assembly import aij
@@ -265,15 +266,23 @@ def _gram(B: PETSc.Mat) -> PETSc.Mat:
 def _prolongation(
     J: PETSc.Mat, u: PETSc.IS, rows, cols, weights
 ) -> tuple[PETSc.Mat, PETSc.Mat, np.ndarray]:
-    """``P_full`` from the coarse unknowns (the distinct ``cols``, numbered process by
-    process in the order of their global index) into all of ``J``'s unknowns (zero rows
-    outside ``u``: ``P_full^T J P_full`` is the coarse ``P^T J_uu P`` without extracting
-    ``J_uu``); ``P``, its rows ``u`` (a virtual sub-matrix: no copy); and the positions
-    in ``u``'s local part of the owned coarse unknowns. Collective."""
+    """``P_full`` from the coarse unknowns (the distinct ``cols`` of every process, each
+    numbered by its owner, process by process in the order of their global index) into
+    all of ``J``'s unknowns (zero rows outside ``u``: ``P_full^T J P_full`` is the coarse
+    ``P^T J_uu P`` without extracting ``J_uu``); ``P``, its rows ``u`` (a virtual
+    sub-matrix: no copy); and the positions in ``u``'s local part of the owned coarse
+    unknowns. Collective; raises on every process if the interpolation does not fit."""
     comm = u.getComm()
     owned_u = u.getIndices()
     first, last = J.getOwnershipRange()
-    coarse = np.unique(cols[(cols >= first) & (cols < last)])  # owned, by global index
+    # the owned columns that some process interpolates from: a vertex's owner need not
+    # hold a cell on which the field is active around it (its rows then do not name it)
+    referenced = J.createVecRight()
+    wanted = np.unique(cols).astype(PETSc.IntType)
+    referenced.setValues(wanted, np.ones(wanted.size), addv=PETSc.InsertMode.ADD_VALUES)
+    referenced.assemble()
+    coarse = np.flatnonzero(referenced.getArray(readonly=True) > 0.0) + first  # by index
+    referenced.destroy()
     offset = comm.tompi4py().exscan(coarse.size) or 0
     # the coarse number of every column, from its owner
     number = J.createVecRight()
@@ -282,7 +291,8 @@ def _prolongation(
     number.setArray(values)
     coarse_cols = np.rint(gather(number, cols)).astype(PETSc.IntType)
     number.destroy()
-    if np.any(coarse_cols < 0) or not np.all(np.isin(rows, owned_u)):
+    fits = not np.any(coarse_cols < 0) and np.all(np.isin(rows, owned_u))
+    if not comm.tompi4py().allreduce(bool(fits and np.all(np.isin(coarse, owned_u))), MPI.LAND):
         raise RuntimeError("BandMultigrid: the interpolation does not fit the fieldsplits")
     order = np.lexsort((coarse_cols, rows))
     rows, coarse_cols, weights = rows[order], coarse_cols[order], weights[order]
