@@ -171,11 +171,12 @@ def test_a_bonded_interface_beside_a_contact_one():
 
 
 @pytest.mark.mpi
-def test_prolongation_from_a_column_only_another_process_names():
-    """A vertex unknown that only another process interpolates from (its owner holds no
-    cell on which the field is active around it) is a coarse unknown of its owner: every
-    process builds the prolongation (before, the other process raised alone and the
-    owner hung in the next collective call)."""
+def test_prolongation_from_entries_only_another_process_has():
+    """A fine unknown whose interpolation only another process has, and a vertex unknown
+    that only another process interpolates from (their owner holds no cell on which the
+    field is active around them): the owner's row of the prolongation comes from the
+    other process and the vertex is a coarse unknown of its owner (before, the other
+    process raised alone and the owner hung in the next collective call)."""
     from mpi4py import MPI
     from petsc4py import PETSc
 
@@ -190,10 +191,11 @@ def test_prolongation_from_a_column_only_another_process_names():
         J.setValue(i, i, 1.0)
     J.assemble()
     u = PETSc.IS().createGeneral(np.arange(first, first + 2, dtype=PETSc.IntType), comm=comm)
-    # rank 0's rows name column 0 only; rank 1's row 2 takes half of column 1 (rank 0's)
+    # rank 0 has row 0 only; rank 1 has rank 0's row 1 (the vertex 1 itself) and its row
+    # 2 takes half of column 1
     rows, cols, weights = {
-        0: ([0, 1], [0, 0], [1.0, 1.0]),
-        1: ([2, 2, 3], [1, 2, 3], [0.5, 0.5, 1.0]),
+        0: ([0], [0], [1.0]),
+        1: ([1, 2, 2, 3], [1, 1, 2, 3], [1.0, 0.5, 0.5, 1.0]),
     }[comm.rank]
     P, P_full, positions = _prolongation(
         J, u, np.array(rows), np.array(cols, dtype=PETSc.IntType), np.array(weights)
@@ -202,7 +204,7 @@ def test_prolongation_from_a_column_only_another_process_names():
     coarse, fine = P_full.createVecs()
     coarse.setArray([1.0, 10.0] if comm.rank == 0 else [100.0, 1000.0])
     P_full.mult(coarse, fine)
-    assert np.allclose(np.concatenate(comm.allgather(fine.array)), [1.0, 1.0, 55.0, 1000.0])
+    assert np.allclose(np.concatenate(comm.allgather(fine.array)), [1.0, 10.0, 55.0, 1000.0])
     assert list(positions) == [0, 1]
     for obj in (P, P_full, coarse, fine, u, J):
         obj.destroy()

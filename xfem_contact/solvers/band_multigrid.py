@@ -76,8 +76,9 @@ class BandMultigrid:
             modes: Near null space of ``A_uu`` (vectors laid out as ``u``); this object
                 takes them over (and destroys them).
             interpolation: ``None`` (degree 1), or ``(rows, cols, weights)``: global
-                unknowns of the operator, rows owned, each a displacement unknown, cols
-                the vertex unknowns it interpolates from (the coarse unknowns).
+                unknowns of the operator, rows owned or not (sent to their owners), each
+                a displacement unknown, cols the vertex unknowns it interpolates from
+                (the coarse unknowns).
         """
         self._forget_prolongations()
         self._forget_modes()
@@ -275,6 +276,7 @@ def _prolongation(
     comm = u.getComm()
     owned_u = u.getIndices()
     first, last = J.getOwnershipRange()
+    rows, cols, weights = _to_owners(J, rows, cols, weights)
     # the owned columns that some process interpolates from: a vertex's owner need not
     # hold a cell on which the field is active around it (its rows then do not name it)
     referenced = J.createVecRight()
@@ -308,6 +310,19 @@ def _prolongation(
     by_index = np.argsort(owned_u)  # u need not be sorted (side -1's nodes, then +1's)
     positions = by_index[np.searchsorted(owned_u, coarse, sorter=by_index)]
     return P, P_full, positions
+
+
+def _to_owners(J: PETSc.Mat, rows, cols, weights) -> tuple[np.ndarray, ...]:
+    """The interpolation's entries ``(row, col, weight)`` on the processes that own their
+    rows (from every process that has them), each ``(row, col)`` once. Collective."""
+    comm = J.getComm().tompi4py()
+    ranges = J.getOwnershipRanges()
+    owner = np.searchsorted(ranges, rows, side="right") - 1
+    sent = [(rows[owner == p], cols[owner == p], weights[owner == p]) for p in range(comm.size)]
+    received = comm.alltoall(sent)
+    rows, cols, weights = (np.concatenate([r[k] for r in received]) for k in range(3))
+    _, once = np.unique(np.stack([rows, cols]), axis=1, return_index=True)
+    return rows[once], cols[once], weights[once]
 
 
 def _restricted(mode: PETSc.Vec, positions: np.ndarray) -> PETSc.Vec:
