@@ -79,7 +79,7 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/inf_sup.py --study 3d --sizes 4 8 12
 	$(PY) bench/inf_sup.py --study 3d --cells hexahedron --elements P2-P1 --treatments restriction --sizes 4 8 --name inf_sup_3d_hexahedron_P2-P1_restriction_4_8
 	$(PY) bench/inf_sup.py --study 3d --cells hexahedron --elements P2-P1 --treatments stabilized --sizes 4 8 12 --name inf_sup_3d_hexahedron_P2-P1_stabilized_4_8_12
-	$(PY) bench/inf_sup.py --study 3d --cells tetrahedron --elements P2-P1 --treatments restriction --sizes 6 8 10 12 --name inf_sup_3d_tetrahedron_P2-P1_restriction_6_8_10_12
+	$(PY) bench/inf_sup.py --study 3d --cells tetrahedron --elements P2-P1 --treatments restriction --sizes 6 8 10 12 14 16 --name inf_sup_3d_tetrahedron_P2-P1_restriction_6_8_10_12_14_16
 	$(PY) bench/sphere_unstructured.py
 	$(PY) bench/inf_sup.py --study 3d --sizes 4 8 --spheres 12 --cells tetrahedron --treatments stabilized --name inf_sup_3d_spheres
 	$(PY) bench/inf_sup.py --study 3d --sizes 4 8 --spheres 12 --cells tetrahedron --elements P1-P1 --treatments "stabilized, ghost 0.1" "stabilized, aggregation 0.25" --name inf_sup_3d_spheres_P1-P1_ghost_aggregation

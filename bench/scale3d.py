@@ -30,7 +30,8 @@ iterative --name scale3d_1_6m``, ``--sizes 50 --solvers plain iterative --name s
 (3.1 M dofs: about 13 GB for the iterative preset), ``--sizes 12 --ranks 1 2
 --direct-max 12 --name scale3d_ranks``, ``--sizes 20 --ranks 1 2 --solvers plain iterative
 --repeat 2 --sleep-waits --name scale3d_ranks20_band3d`` (n = 24: ``--sizes 24 ... --name
-scale3d_ranks24_band3d``) and ``--sizes 16 --ranks 1 2
+scale3d_ranks24_band3d``; n = 34: ``--sizes 34 --ranks 1 2 --solvers plain iterative
+--sleep-waits --name scale3d_1m_ranks``) and ``--sizes 16 --ranks 1 2
 --solvers plain direct --direct-max 16 --sleep-waits --name scale3d_direct16``.
 ``bench/memory3d.py`` shows where the memory goes.
 """

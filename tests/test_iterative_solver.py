@@ -168,3 +168,43 @@ def test_a_bonded_interface_beside_a_contact_one():
     assert max(report.linear_iterations) <= 20
     with pytest.raises(ValueError, match="linear problem"):
         inclusion_problem(6, 2, "bonded", petsc_options=preset("iterative")).solve()
+
+
+@pytest.mark.mpi
+def test_prolongation_from_entries_only_another_process_has():
+    """A fine unknown whose interpolation only another process has, and a vertex unknown
+    that only another process interpolates from (their owner holds no cell on which the
+    field is active around them): the owner's row of the prolongation comes from the
+    other process and the vertex is a coarse unknown of its owner (before, the other
+    process raised alone and the owner hung in the next collective call)."""
+    from mpi4py import MPI
+    from petsc4py import PETSc
+
+    from xfem_contact.solvers.band_multigrid import _prolongation
+
+    comm = MPI.COMM_WORLD
+    if comm.size != 2:
+        pytest.skip("needs 2 processes")
+    first = 2 * comm.rank  # two unknowns a process: 0, 1 on rank 0; 2, 3 on rank 1
+    J = PETSc.Mat().createAIJ(((2, 4), (2, 4)), nnz=1, comm=comm)
+    for i in range(first, first + 2):
+        J.setValue(i, i, 1.0)
+    J.assemble()
+    u = PETSc.IS().createGeneral(np.arange(first, first + 2, dtype=PETSc.IntType), comm=comm)
+    # rank 0 has row 0 only; rank 1 has rank 0's row 1 (the vertex 1 itself) and its row
+    # 2 takes half of column 1
+    rows, cols, weights = {
+        0: ([0], [0], [1.0]),
+        1: ([1, 2, 2, 3], [1, 1, 2, 3], [1.0, 0.5, 0.5, 1.0]),
+    }[comm.rank]
+    P, P_full, positions = _prolongation(
+        J, u, np.array(rows), np.array(cols, dtype=PETSc.IntType), np.array(weights)
+    )
+    assert P_full.getSize() == (4, 4)
+    coarse, fine = P_full.createVecs()
+    coarse.setArray([1.0, 10.0] if comm.rank == 0 else [100.0, 1000.0])
+    P_full.mult(coarse, fine)
+    assert np.allclose(np.concatenate(comm.allgather(fine.array)), [1.0, 10.0, 55.0, 1000.0])
+    assert list(positions) == [0, 1]
+    for obj in (P, P_full, coarse, fine, u, J):
+        obj.destroy()

@@ -65,10 +65,11 @@ def vertex_interpolation(space: EnrichedSpace):
     degree 2: the coarse level of a two-level p-multigrid), or ``None`` for degree 1.
 
     Returns:
-        ``(rows, cols, weights)``: local dofs of ``space.W`` (``rows`` owned and active,
-        ``cols`` the active vertex dofs of the same field and component, owned or ghost)
-        and the weights of the degree-1 basis at the rows' nodes; each ``(row, col)``
-        once, taken from a cell on which the field is active. Not collective.
+        ``(rows, cols, weights)``: local dofs of ``space.W`` (``rows`` active, owned or
+        ghost: a dof's owner need not hold a cell on which the field is active around
+        it; ``cols`` the active vertex dofs of the same field and component) and the
+        weights of the degree-1 basis at the rows' nodes; each ``(row, col)`` once here,
+        taken from a cell on which the field is active. Not collective.
     """
     if space.degree == 1:
         return None
@@ -77,7 +78,6 @@ def vertex_interpolation(space: EnrichedSpace):
     fine = basix.create_element(basix.ElementFamily.P, cell_name, space.degree)
     coarse = basix.create_element(basix.ElementFamily.P, cell_name, 1)
     table = coarse.tabulate(0, fine.points)[0, :, :, 0]  # (fine nodes, vertices)
-    n_owned = W.dofmap.index_map.size_local * W.dofmap.index_map_bs
     gdim = W.mesh.geometry.dim
     node, vertex = np.nonzero(np.abs(table) > 1e-14)  # the nonzero weights
     rows, cols, weights = [], [], []
@@ -89,10 +89,8 @@ def vertex_interpolation(space: EnrichedSpace):
             cols.append(dofs[:, gdim * vertex + c].ravel())
             weights.append(np.tile(table[node, vertex], dofs.shape[0]))
     rows, cols, weights = (np.concatenate(a) for a in (rows, cols, weights))
-    keep = rows < n_owned
-    key = rows[keep].astype(np.int64) * active.size + cols[keep]
-    _, first = np.unique(key, return_index=True)
-    return rows[keep][first], cols[keep][first], weights[keep][first]
+    _, first = np.unique(rows.astype(np.int64) * active.size + cols, return_index=True)
+    return rows[first], cols[first], weights[first]
 
 
 def rigid_modes(space: EnrichedSpace) -> Iterator[dolfinx.fem.Function]:

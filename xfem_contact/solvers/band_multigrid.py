@@ -40,6 +40,7 @@ METIS (the row ``band_3d``).
 from __future__ import annotations
 
 import numpy as np
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from xfem_contact.solvers.assembly import aij
@@ -75,8 +76,9 @@ class BandMultigrid:
             modes: Near null space of ``A_uu`` (vectors laid out as ``u``); this object
                 takes them over (and destroys them).
             interpolation: ``None`` (degree 1), or ``(rows, cols, weights)``: global
-                unknowns of the operator, rows owned, each a displacement unknown, cols
-                the vertex unknowns it interpolates from (the coarse unknowns).
+                unknowns of the operator, rows owned or not (sent to their owners), each
+                a displacement unknown, cols the vertex unknowns it interpolates from
+                (the coarse unknowns).
         """
         self._forget_prolongations()
         self._forget_modes()
@@ -265,15 +267,24 @@ def _gram(B: PETSc.Mat) -> PETSc.Mat:
 def _prolongation(
     J: PETSc.Mat, u: PETSc.IS, rows, cols, weights
 ) -> tuple[PETSc.Mat, PETSc.Mat, np.ndarray]:
-    """``P_full`` from the coarse unknowns (the distinct ``cols``, numbered process by
-    process in the order of their global index) into all of ``J``'s unknowns (zero rows
-    outside ``u``: ``P_full^T J P_full`` is the coarse ``P^T J_uu P`` without extracting
-    ``J_uu``); ``P``, its rows ``u`` (a virtual sub-matrix: no copy); and the positions
-    in ``u``'s local part of the owned coarse unknowns. Collective."""
+    """``P_full`` from the coarse unknowns (the distinct ``cols`` of every process, each
+    numbered by its owner, process by process in the order of their global index) into
+    all of ``J``'s unknowns (zero rows outside ``u``: ``P_full^T J P_full`` is the coarse
+    ``P^T J_uu P`` without extracting ``J_uu``); ``P``, its rows ``u`` (a virtual
+    sub-matrix: no copy); and the positions in ``u``'s local part of the owned coarse
+    unknowns. Collective; raises on every process if the interpolation does not fit."""
     comm = u.getComm()
     owned_u = u.getIndices()
     first, last = J.getOwnershipRange()
-    coarse = np.unique(cols[(cols >= first) & (cols < last)])  # owned, by global index
+    rows, cols, weights = _to_owners(J, rows, cols, weights)
+    # the owned columns that some process interpolates from: a vertex's owner need not
+    # hold a cell on which the field is active around it (its rows then do not name it)
+    referenced = J.createVecRight()
+    wanted = np.unique(cols).astype(PETSc.IntType)
+    referenced.setValues(wanted, np.ones(wanted.size), addv=PETSc.InsertMode.ADD_VALUES)
+    referenced.assemble()
+    coarse = np.flatnonzero(referenced.getArray(readonly=True) > 0.0) + first  # by index
+    referenced.destroy()
     offset = comm.tompi4py().exscan(coarse.size) or 0
     # the coarse number of every column, from its owner
     number = J.createVecRight()
@@ -282,7 +293,8 @@ def _prolongation(
     number.setArray(values)
     coarse_cols = np.rint(gather(number, cols)).astype(PETSc.IntType)
     number.destroy()
-    if np.any(coarse_cols < 0) or not np.all(np.isin(rows, owned_u)):
+    fits = not np.any(coarse_cols < 0) and np.all(np.isin(rows, owned_u))
+    if not comm.tompi4py().allreduce(bool(fits and np.all(np.isin(coarse, owned_u))), MPI.LAND):
         raise RuntimeError("BandMultigrid: the interpolation does not fit the fieldsplits")
     order = np.lexsort((coarse_cols, rows))
     rows, coarse_cols, weights = rows[order], coarse_cols[order], weights[order]
@@ -298,6 +310,19 @@ def _prolongation(
     by_index = np.argsort(owned_u)  # u need not be sorted (side -1's nodes, then +1's)
     positions = by_index[np.searchsorted(owned_u, coarse, sorter=by_index)]
     return P, P_full, positions
+
+
+def _to_owners(J: PETSc.Mat, rows, cols, weights) -> tuple[np.ndarray, ...]:
+    """The interpolation's entries ``(row, col, weight)`` on the processes that own their
+    rows (from every process that has them), each ``(row, col)`` once. Collective."""
+    comm = J.getComm().tompi4py()
+    ranges = J.getOwnershipRanges()
+    owner = np.searchsorted(ranges, rows, side="right") - 1
+    sent = [(rows[owner == p], cols[owner == p], weights[owner == p]) for p in range(comm.size)]
+    received = comm.alltoall(sent)
+    rows, cols, weights = (np.concatenate([r[k] for r in received]) for k in range(3))
+    _, once = np.unique(np.stack([rows, cols]), axis=1, return_index=True)
+    return rows[once], cols[once], weights[once]
 
 
 def _restricted(mode: PETSc.Vec, positions: np.ndarray) -> PETSc.Vec:

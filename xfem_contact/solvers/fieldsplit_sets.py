@@ -114,8 +114,7 @@ def _reduced(interpolation, chosen, D):
         return None
     rows, cols, weights = interpolation
     rows, cols = chosen.columns[rows], chosen.columns[cols]
-    first = D.getOwnershipRange()[0]
-    scale = gather(D, cols) / D.getArray(readonly=True)[rows - first]
+    scale = gather(D, cols) / gather(D, rows)
     return rows, cols, weights * scale
 
 
