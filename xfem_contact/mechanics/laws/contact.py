@@ -57,8 +57,8 @@ class ContactLaw(MultiplierLaw):
 
     Args:
         augmentation: Dimensionless factor of ``r = augmentation * E / h`` (> 0).
-        lbb, multiplier_stabilization, multiplier_extension, multiplier_degree,
-            stabilization_length: See
+        **lbb_options: ``lbb``, ``multiplier_stabilization``, ``multiplier_extension``,
+            ``multiplier_degree``, ``stabilization_length``: see
             :class:`~xfem_contact.mechanics.laws.multiplier.MultiplierLaw`.
     """
 

@@ -51,9 +51,9 @@ class SlidingContact(ContactLaw):
             feet of its points cross master-piece ends, a Gauss rule per sub-segment
             (:mod:`~xfem_contact.mechanics.sliding.segments`); False: the interface
             rule's points. An attribute, settable between solves.
-        augmentation, lbb, multiplier_stabilization, multiplier_extension, multiplier_degree,
-            stabilization_length: As for
-            :class:`~xfem_contact.mechanics.laws.contact.Frictionless` (``lbb``:
+        **options: ``augmentation``, ``lbb``, ``multiplier_stabilization``,
+            ``multiplier_extension``, ``multiplier_degree``, ``stabilization_length``: as
+            for :class:`~xfem_contact.mechanics.laws.contact.Frictionless` (``lbb``:
             ``"stabilized"`` or ``"none"``; ``stabilization_length``: ``"cell"`` only).
     """
 
