@@ -38,7 +38,13 @@ from xfem_contact.geometry.exact_lines import ExactLevelSet
 from xfem_contact.geometry.exact_margin import exact_margin
 from xfem_contact.geometry.tensor_levelset import coefficients
 from xfem_contact.quadrature.rules import RuleSet
-from xfem_contact.quadrature.saye import MAX_DEPTH, CutRules, certified_sides, saye_points
+from xfem_contact.quadrature.saye import (
+    MAX_DEPTH,
+    CutRules,
+    certified_boxes,
+    certified_sides,
+    saye_points,
+)
 from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
 from xfem_contact.quadrature.tet_saye import RAISE_TOLERANCE, truncated_saye_points
 
@@ -148,16 +154,16 @@ def classify_p2_tets(
     """
     phi = nodal_values(phi, 10, "P2 tetrahedron", "tetrahedron")
     B = phi @ _to_simplex_bernstein().T
-    side = np.where(B.max(axis=1) < 0, -1, np.where(B.min(axis=1) >= 0, 1, 0)).astype(np.int8)
+    low, high = B.min(axis=1), B.max(axis=1)
+    side = np.where(high < 0, -1, np.where(low >= 0, 1, 0)).astype(np.int8)
     rest = np.flatnonzero(side == 0)
     sides = certified_sides(_cube_coefficients(phi[rest])).reshape(-1, 4)
     side[rest] = np.where((sides == -1).all(axis=1), -1, np.where((sides == 1).all(axis=1), 1, 0))
     if exact is not None:  # the tetrahedron's coefficients with the margin decide
-        low, high = B.min(axis=1), B.max(axis=1)
         near = np.flatnonzero((side != 0) & (np.minimum(np.abs(low), np.abs(high)) <= high - low))
         margin = exact_margin(phi[near], lambda rows, X: exact(near[rows], X))
-        certain = (high[near] < -margin) | (low[near] >= margin)
-        side[near[~certain]] = 0
+        boxes = certified_boxes(B[near], margin, np.arange(near.size))
+        side[near[~(boxes["minus"] | boxes["plus"])]] = 0
     return side
 
 

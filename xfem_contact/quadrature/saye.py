@@ -314,7 +314,7 @@ def certified_boxes(
     coefficients ``B`` ``(m, ...)`` of the polynomial on them: all ``< -margin[cell]``
     (side -1) or all ``>= margin[cell]`` (side +1); ``margin`` ``None``: 0 (the polynomial's
     own sides). A box of neither may be cut."""
-    flat = B.reshape(B.shape[0], -1)
+    flat = B.reshape(B.shape[0], int(np.prod(B.shape[1:])))  # no boxes: (0, k)
     if margin is None:
         return {"minus": (flat < 0).all(axis=1), "plus": (flat >= 0).all(axis=1)}
     m = margin[cell][:, None]
