@@ -93,6 +93,7 @@ TREATMENTS = {
     "stabilized, ghost 0.1": ("stabilized", 0.1, None, "cell"),
     "stabilized, aggregation 0.25": ("stabilized", None, 0.25, "cell"),
     "stabilized, cut length": ("stabilized", None, None, "cut"),
+    "stabilized, patch length": ("stabilized", None, None, "patch"),
 }
 #: The treatments of each study's default result (the others: ``--treatments``); a crack
 #: refuses the stabilisation (it squares the tip's singular traction on the lips)

@@ -175,6 +175,7 @@ class Problem:
                 self.space.split,
                 self.space.ramp,
                 self.space.interpolants,
+                float(self.bulk.ghost_penalty),
             )
             for name in self.laws
         }

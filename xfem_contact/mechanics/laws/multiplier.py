@@ -34,9 +34,9 @@ from xfem_contact.mechanics.parameters import Parameter, constant
 
 LBB_OPTIONS = ("stabilized", "restriction", "none")
 #: The lengths the Barbosa-Hughes scale may take (see ``MultiplierLaw.stabilization_scale``)
-STABILIZATION_LENGTHS = ("cell", "cut")
+STABILIZATION_LENGTHS = ("cell", "cut", "patch")
 #: The default weight ``gamma`` of the Barbosa-Hughes term with each length
-STABILIZATION_WEIGHTS = {"cell": 0.1, "cut": 0.5}
+STABILIZATION_WEIGHTS = {"cell": 0.1, "cut": 0.5, "patch": 0.5}
 #: Lagrange degrees of a multiplier field
 MULTIPLIER_DEGREES = (1, 2)
 #: Weight of the normal-gradient term on cells where the interface follows a reference
@@ -124,15 +124,14 @@ class MultiplierLaw(InterfaceLaw):
         return vital_vertex_prolongation(ctx.cut, space, ctx.field, ctx.name)
 
     # -- LBB terms ----------------------------------------------------------------------
-    @staticmethod
-    def side_compliances(ctx: InterfaceContext) -> dict:
+    def side_compliances(self, ctx: InterfaceContext) -> dict:
         """Per side ``s``, ``c_s = l_s / (2 mu_s + lambda_s)`` (m/Pa, UFL, cellwise):
         the side's trace length (:meth:`InterfaceContext.trace_lengths`) over its
         P-wave modulus. ``int_Gamma_T |sigma_s n|^2 ds <= a_T_s(u, u) / c_s`` on every
         cut cell ``T`` (``a_T_s`` the side's elastic energy in ``T``): ``|sigma n|^2 <=
         (2 mu + lambda) sigma : eps`` pointwise, with the plane-stress ``lambda`` in
         plane stress."""
-        lengths = ctx.trace_lengths()
+        lengths = ctx.trace_lengths(patch=self.stabilization_length == "patch")
         m = ctx.materials
         return {s: lengths[s] / (2.0 * m[s].ufl_mu + m[s].ufl_lmbda) for s in (-1, 1)}
 
@@ -149,7 +148,7 @@ class MultiplierLaw(InterfaceLaw):
         volume and stiffness weights of Annavarapu, Hautefeuille and Dolbow 2012); a
         side that holds a sliver of the cell weighs nothing.
         """
-        if self.stabilization_length == "cut":
+        if self.stabilization_length in ("cut", "patch"):
             c = self.side_compliances(ctx)
             total = c[-1] + c[1]
             return c[-1] / total, c[1] / total
@@ -179,7 +178,7 @@ class MultiplierLaw(InterfaceLaw):
         compliance (docs' stability page).
         """
         gamma = constant(self, "multiplier_stabilization")
-        if self.stabilization_length == "cut":
+        if self.stabilization_length in ("cut", "patch"):
             c = self.side_compliances(ctx)
             return gamma * (c[-1] + c[1])
         w_minus, w_plus = self.traction_weights(ctx)
