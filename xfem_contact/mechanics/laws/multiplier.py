@@ -60,7 +60,9 @@ class MultiplierLaw(InterfaceLaw):
             :func:`~xfem_contact.mechanics.lbb_space.vital_vertex_prolongation`).
         stabilization_length: The length of the Barbosa-Hughes scale (one of
             :data:`STABILIZATION_LENGTHS`): ``"cell"`` the cell's diameter, ``"cut"`` the
-            sides' trace lengths in each cut cell (see :meth:`stabilization_scale`).
+            sides' trace lengths in each cut cell, ``"patch"`` those lengths credited
+            with the facet neighbours' control through the ghost penalty (see
+            :meth:`stabilization_scale`).
     """
 
     multiplier_stabilization = Parameter(minimum=0.0)
@@ -126,7 +128,8 @@ class MultiplierLaw(InterfaceLaw):
     # -- LBB terms ----------------------------------------------------------------------
     def side_compliances(self, ctx: InterfaceContext) -> dict:
         """Per side ``s``, ``c_s = l_s / (2 mu_s + lambda_s)`` (m/Pa, UFL, cellwise):
-        the side's trace length (:meth:`InterfaceContext.trace_lengths`) over its
+        the side's trace length (:meth:`InterfaceContext.trace_lengths`; the patch
+        lengths with ``stabilization_length="patch"``) over its
         P-wave modulus. ``int_Gamma_T |sigma_s n|^2 ds <= a_T_s(u, u) / c_s`` on every
         cut cell ``T`` (``a_T_s`` the side's elastic energy in ``T``): ``|sigma n|^2 <=
         (2 mu + lambda) sigma : eps`` pointwise, with the plane-stress ``lambda`` in
@@ -170,7 +173,9 @@ class MultiplierLaw(InterfaceLaw):
         (2 mu)`` for one material; ``h`` the cell's diameter, ``w_s`` of
         :meth:`traction_weights`).
 
-        ``"cut"``: ``gamma (c_- + c_+)`` per cut cell (:meth:`side_compliances`). With
+        ``"cut"`` (and ``"patch"``, with the patch lengths of
+        :meth:`InterfaceContext.trace_lengths`, whose bound counts the ghost penalty
+        too): ``gamma (c_- + c_+)`` per cut cell (:meth:`side_compliances`). With
         the weights ``w_s = c_s / (c_- + c_+)`` it bounds what the displacement block
         loses, ``s int_Gamma_T |t(u)|^2 ds <= gamma a_T(u, u)`` on every cut cell ``T``:
         the block keeps ``(1 - gamma)`` of the elastic energy for ``gamma < 1`` however
