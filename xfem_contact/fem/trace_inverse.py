@@ -150,28 +150,13 @@ def side_trace_lengths(cut: CutMesh, name: str | None, degree: int) -> dict[int,
     ``cut.cut_cells``; 0 on the cells of other interfaces) for a displacement of
     ``degree`` (see the module). Local."""
     interface = cut.interface_rules_of(name)
-    cells = cut.cut_cells
-
     cell_name = cut.mesh.topology.cell_name()
-    if cut.maps.coordinate_element.degree == 1 and cell_name in SIMPLICES:
-        # affine cells: one Jacobian a cell
-        origin = np.zeros((cells.size, cut.mesh.topology.dim))
-        per_cell = np.abs(np.linalg.det(cut.maps.jacobian(cells, origin)))
-
-        def det(rules: RuleSet) -> npt.NDArray[np.float64]:
-            return per_cell[rules.point_rows]
-
-    else:
-
-        def det(rules: RuleSet) -> npt.NDArray[np.float64]:
-            J = cut.maps.jacobian(cells[rules.point_rows], rules.points)
-            return np.abs(np.linalg.det(J))
-
-    interface_det = det(interface)
+    interface_det = _rule_dets(cut, interface)
     out = {}
     for s, slot in ((-1, SIDE_MINUS), (1, SIDE_PLUS)):
         side = cut.rules[slot]
-        lengths = trace_lengths(cell_name, degree, side, det(side), interface, interface_det)
+        dets = _rule_dets(cut, side)
+        lengths = trace_lengths(cell_name, degree, side, dets, interface, interface_det)
         out[s] = np.where(np.isfinite(lengths), lengths, 0.0)
     return out
 
@@ -228,61 +213,69 @@ def patch_trace_lengths(
     shared = dolfinx.la.vector(imap, bs)
     data = shared.array.reshape(-1, bs)
     for k, (s, slot) in enumerate(((-1, SIDE_MINUS), (1, SIDE_PLUS))):
-        rules = cut.rules[slot]
-        X = cut.maps.push_forward(cells[rules.point_rows], rules.points)
-        weights = rules.weights * _abs_det(cut, cells[rules.point_rows], rules.points)
-        Y = (X[:, :tdim] - centres[cells[rules.point_rows]]) / h[cells[rules.point_rows], None]
-        M = _cell_masses(rules, Y, weights, exponents)
+        M = _own_basis_masses(cut, cut.rules[slot], centres, h, exponents)
         data[cells[carries], k * m * m : (k + 1) * m * m] = M[carries].reshape(-1, m * m)
         data[cells[carries], 2 * m * m + k] = own[s][carries]
     shared.scatter_forward()
+    M_gamma = _own_basis_masses(cut, interface, centres, h, exponents)
 
     side_of = cut.side_indicator().x.array
     mesh.topology.create_connectivity(tdim, tdim - 1)
     mesh.topology.create_connectivity(tdim - 1, tdim)
     c2f = mesh.topology.connectivity(tdim, tdim - 1)
     f2c = mesh.topology.connectivity(tdim - 1, tdim)
-    nfacets = c2f.links(0).size
-    theta = 1.0 / (2 * nfacets)
+    theta = 1.0 / (2 * c2f.links(0).size)
+    # the facet neighbours of the carrying cut cells (both affine)
+    pairs = []  # (row, T, F, K)
+    for row in np.flatnonzero(carries):
+        T = cells[row]
+        for F in c2f.links(T) if affine[T] else ():
+            link = f2c.links(F)
+            K = link[0] if link[-1] == T else link[-1]
+            if link.size == 2 and affine[K]:
+                pairs.append((row, T, F, K))
+    uncut = np.unique([K for *_, K in pairs if side_of[K] != 0]).astype(np.int32)
+    masses = _full_cell_masses(cut, degree, uncut, centres, h, exponents)
+    full = dict(zip(uncut, masses, strict=True))
+    facet_rule = _facet_rule(mesh, degree)
+    jumps, bases = {}, {}  # per (T, F) and (T, K), shared by the sides
+
     out = {s: own[s].copy() for s in (-1, 1)}
-    full = _full_cell_rule(mesh, degree)
     for k, s in enumerate((-1, 1)):
         length = data[:, 2 * m * m + k]
-        for row in np.flatnonzero(carries):
-            T = cells[row]
-            if not affine[T] or length[T] <= 0:
+        A = {row: data[cells[row], k * m * m : (k + 1) * m * m].reshape(m, m) for row, *_ in pairs}
+        lent = dict.fromkeys(A, False)
+        borrowers = dict.fromkeys(A, 0)
+        for row, T, F, K in pairs:
+            if length[T] <= 0:
                 continue
-            lenders, borrowers = [], 0
-            for F in c2f.links(T):
-                link = f2c.links(F)
-                if link.size != 2:
-                    continue
-                K = link[0] if link[1] == T else link[1]
-                if not affine[K]:
-                    continue
-                if side_of[K] == s:
-                    lenders.append((K, F, None))
-                elif length[K] > BORROW_RATIO * length[T]:
-                    lenders.append((K, F, data[K, k * m * m : (k + 1) * m * m].reshape(m, m)))
-                elif 0 < length[K] and BORROW_RATIO * length[K] < length[T]:
-                    borrowers += 1
-            if not lenders:
-                if borrowers:
-                    out[s][row] = (1.0 - theta * borrowers) * own[s][row]
+            if side_of[K] == s:
+                M_K = full[K]
+            elif length[K] > BORROW_RATIO * length[T]:
+                M_K = data[K, k * m * m : (k + 1) * m * m].reshape(m, m)
+            else:
+                borrowers[row] += 0 < length[K] and BORROW_RATIO * length[K] < length[T]
                 continue
-            M_own = data[T, k * m * m : (k + 1) * m * m].reshape(m, m)
-            A = (1.0 - theta * borrowers) * M_own
-            for K, F, M_K in lenders:
-                basis = _basis_change(exponents, centres, h, T, K)
-                if M_K is None:
-                    M_K = _full_cell_mass(cut, full, K, centres, h, exponents)
-                M_K = basis.T @ M_K @ basis
+            if (T, K) not in bases:
+                bases[T, K] = _basis_change(exponents, centres, h, T, K)
                 h_facet = 0.5 * (h[T] + h[K])  # the ghost penalty's avg(h)
-                G = ghost[s] * _jump_mass(mesh, F, degree, exponents, centres[T], h[T], h_facet)
-                # min over q_K of theta |q_K|^2_(K_s) + |p - q_K|^2_G: a Schur complement
-                A = A + G - G @ np.linalg.pinv(theta * M_K + G, rcond=1e-13, hermitian=True) @ G
-            M_gamma = _interface_mass(cut, interface, row, T, centres, h, exponents)
-            out[s][row] = _least_ratio(A, M_gamma)
+                jumps[T, F] = _jump_mass(
+                    mesh, F, facet_rule, degree, exponents, centres[T], h[T], h_facet
+                )
+            M_K = bases[T, K].T @ M_K @ bases[T, K]
+            G = ghost[s] * jumps[T, F]
+            # min over q_K of theta |q_K|^2_(K_s) + |p - q_K|^2_G: a Schur complement
+            A[row] = (
+                A[row] + G - G @ np.linalg.pinv(theta * M_K + G, rcond=1e-13, hermitian=True) @ G
+            )
+            lent[row] = True
+        for row in A:
+            if length[cells[row]] <= 0 or not (lent[row] or borrowers[row]):
+                continue
+            # A[row] holds the own mass once: the borrowers' shares come off it
+            M_own = data[cells[row], k * m * m : (k + 1) * m * m].reshape(m, m)
+            matrix = A[row] - theta * borrowers[row] * M_own
+            out[s][row] = _least_ratio(matrix, M_gamma[row])
     return out
 
 
@@ -321,16 +314,17 @@ def _affine_cells(cut: CutMesh, nlocal: int) -> npt.NDArray[np.bool_]:
 def _monomials(exponents, Y, derivative=None, h=1.0):
     """Values of ``phi_e(Y) = Y^e`` (or of their derivative ``d^alpha / dx^alpha`` for
     ``x = h Y``), shape ``(m, npoints)``."""
-    alpha = np.zeros(exponents.shape[1], dtype=np.int64) if derivative is None else derivative
-    out = np.ones((exponents.shape[0], Y.shape[0]))
-    for axis in range(exponents.shape[1]):
-        e = exponents[:, axis]
-        a = alpha[axis]
-        factor = np.ones_like(e, dtype=float)
-        for i in range(a):
+    m, tdim = exponents.shape
+    alpha = np.zeros(tdim, dtype=np.int64) if derivative is None else derivative
+    top = int(exponents.max(initial=0))
+    out = np.ones((m, Y.shape[0]))
+    for axis in range(tdim):
+        powers = np.cumprod(np.vstack([np.ones(Y.shape[0]), np.tile(Y[:, axis], (top, 1))]), 0)
+        e, a = exponents[:, axis], int(alpha[axis])
+        factor = np.ones(m)
+        for i in range(a):  # the falling factorial e (e - 1) ... (e - a + 1)
             factor *= e - i
-        power = np.maximum(e - a, 0)
-        out *= (factor / h**a)[:, None] * Y[None, :, axis] ** power[:, None]
+        out *= (factor / h**a)[:, None] * powers[np.maximum(e - a, 0)]
     return out
 
 
@@ -346,35 +340,69 @@ def _basis_change(exponents, centres, h, T, K) -> npt.NDArray[np.float64]:
     return np.linalg.lstsq(phi_K.T, phi_T.T, rcond=None)[0]
 
 
-def _full_cell_rule(mesh: dolfinx.mesh.Mesh, degree: int):
-    cell = mesh.topology.cell_type
-    return basix.make_quadrature(getattr(basix.CellType, cell.name), 2 * degree * mesh.topology.dim)
+def _rule_dets(cut: CutMesh, rules: RuleSet) -> npt.NDArray[np.float64]:
+    """``|det J|`` at the points of ``rules`` (rows of ``cut.cut_cells``); one Jacobian a
+    cell on affine simplices."""
+    cells = cut.cut_cells
+    if cut.maps.coordinate_element.degree == 1 and cut.mesh.topology.cell_name() in SIMPLICES:
+        origin = np.zeros((cells.size, cut.mesh.topology.dim))
+        return np.abs(np.linalg.det(cut.maps.jacobian(cells, origin)))[rules.point_rows]
+    return _abs_det(cut, cells[rules.point_rows], rules.points)
 
 
-def _full_cell_mass(cut, rule, K, centres, h, exponents) -> npt.NDArray[np.float64]:
-    """The mass matrix of the monomials about ``K``'s centre over the whole cell."""
-    X, w = rule
+def _own_basis_masses(cut: CutMesh, rules: RuleSet, centres, h, exponents) -> np.ndarray:
+    """Per rule (rows of ``cut.cut_cells``) the mass matrix of the monomials about its
+    cell's centre scaled by its ``h``, shape ``(nrows, m, m)``."""
     tdim = exponents.shape[1]
-    cells = np.full(X.shape[0], K, dtype=np.int32)
-    x = cut.maps.push_forward(cells, X)[:, :tdim]
-    phi = _monomials(exponents, (x - centres[K]) / h[K])
-    return (phi * (w * _abs_det(cut, cells, X))) @ phi.T
+    cells = cut.cut_cells[rules.point_rows]
+    x = cut.maps.push_forward(cells, rules.points)[:, :tdim]
+    weights = rules.weights * _rule_dets(cut, rules)
+    return _cell_masses(rules, (x - centres[cells]) / h[cells, None], weights, exponents)
 
 
-def _jump_mass(mesh, F, degree, exponents, centre, h_cell, h_facet) -> npt.NDArray[np.float64]:
-    """``sum_(j<k) h_facet^(2j+1) int_F grad^j phi . grad^j phi^T ds`` for the
-    monomials about ``centre`` scaled by ``h_cell``, shape ``(m, m)``."""
+def _full_cell_masses(cut: CutMesh, degree: int, cells, centres, h, exponents) -> np.ndarray:
+    """The mass matrices of the monomials about each of ``cells``' centres over the
+    whole cell, shape ``(len(cells), m, m)``."""
+    mesh = cut.mesh
     tdim = mesh.topology.dim
-    facet_type = basix.cell.sub_entity_type(
-        getattr(basix.CellType, mesh.topology.cell_type.name), tdim - 1, 0
-    )
-    X, w = basix.make_quadrature(facet_type, 2 * degree * tdim)
+    cell = getattr(basix.CellType, mesh.topology.cell_type.name)
+    X, w = basix.make_quadrature(cell, 2 * degree * tdim)
+    out = np.empty((len(cells), exponents.shape[0], exponents.shape[0]))
+    chunk = max(1, POINTS // X.shape[0])
+    for start in range(0, len(cells), chunk):
+        part = cells[start : start + chunk]
+        x = cut.maps.push_forward_lattice(part, X)[:, :tdim].reshape(len(part), -1, tdim)
+        J = cut.maps.jacobian_lattice(part, X)[:, :tdim, :tdim]
+        dx = (w * np.abs(np.linalg.det(J)).reshape(len(part), -1)).ravel()
+        Y = ((x - centres[part, None]) / h[part, None, None]).reshape(-1, tdim)
+        phi = _monomials(exponents, Y).reshape(exponents.shape[0], len(part), -1)
+        weighted = phi * dx.reshape(len(part), -1)[None]
+        out[start : start + len(part)] = np.einsum("icq,jcq->cij", weighted, phi)
+    return out
+
+
+def _facet_rule(mesh: dolfinx.mesh.Mesh, degree: int):
+    """A Gauss rule on the reference facet exact for the products of the strain
+    monomials' derivatives restricted to a facet."""
+    tdim = mesh.topology.dim
+    cell = getattr(basix.CellType, mesh.topology.cell_type.name)
+    facet = basix.cell.sub_entity_type(cell, tdim - 1, 0)
+    return basix.make_quadrature(facet, 2 * degree * (tdim - 1))
+
+
+def _jump_mass(
+    mesh, F, rule, degree, exponents, centre, h_cell, h_facet
+) -> npt.NDArray[np.float64]:
+    """``sum_(j<k) h_facet^(2j+1) int_F grad^j phi . grad^j phi^T ds`` for the
+    monomials about ``centre`` scaled by ``h_cell`` (``k`` the displacement's
+    ``degree``: the ghost penalty jumps ``grad^(j+1) u``), shape ``(m, m)``."""
+    tdim = mesh.topology.dim
+    X, w = rule
     nodes = dolfinx.mesh.entities_to_geometry(mesh, tdim - 1, np.array([F], dtype=np.int32))[0]
     v = mesh.geometry.x[nodes][:, :tdim]
     axes = np.stack([v[1] - v[0]] + ([v[2] - v[0]] if tdim == 3 else []), 1)  # (tdim, tdim-1)
     measure = np.sqrt(np.linalg.det(axes.T @ axes))
-    x = v[0] + X @ axes.T
-    Y = (x - centre) / h_cell
+    Y = (v[0] + X @ axes.T - centre) / h_cell
     m = exponents.shape[0]
     G = np.zeros((m, m))
     for j in range(degree):
@@ -387,18 +415,6 @@ def _jump_mass(mesh, F, degree, exponents, centre, h_cell, h_facet) -> npt.NDArr
             d = _monomials(exponents, Y, alpha, h_cell)
             G += h_facet ** (2 * j + 1) * multiplicity * (d * (w * measure)) @ d.T
     return G
-
-
-def _interface_mass(cut, interface, row, T, centres, h, exponents) -> npt.NDArray[np.float64]:
-    """The interface's mass matrix in ``T`` (row ``row``) of the monomials about its
-    centre."""
-    tdim = exponents.shape[1]
-    at = interface.point_rows == row
-    X, w = interface.points[at], interface.weights[at]
-    cells = np.full(X.shape[0], T, dtype=np.int32)
-    x = cut.maps.push_forward(cells, X)[:, :tdim]
-    phi = _monomials(exponents, (x - centres[T]) / h[T])
-    return (phi * (w * _abs_det(cut, cells, X))) @ phi.T
 
 
 def _least_ratio(A: npt.NDArray[np.float64], B: npt.NDArray[np.float64]) -> float:
