@@ -62,3 +62,15 @@ def test_the_patch_length_is_the_same_on_one_and_two_ranks():
     beta = circle_inf_sup(None, n=8).beta
     beta_self = circle_inf_sup(None, n=8, comm=MPI.COMM_SELF).beta
     assert abs(beta - beta_self) <= 1e-8 * beta_self
+
+
+def test_lowering_the_credited_ghost_penalty_is_refused():
+    """The patch lengths credit the ghost penalty of the cut: a lower weight would void
+    the bound; a higher one keeps it."""
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    cut = CutMesh(mesh, lambda x: np.hypot(x[0] - 0.5, x[1] - 0.5) - 0.3, degree=2)
+    law = Bonded(lbb="stabilized", stabilization_length="patch")
+    problem = Problem(cut, 1, Material(100e6, 0.3), law)
+    problem.ghost_penalty = 0.05
+    with pytest.raises(ValueError, match="ghost_penalty 0.001 is below 0.01"):
+        problem.ghost_penalty = 0.001
