@@ -213,23 +213,13 @@ class Problem:
     @property
     def ghost_penalty(self) -> float:
         """Weight of the ghost penalty (a Constant of the forms: settable, see
-        :class:`~xfem_contact.mechanics.bulk.SmallStrain`; not below its value at the
-        cut with a law of ``stabilization_length="patch"``, whose lengths credit it)."""
+        :class:`~xfem_contact.mechanics.bulk.SmallStrain`; the laws may refuse a value)."""
         return self.bulk.ghost_penalty
 
     @ghost_penalty.setter
     def ghost_penalty(self, value: float) -> None:
-        built = [
-            ctx.ghost_penalty
-            for name, ctx in self.contexts.items()
-            if getattr(self.laws[name], "stabilization_length", None) == "patch"
-        ]
-        if built and value < min(built):
-            raise ValueError(
-                f"ghost_penalty {value!r} is below {min(built)!r}, the weight the "
-                "stabilization_length='patch' lengths were computed with (they credit it): "
-                "build the problem with the lower ghost_penalty"
-            )
+        for name, law in self.laws.items():
+            law.check_ghost_penalty(self.contexts[name], value)
         self.bulk.ghost_penalty = value
 
     @property

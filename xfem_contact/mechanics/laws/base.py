@@ -437,6 +437,11 @@ class InterfaceLaw(abc.ABC):
         """The law's name and options (for summaries)."""
         return {"law": self.name}
 
+    def check_ghost_penalty(self, ctx: InterfaceContext, value: float) -> None:
+        """Refuse a new ghost penalty weight ``value`` that the forms built on ``ctx``
+        rely on being larger (ValueError); none here."""
+        return None
+
 
 class FixedAtConstruction:
     """A law option that shapes the forms or the pairing (the LBB treatment, the slave
