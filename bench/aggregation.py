@@ -37,7 +37,8 @@ P2 on quadrilaterals and triangles, n = 10, 20, 40) and case 3 (the annulus, alp
 P2 on curved Q2 cells, 4 x 16, 8 x 32, 16 x 64) with the default treatment (ghost
 penalty 0.01), none (no ghost penalty, the dofs of empty support dropped), aggregation
 (0.25, 0.15) on top of the ghost penalty, aggregation alone, and the Barbosa-Hughes scale
-of the cut (``stabilization_length="cut"``) with the ghost penalty.
+of the cut (``stabilization_length="cut"``, and ``"patch"``) with the ghost penalty
+(``--accuracy-columns``: some of these only).
 
 Part ``crack``: the Williams crack on Q2 quadrilaterals (geometric tip enrichment,
 r_e = 0.3), n = 32, 64, 128, without and with ``aggregation=0.25`` (the default tip
@@ -47,11 +48,13 @@ its rate and the condition number of the matrix the solver factors (tip-transfor
 
 Run: ``python bench/aggregation.py [--parts conditioning crack_conditioning accuracy
 crack] [--circles 30] [--sizes 8 16 32] [--treatments none "aggregation 0.25"]
-[--tip-basis plain] [--tip-radius none] [--dense-below 0] [--name NAME]``; writes
+[--tip-basis plain] [--tip-radius none] [--dense-below 0] [--accuracy-columns LABEL ...]
+[--name NAME]``; writes
 ``bench/results/aggregation.{json,md}`` (conditioning; ``NAME.{json,md}`` with
 ``--name``),
 ``bench/results/aggregation_crack_conditioning.{json,md}``,
-``bench/results/aggregation_accuracy.md`` and ``bench/results/aggregation_crack.md``.
+``bench/results/aggregation_accuracy.md`` (``NAME.md`` with ``--name``) and
+``bench/results/aggregation_crack.md``.
 """
 
 import os
@@ -265,11 +268,14 @@ ACCURACY_TREATMENTS = {
     "ghost penalty 0.01 + aggregation 0.15": {"aggregation": 0.15},
     "aggregation 0.25 alone": {"aggregation": 0.25, "ghost_penalty": 0.0},
     "ghost penalty 0.01, stabilization length 'cut'": {"stabilization_length": "cut"},
+    "ghost penalty 0.01, stabilization length 'patch'": {"stabilization_length": "patch"},
 }
 
 
-def accuracy() -> None:
-    """The accuracy part (module docstring): prints and writes a Markdown table."""
+def accuracy(columns: list[str] | None = None, name: str = "aggregation_accuracy") -> None:
+    """The accuracy part (module docstring): prints and writes a Markdown table of the
+    ``columns`` (labels of :data:`ACCURACY_TREATMENTS`; None: all) to ``name``."""
+    treatments = {c: ACCURACY_TREATMENTS[c] for c in (columns or ACCURACY_TREATMENTS)}
     cases = [
         (f"case 2, {cell}, n = {n}", lambda o, n=n, c=cell: _case2(n, c, o))
         for cell in ("quadrilateral", "triangle")
@@ -280,20 +286,20 @@ def accuracy() -> None:
         for nr, na in ((4, 16), (8, 32), (16, 64))
     ]
     lines = [
-        "| case | " + " | ".join(ACCURACY_TREATMENTS) + " |",
-        "|---|" + "---|" * len(ACCURACY_TREATMENTS),
+        "| case | " + " | ".join(treatments) + " |",
+        "|---|" + "---|" * len(treatments),
     ]
-    for name, run in cases:
+    for case, run in cases:
         errors = []
-        for options in ACCURACY_TREATMENTS.values():
+        for options in treatments.values():
             try:
                 errors.append(f"{run(options):.3e}")
             except Exception as error:  # reported, not hidden
                 errors.append(f"failed: {type(error).__name__}")
-        lines.append(f"| {name} | " + " | ".join(errors) + " |")
+        lines.append(f"| {case} | " + " | ".join(errors) + " |")
         note(lines[-1])
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "aggregation_accuracy.md").write_text("\n".join(lines) + "\n")
+    (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 
@@ -362,10 +368,17 @@ def main() -> None:
         help="all eigenvalues of a dense matrix below this many unknowns, else the extreme "
         "ones (SLEPc; 0: always, about 5 times faster at n = 8)",
     )
+    parser.add_argument(
+        "--accuracy-columns",
+        nargs="+",
+        default=None,
+        choices=list(ACCURACY_TREATMENTS),
+        help="the accuracy part's treatments (default: all)",
+    )
     parser.add_argument("--name", default=None, help="results name (default: the part's)")
     args = parser.parse_args()
     if "accuracy" in args.parts:
-        accuracy()
+        accuracy(args.accuracy_columns, args.name or "aggregation_accuracy")
     if "conditioning" in args.parts:
         conditioning(args)
     if "crack_conditioning" in args.parts:

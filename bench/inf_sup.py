@@ -19,7 +19,8 @@ The studies (``--study``):
 
 The treatments (``--treatments``): none, restriction, stabilized; stabilized with the
 ghost penalty raised to the stabilisation's weight (0.1), with cell aggregation, or with
-the scale of the cut (``stabilization_length="cut"``).
+the scale of the cut (``stabilization_length="cut"``, or ``"patch"``, credited through
+the ghost penalty); ``--weight`` sets the stabilisation's weight ``gamma``.
 Prints, per element, treatment and n, the least and median beta, the count of
 indefinite pairs (beta^2 < 0; without a treatment, round-off of a zero eigenvalue: a
 spurious multiplier), the count of samples whose displacement block has a negative
@@ -31,7 +32,7 @@ differ from the study's default, or ``--name``). BLAS runs on one thread (the de
 eigenproblems are small; threads only contend).
 
 Run: ``python bench/inf_sup.py [--study circles|crack|3d] [--circles 50] [--sizes 8 16
-32 64] [--elements P2-P2] [--treatments ...]``.
+32 64] [--elements P2-P2] [--treatments ...] [--weight 0.75]``.
 """
 
 import os
@@ -93,6 +94,7 @@ TREATMENTS = {
     "stabilized, ghost 0.1": ("stabilized", 0.1, None, "cell"),
     "stabilized, aggregation 0.25": ("stabilized", None, 0.25, "cell"),
     "stabilized, cut length": ("stabilized", None, None, "cut"),
+    "stabilized, patch length": ("stabilized", None, None, "patch"),
 }
 #: The treatments of each study's default result (the others: ``--treatments``); a crack
 #: refuses the stabilisation (it squares the tip's singular traction on the lips)
@@ -190,12 +192,25 @@ CUTS: dict[str, Callable[..., Iterator[CutMesh]]] = {
 
 
 def sample(
-    study: str, cell: str, degree: int, multiplier: int, lbb: str, n: int, count: int
+    study: str,
+    cell: str,
+    degree: int,
+    multiplier: int,
+    lbb: str,
+    n: int,
+    count: int,
+    weight: float | None = None,
 ) -> tuple[list[InfSup] | None, str]:
     """The :class:`InfSup` of each cut of one mesh and ``""``; or None and the reason the
-    problem refuses the treatment."""
+    problem refuses the treatment. ``weight``: the stabilisation's ``gamma`` (None: the
+    default of the treatment's length)."""
     treatment, ghost_penalty, aggregation, length = TREATMENTS[lbb]
-    law = Bonded(lbb=treatment, multiplier_degree=multiplier, stabilization_length=length)
+    law = Bonded(
+        lbb=treatment,
+        multiplier_degree=multiplier,
+        stabilization_length=length,
+        multiplier_stabilization=weight,
+    )
     out = []
     for cut in CUTS[study](n, cell, degree, count):
         try:
@@ -293,6 +308,9 @@ def main() -> None:
         "--cells", nargs="+", help="these cells only (default: both of the study's)"
     )
     parser.add_argument("--treatments", nargs="+", choices=list(TREATMENTS), help="LBB treatments")
+    parser.add_argument(
+        "--weight", type=float, help="the stabilisation's weight gamma (default: the length's)"
+    )
     parser.add_argument("--name", help="results bench/results/NAME.* (default: see above)")
     args = parser.parse_args()
     study = args.study
@@ -313,6 +331,8 @@ def main() -> None:
         parts += chosen
     if list(treatments) != list(DEFAULT_TREATMENTS[study]):
         parts += [t.replace(", ", "_").replace(" ", "_") for t in treatments]
+    if args.weight is not None:
+        parts.append(f"weight_{args.weight:g}")
     name = args.name or "_".join(["inf_sup", *parts, *(args.cells or [])])
     command = shlex.join(["python", "bench/inf_sup.py", *sys.argv[1:]])
     rows = []
@@ -320,7 +340,9 @@ def main() -> None:
         for lbb in treatments:
             for n in sizes:
                 start = time.perf_counter()
-                results, refused = sample(study, cell, degree, multiplier, lbb, n, count)
+                results, refused = sample(
+                    study, cell, degree, multiplier, lbb, n, count, args.weight
+                )
                 b2 = [r.beta_squared for r in results or []]
                 b = np.sqrt(np.maximum(b2, 0.0)) if b2 else np.zeros(1)
                 rows.append(

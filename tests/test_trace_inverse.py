@@ -14,7 +14,11 @@ import pytest
 from mpi4py import MPI
 
 from xfem_contact.fem.cutmesh import CutMesh
-from xfem_contact.fem.trace_inverse import side_trace_lengths, strain_exponents
+from xfem_contact.fem.trace_inverse import (
+    patch_trace_lengths,
+    side_trace_lengths,
+    strain_exponents,
+)
 
 #: The corner cut: the line x + y = T through the cell (0, 0), (1, 0), (0, 1) of a
 #: 1 x 1 mesh of two right triangles (the other cell is not cut)
@@ -74,3 +78,31 @@ def test_the_strain_spaces(cell, degree, tdim, size):
 def test_a_degree_below_one_is_refused():
     with pytest.raises(ValueError, match="degree must be at least 1"):
         strain_exponents("triangle", 0, 2)
+
+
+def test_a_side_borrows_its_uncut_neighbour_through_the_ghost_penalty():
+    """Constant strains (P1): the cut cell's side ``+`` borrows the uncut neighbour ``K``
+    across the diagonal ``F``: ``l_+ = (|T_+| + theta |K| G / (theta |K| + G)) / |Gamma|``
+    with ``G = eta h |F|`` (the jump term of degree 0; ``theta = 1/6``, ``h`` the cells'
+    diameter). Side ``-`` has no neighbour on its side: its own length."""
+    cut = corner_cut()
+    eta, h = 0.3, np.sqrt(2.0)
+    ncells = cut.mesh.topology.index_map(2).size_local
+    lengths = patch_trace_lengths(cut, None, 1, {-1: eta, 1: eta}, np.full(ncells, h))
+    own = side_trace_lengths(cut, None, 1)
+    gamma, lent = T * np.sqrt(2.0), 0.5 / 6.0
+    G = eta * h * np.sqrt(2.0)
+    expected = (0.5 - T**2 / 2 + lent * G / (lent + G)) / gamma
+    assert lengths[1][0] == pytest.approx(expected, rel=1e-12)
+    assert lengths[-1][0] == pytest.approx(own[-1][0], rel=1e-12)
+
+
+@pytest.mark.parametrize("cell", ["triangle", "quadrilateral"])
+def test_without_the_ghost_penalty_nothing_is_borrowed(cell):
+    """``eta = 0``: no credit, and no cell of this single cut cell's mesh lends."""
+    cut = corner_cut(cell)
+    ncells = cut.mesh.topology.index_map(2).size_local
+    lengths = patch_trace_lengths(cut, None, 2, {-1: 0.0, 1: 0.0}, np.ones(ncells))
+    own = side_trace_lengths(cut, None, 2)
+    for s in (-1, 1):
+        assert lengths[s] == pytest.approx(own[s], rel=1e-10)

@@ -28,6 +28,7 @@ def interface_context(
     split: Callable = ufl.split,
     ramp: dolfinx.fem.Function | None = None,
     interpolants: dict | None = None,
+    ghost_penalty: float = 0.0,
 ) -> InterfaceContext:
     """The context of interface ``name`` on the current cut of ``cut``.
 
@@ -43,6 +44,7 @@ def interface_context(
         split: The fields of a Function on ``W`` (the space's ``split``).
         ramp: The ramp of a crack's branch functions (the space's), None without.
         interpolants: The interpolants subtracted from them (the space's), None without.
+        ghost_penalty: The ghost penalty's weight (the patch trace lengths' credit).
 
     Collective.
     """
@@ -65,6 +67,7 @@ def interface_context(
         split=split,
         ramp=ramp,
         interpolants=interpolants,
+        ghost_penalty=ghost_penalty,
     )
 
 

@@ -39,10 +39,13 @@ DEFAULTS: dict[str, Default] = {
         1, "multiplier degree: 1 (the cut cells' vertices) or 2 (their vertices and edge nodes)"
     ),
     "multiplier_stabilization": Default(
-        None, "weight of the Barbosa-Hughes term (None: 0.1 with the 'cell' length, 0.5 'cut')"
+        None,
+        "weight of the Barbosa-Hughes term (None: 0.1 with the 'cell' length, 0.5 'cut', 'patch')",
     ),
     "stabilization_length": Default(
-        "cell", "length of the Barbosa-Hughes scale: the cell's diameter or the cut's ('cut')"
+        "cell",
+        "length of the Barbosa-Hughes scale: the cell's diameter, the cut's ('cut') or the "
+        "cut's credited through the ghost penalty ('patch')",
     ),
     "multiplier_extension": Default(1e-12, "weight of the multiplier's normal-gradient term"),
     "slave": Default(-1, "slave side of large sliding (-1 or +1)"),

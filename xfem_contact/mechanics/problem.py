@@ -175,6 +175,7 @@ class Problem:
                 self.space.split,
                 self.space.ramp,
                 self.space.interpolants,
+                float(self.bulk.ghost_penalty),
             )
             for name in self.laws
         }
@@ -212,11 +213,13 @@ class Problem:
     @property
     def ghost_penalty(self) -> float:
         """Weight of the ghost penalty (a Constant of the forms: settable, see
-        :class:`~xfem_contact.mechanics.bulk.SmallStrain`)."""
+        :class:`~xfem_contact.mechanics.bulk.SmallStrain`; the laws may refuse a value)."""
         return self.bulk.ghost_penalty
 
     @ghost_penalty.setter
     def ghost_penalty(self, value: float) -> None:
+        for name, law in self.laws.items():
+            law.check_ghost_penalty(self.contexts[name], value)
         self.bulk.ghost_penalty = value
 
     @property

@@ -38,7 +38,7 @@ import ufl
 
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.evaluation import FieldSampler, rule_cells
-from xfem_contact.fem.trace_inverse import side_trace_lengths
+from xfem_contact.fem.trace_inverse import patch_trace_lengths, side_trace_lengths
 from xfem_contact.geometry.levelset import CellMaps, LevelSet
 from xfem_contact.mechanics.materials import Material
 from xfem_contact.quadrature.rules import RuleSet
@@ -99,6 +99,7 @@ class InterfaceContext:
     split: typing.Callable = ufl.split
     ramp: dolfinx.fem.Function | None = None
     interpolants: dict[int, tuple[dolfinx.fem.Function, ...]] | None = None
+    ghost_penalty: float = 0.0
     #: Point values cached for the fixed rules (basis tables, dofs, the normal) and the
     #: objects made :meth:`once`
     _cache: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
@@ -110,25 +111,51 @@ class InterfaceContext:
             self._cache[key] = make()
         return self._cache[key]
 
-    def trace_lengths(self) -> dict[int, dolfinx.fem.Function]:
+    def trace_lengths(self, patch: bool = False) -> dict[int, dolfinx.fem.Function]:
         """``{-1: l_-, 1: l_+}``: each side's trace length on the interface's cut cells
         (m, DG0 on :attr:`cell_size`'s space, 0 elsewhere; see
         :mod:`xfem_contact.fem.trace_inverse`): ``int_Gamma_T p^2 ds <= int_T_s p^2 dx /
-        l_s`` for the strains ``p`` of a side. Made once per context, that is per cut.
-        Collective."""
+        l_s`` for the strains ``p`` of a side. With ``patch``, the side's energy in
+        ``T`` credited with its facet neighbours' through the ghost penalty
+        (:func:`~xfem_contact.fem.trace_inverse.patch_trace_lengths`, with
+        :attr:`ghost_penalty` and the sides' Lamé parameters as built). Made once per
+        context, that is per cut. Collective."""
 
         def make():
             V0 = self.cell_size.function_space
             cells = V0.dofmap.list[self.cut.cut_cells, 0]
+            if patch:
+                h = self.cell_size.x.array[V0.dofmap.list[:, 0]]
+                lengths = patch_trace_lengths(
+                    self.cut, self.name, self.degree, self.ghost_credit(), h
+                )
+            else:
+                lengths = side_trace_lengths(self.cut, self.name, self.degree)
             out = {}
-            for side, lengths in side_trace_lengths(self.cut, self.name, self.degree).items():
+            for side, values in lengths.items():
                 f = dolfinx.fem.Function(V0, name=f"trace_length_{side:+d}")
-                f.x.array[cells] = lengths
+                f.x.array[cells] = values
                 f.x.scatter_forward()
                 out[side] = f
             return out
 
-        return self.once("trace_lengths", make)
+        return self.once("patch_trace_lengths" if patch else "trace_lengths", make)
+
+    def ghost_credit(self) -> dict[int, float]:
+        """Per side ``eta_s = g 2 mu_s / (2 mu_s + d lambda_s)`` (``g`` the
+        :attr:`ghost_penalty`, ``d`` the dimension): the ghost penalty of side ``s``
+        bounds ``eta_s sum_j h^(2j+1) |[grad^j q]|^2`` on a facet for every component
+        ``q`` of ``C^1/2 eps`` (``|C^1/2 e|^2 <= (2 mu + d lambda) |e|^2``). 0 for a side
+        whose material varies by region."""
+        out = {}
+        for s, m in self.materials.items():
+            material = getattr(m, "material", None)
+            if material is None:
+                out[s] = 0.0
+                continue
+            mu, lmbda = material.mu, material.lmbda
+            out[s] = self.ghost_penalty * 2.0 * mu / (2.0 * mu + self.gdim * lmbda)
+        return out
 
     @property
     def gdim(self) -> int:
@@ -409,6 +436,11 @@ class InterfaceLaw(abc.ABC):
     def describe(self) -> dict:
         """The law's name and options (for summaries)."""
         return {"law": self.name}
+
+    def check_ghost_penalty(self, ctx: InterfaceContext, value: float) -> None:
+        """Refuse a new ghost penalty weight ``value`` that the forms built on ``ctx``
+        rely on being larger (ValueError); none here."""
+        return None
 
 
 class FixedAtConstruction:

@@ -34,9 +34,9 @@ from xfem_contact.mechanics.parameters import Parameter, constant
 
 LBB_OPTIONS = ("stabilized", "restriction", "none")
 #: The lengths the Barbosa-Hughes scale may take (see ``MultiplierLaw.stabilization_scale``)
-STABILIZATION_LENGTHS = ("cell", "cut")
+STABILIZATION_LENGTHS = ("cell", "cut", "patch")
 #: The default weight ``gamma`` of the Barbosa-Hughes term with each length
-STABILIZATION_WEIGHTS = {"cell": 0.1, "cut": 0.5}
+STABILIZATION_WEIGHTS = {"cell": 0.1, "cut": 0.5, "patch": 0.5}
 #: Lagrange degrees of a multiplier field
 MULTIPLIER_DEGREES = (1, 2)
 #: Weight of the normal-gradient term on cells where the interface follows a reference
@@ -60,7 +60,9 @@ class MultiplierLaw(InterfaceLaw):
             :func:`~xfem_contact.mechanics.lbb_space.vital_vertex_prolongation`).
         stabilization_length: The length of the Barbosa-Hughes scale (one of
             :data:`STABILIZATION_LENGTHS`): ``"cell"`` the cell's diameter, ``"cut"`` the
-            sides' trace lengths in each cut cell (see :meth:`stabilization_scale`).
+            sides' trace lengths in each cut cell, ``"patch"`` those lengths credited
+            with the facet neighbours' control through the ghost penalty (see
+            :meth:`stabilization_scale`).
     """
 
     multiplier_stabilization = Parameter(minimum=0.0)
@@ -118,21 +120,32 @@ class MultiplierLaw(InterfaceLaw):
             "stabilization_length": self.stabilization_length,
         }
 
+    def check_ghost_penalty(self, ctx: InterfaceContext, value: float) -> None:
+        """With ``stabilization_length="patch"`` the trace lengths credit the ghost
+        penalty the context was built with (:meth:`InterfaceContext.trace_lengths`): a
+        lower weight would void their bound, and is refused (a higher one keeps it)."""
+        if self.stabilization_length == "patch" and value < ctx.ghost_penalty:
+            raise ValueError(
+                f"ghost_penalty {value!r} is below {ctx.ghost_penalty!r}, the weight the "
+                "stabilization_length='patch' lengths were computed with (they credit it): "
+                "build the problem with the lower ghost_penalty"
+            )
+
     def prolongation(self, ctx: InterfaceContext, space):
         if self.lbb != "restriction":
             return None
         return vital_vertex_prolongation(ctx.cut, space, ctx.field, ctx.name)
 
     # -- LBB terms ----------------------------------------------------------------------
-    @staticmethod
-    def side_compliances(ctx: InterfaceContext) -> dict:
+    def side_compliances(self, ctx: InterfaceContext) -> dict:
         """Per side ``s``, ``c_s = l_s / (2 mu_s + lambda_s)`` (m/Pa, UFL, cellwise):
-        the side's trace length (:meth:`InterfaceContext.trace_lengths`) over its
+        the side's trace length (:meth:`InterfaceContext.trace_lengths`; the patch
+        lengths with ``stabilization_length="patch"``) over its
         P-wave modulus. ``int_Gamma_T |sigma_s n|^2 ds <= a_T_s(u, u) / c_s`` on every
         cut cell ``T`` (``a_T_s`` the side's elastic energy in ``T``): ``|sigma n|^2 <=
         (2 mu + lambda) sigma : eps`` pointwise, with the plane-stress ``lambda`` in
         plane stress."""
-        lengths = ctx.trace_lengths()
+        lengths = ctx.trace_lengths(patch=self.stabilization_length == "patch")
         m = ctx.materials
         return {s: lengths[s] / (2.0 * m[s].ufl_mu + m[s].ufl_lmbda) for s in (-1, 1)}
 
@@ -149,7 +162,7 @@ class MultiplierLaw(InterfaceLaw):
         volume and stiffness weights of Annavarapu, Hautefeuille and Dolbow 2012); a
         side that holds a sliver of the cell weighs nothing.
         """
-        if self.stabilization_length == "cut":
+        if self.stabilization_length in ("cut", "patch"):
             c = self.side_compliances(ctx)
             total = c[-1] + c[1]
             return c[-1] / total, c[1] / total
@@ -171,7 +184,9 @@ class MultiplierLaw(InterfaceLaw):
         (2 mu)`` for one material; ``h`` the cell's diameter, ``w_s`` of
         :meth:`traction_weights`).
 
-        ``"cut"``: ``gamma (c_- + c_+)`` per cut cell (:meth:`side_compliances`). With
+        ``"cut"`` (and ``"patch"``, with the patch lengths of
+        :meth:`InterfaceContext.trace_lengths`, whose bound counts the ghost penalty
+        too): ``gamma (c_- + c_+)`` per cut cell (:meth:`side_compliances`). With
         the weights ``w_s = c_s / (c_- + c_+)`` it bounds what the displacement block
         loses, ``s int_Gamma_T |t(u)|^2 ds <= gamma a_T(u, u)`` on every cut cell ``T``:
         the block keeps ``(1 - gamma)`` of the elastic energy for ``gamma < 1`` however
@@ -179,7 +194,7 @@ class MultiplierLaw(InterfaceLaw):
         compliance (docs' stability page).
         """
         gamma = constant(self, "multiplier_stabilization")
-        if self.stabilization_length == "cut":
+        if self.stabilization_length in ("cut", "patch"):
             c = self.side_compliances(ctx)
             return gamma * (c[-1] + c[1])
         w_minus, w_plus = self.traction_weights(ctx)
