@@ -13,7 +13,7 @@ is constant, both spaces hold the exact pressure, and the limits coincide."""
 import numpy as np
 import pytest
 
-from xfem_contact.cases.solid import sliding_plane_errors, sliding_plane_problem
+from xfem_contact.cases.sliding_plane import sliding_plane_errors, sliding_plane_problem
 
 CELLS = ["tetrahedron", "hexahedron"]
 
