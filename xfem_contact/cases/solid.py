@@ -173,6 +173,7 @@ def uniform_stress_problem(
     comm: MPI.Comm = MPI.COMM_WORLD,
     stress: tuple[float, float, float] = TRIAXIAL,
     mesh: dolfinx.mesh.Mesh | None = None,
+    quadrature_degree: int | None = None,
     **options,
 ) -> ElasticityProblem:
     """An inclusion (``levelset < 0``: a numpy callable of ``x`` ``(3, n)``, a closed
@@ -183,14 +184,16 @@ def uniform_stress_problem(
     rigid modes held by point constraints the exact field satisfies (``u_i = 0`` where
     ``x_i = 1/2``): the exact stress is ``diag(stress)`` everywhere, the exact contact
     traction ``sigma n``. ``law``: ``bonded``, ``sticking`` (a contact law stays closed:
-    every ``n.sigma.n < 0``), ...; ``options`` go to the problem."""
+    every ``n.sigma.n < 0``), ...; ``quadrature_degree``: the cut rules'
+    (:class:`~xfem_contact.fem.cutmesh.CutMesh`'s default when None); ``options`` go to
+    the problem."""
     if (n is None) == (mesh is None):
         raise ValueError(f"give n (cells per edge) or mesh, not both nor neither; got n={n!r}")
     if mesh is None:
         if n % 2:
             raise ValueError(f"n must be even (the point constraints are mesh nodes), got {n}")
         mesh = dolfinx.mesh.create_unit_cube(comm, n, n, n, dolfinx.mesh.CellType[cell])
-    cut = CutMesh(mesh, levelset, degree=2)
+    cut = CutMesh(mesh, levelset, degree=2, quadrature_degree=quadrature_degree)
     cls = ContactProblem if law in ContactProblem.LAWS else ElasticityProblem
     problem = cls(cut, degree, SOLID, law, **options)
     problem.stress = tuple(stress)

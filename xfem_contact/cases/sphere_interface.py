@@ -60,15 +60,23 @@ def stick_fraction(problem) -> float:
     return comm.allreduce(float(dA[stick].sum()), op=MPI.SUM) / area
 
 
-def multiplier_difference(problem, reference) -> float:
+#: The parts of a Cartesian multiplier :func:`multiplier_difference` measures
+MULTIPLIER_PARTS = ("all", "normal", "tangential")
+
+
+def multiplier_difference(problem, reference, part: str = "all") -> float:
     """Relative L2 difference on ``problem``'s interface of its Cartesian multiplier
     (Pa) and that of ``reference`` (the same case solved on another mesh, read at the
     same points: the exact sphere of ``levelset="quadric"`` lies in the reference's
-    cut cells), by ``problem``'s interface rule. Serial: the reference is read where
-    the points fall in its local cells."""
+    cut cells), by ``problem``'s interface rule. ``part``: the whole vector
+    (``"all"``), its normal part ``(lambda.n) n`` or its tangential part ``(I - n n)
+    lambda`` (``n`` the exact sphere's), each over the same part of the reference's.
+    Serial: the reference is read where the points fall in its local cells."""
     if problem.mesh.comm.size > 1:
         raise ValueError("multiplier_difference: serial only (reads another mesh's cells)")
-    ctx, _, dA = interface_rule(problem)
+    if part not in MULTIPLIER_PARTS:
+        raise ValueError(f"part must be one of {MULTIPLIER_PARTS}, got {part!r}")
+    ctx, n, dA = interface_rule(problem)
     lam = ctx.values_at(problem.w, ctx.field)
     (name,) = reference.laws
     field = reference.contexts[name].field
@@ -80,5 +88,10 @@ def multiplier_difference(problem, reference) -> float:
     colliding = dolfinx.geometry.compute_colliding_cells(mesh, candidates, points)
     cells = np.array([colliding.links(i)[0] for i in range(points.shape[0])], dtype=np.int32)
     lam_ref = lam_ref_function.eval(points, cells)
+    if part != "all":
+        normal = np.sum(lam * n, axis=1)[:, None] * n, np.sum(lam_ref * n, axis=1)[:, None] * n
+        lam, lam_ref = (
+            (normal[0], normal[1]) if part == "normal" else (lam - normal[0], lam_ref - normal[1])
+        )
     misfit = np.sum(np.sum((lam - lam_ref) ** 2, axis=1) * dA)
     return float(np.sqrt(misfit / np.sum(np.sum(lam_ref**2, axis=1) * dA)))
