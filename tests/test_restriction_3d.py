@@ -30,7 +30,8 @@ from xfem_contact.mechanics.problem import Problem
 from xfem_contact.scenes.scene import load_scene
 
 #: beta of the restricted P1-P1 pair on tetrahedra stays above this at n = 4 and 8;
-#: without LBB treatment it is below (0.082 and 0.015)
+#: without LBB treatment it is below (0.082 and 0.015: the guard's failure, checked on the
+#: same sphere and meshes by tests/stability/test_inf_sup.py)
 FLOOR = 0.15
 
 
@@ -44,12 +45,6 @@ def sphere_beta(n: int, lbb: str, cell: str = "tetrahedron", degree: int = 1) ->
 def test_the_restriction_keeps_the_constant_above_the_floor():
     values = [sphere_beta(n, "restriction") for n in (4, 8)]
     assert min(values) > FLOOR, values
-
-
-def test_without_lbb_treatment_the_constant_falls_below_the_floor():
-    """The guard's failure: the same pair with the full P1 multiplier."""
-    values = [sphere_beta(n, "none") for n in (4, 8)]
-    assert max(values) < FLOOR and values[1] < 0.5 * values[0], values
 
 
 def test_the_restriction_on_unstructured_tetrahedra():
