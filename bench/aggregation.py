@@ -175,11 +175,20 @@ def crack_levelsets(tip, angle):
 
 
 def free_crack(
-    mesh, tip, angle, degree, ghost_penalty, aggregation, tip_basis="auto", tip_radius="auto"
+    mesh,
+    tip,
+    angle,
+    degree,
+    ghost_penalty,
+    aggregation,
+    tip_basis="auto",
+    tip_radius="auto",
+    tip_dofs="nodal",
 ) -> Problem:
     """A crack with free lips in the unit square, its boundary clamped, geometric tip
     enrichment of the default radius (of this crack; kept by ``update_interface``) or
-    ``tip_radius`` (None: topological), the tip basis ``tip_basis``."""
+    ``tip_radius`` (None: topological), the tip basis ``tip_basis``, the branch dofs
+    ``tip_dofs``."""
     phi, psi = crack_levelsets(tip, angle)
     cut = CutMesh(mesh, phi, degree=degree, tangent=psi)
     problem = Problem(
@@ -191,6 +200,7 @@ def free_crack(
         aggregation=aggregation,
         tip_basis=tip_basis,
         tip_radius=tip_radius,
+        tip_dofs=tip_dofs,
     )
     zero = lambda x: np.zeros((2, x.shape[1]))  # noqa: E731
     on_boundary = lambda x: (  # noqa: E731
@@ -356,6 +366,12 @@ def main() -> None:
         help="the cracks' tip enrichment: the default zone, or the tip cells' nodes (none)",
     )
     parser.add_argument(
+        "--tip-dofs",
+        default="nodal",
+        choices=["nodal", "gathered"],
+        help="the cracks' branch unknowns: each vertex's, or one per tip and function",
+    )
+    parser.add_argument(
         "--dense-below",
         type=int,
         default=1500,
@@ -404,6 +420,7 @@ def conditioning(args, kind: str = "interface") -> None:
                         aggregation,
                         args.tip_basis,
                         None if args.tip_radius == "none" else "auto",
+                        args.tip_dofs,
                     )
                 for a, b, c in samples:
                     if kind == "interface":
@@ -451,6 +468,8 @@ def conditioning(args, kind: str = "interface") -> None:
         name += f"_{args.tip_basis}"
     if kind == "crack" and args.tip_radius != "auto":
         name += "_topological"
+    if kind == "crack" and args.tip_dofs != "nodal":
+        name += f"_{args.tip_dofs}"
     name = args.name or name
     (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
     (RESULTS / f"{name}.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))

@@ -52,8 +52,10 @@ def tip_transform(
     space: EnrichedSpace, off: bool = False
 ) -> Callable[[PETSc.Mat, PETSc.Mat], PETSc.Mat] | None:
     """The solvers' ``transform(R, J)`` for ``space``: :func:`tip_scaling` with a crack's
-    tip enrichment; None without a crack, or when ``off``. Not collective."""
-    if off or space.branch_field is None:
+    tip enrichment of nodal branch dofs; None without a crack, with gathered ones
+    (:mod:`~xfem_contact.fem.tip_dofs`: the Jacobi scaling suffices), or when ``off``.
+    Not collective."""
+    if off or space.branch_field is None or space.tip_dofs == "gathered":
         return None
     return functools.partial(tip_scaling, space)
 
