@@ -5,18 +5,19 @@ cells where its ramp ``R`` is not 0: with a tip radius ``r_e``, the P1 function 
 the vertices within ``r_e`` of a tip (``tip_dofs="nodal"``), or the smooth cut-off
 below (``"gathered"``); without one, on the tip cells.
 
-With ``tip_dofs="gathered"`` (:class:`~xfem_contact.fem.enrichment.EnrichedSpace`) the
-branch dofs of every vertex near one tip take one value per branch function ``F_k`` and
-component (the dof gathering of Laborde, Pommier, Renard and Salaün, IJNME 64, 2005):
-the vertices' hats sum to 1 on the cells where the ramp is not 0, so the enrichment is
-``R(x) sum_k F_k a_k`` with constant ``a_k``, the cut-off method of Chahine, Laborde and
-Renard (2008). The ramp ``R`` is then the P1 interpolant of a smooth cut-off of the
-distance ``d`` to the nearest tip: 1 for ``d <= r_e / 2``, ``1 - 3 s^2 + 2 s^3`` with
-``s = (2 d - r_e) / r_e`` up to ``r_e``, 0 beyond. Its slope is fixed by ``r_e``, not by
-``h``: ``(1 - R) u`` is as smooth as ``u`` off the tip, so the standard functions
-approximate it at their full order. The few gathered unknowns are far from the
-standard space (``F_k`` is singular at the tip), whatever the number of vertices in the
-zone, so the branch functions add no near-dependence that grows as ``h -> 0``.
+With ``tip_dofs="gathered"`` the branch dofs of every vertex near one tip take one
+value per branch function ``F_k`` and component (the dof gathering of Laborde, Pommier,
+Renard and Salaün, IJNME 64, 2005): the vertices' hats sum to 1 on the cells where the
+ramp is not 0, so the enrichment is ``R(x) sum_k F_k a_k`` with constant ``a_k``, the
+cut-off method of Chahine, Laborde and Renard (2008). The ramp ``R`` is then the P1
+interpolant of a smooth cut-off of the distance ``d`` to the nearest tip,
+``1 - 10 s^3 + 15 s^4 - 6 s^5`` with ``s = d / r_e`` (1 at the tip, 0 from ``r_e`` on,
+its first and second derivatives 0 at both ends). Its slopes are fixed by ``r_e``, not by
+``h``, so ``(1 - R) u`` is as smooth as ``u`` off the tip and the standard functions
+approximate it at their full order (a cut-off with a jump of its second derivative
+lowers the rate of degree 2). The few gathered unknowns, each shifted by its
+interpolant on the standard nodes (:mod:`xfem_contact.solvers.block_scaling`), add no
+near-dependence that grows as ``h -> 0``, whatever the number of vertices in the zone.
 """
 
 from __future__ import annotations
@@ -63,7 +64,7 @@ def cutoff(distance: npt.NDArray[np.float64], radius: float) -> npt.NDArray[np.f
     """The smooth cut-off of the module docstring at distances ``distance`` (m) from a
     tip, for the tip radius ``radius`` (m); same shape as ``distance``."""
     s = np.clip(np.asarray(distance) / radius, 0.0, 1.0)
-    return 1.0 - 3.0 * s**2 + 2.0 * s**3
+    return 1.0 - s**3 * (10.0 - 15.0 * s + 6.0 * s**2)
 
 
 def branch_support(space: EnrichedSpace) -> npt.NDArray[np.bool_]:
