@@ -45,13 +45,19 @@ basis: ``"shifted"`` without aggregation, ``"plain"`` with it): the energy error
 its rate and the condition number of the matrix the solver factors (tip-transformed;
 ``bench/crack_convergence.py``'s estimate, n <= 64).
 
+Part ``tip_dofs``: the Williams crack (r_e = 0.3) on ``--elements`` and ``--sizes``
+with nodal and gathered branch dofs (``tip_dofs``, :mod:`xfem_contact.fem.tip_dofs`):
+energy errors and rates. ``--tip-dofs gathered`` gathers the cracks' branch dofs in the
+``crack_conditioning`` part (written to ``..._gathered``).
+
 Run: ``python bench/aggregation.py [--parts conditioning crack_conditioning accuracy
-crack] [--circles 30] [--sizes 8 16 32] [--treatments none "aggregation 0.25"]
+crack tip_dofs] [--circles 30] [--sizes 8 16 32] [--treatments none "aggregation 0.25"]
 [--tip-basis plain] [--tip-radius none] [--dense-below 0] [--name NAME]``; writes
 ``bench/results/aggregation.{json,md}`` (conditioning; ``NAME.{json,md}`` with
 ``--name``),
 ``bench/results/aggregation_crack_conditioning.{json,md}``,
-``bench/results/aggregation_accuracy.md`` and ``bench/results/aggregation_crack.md``.
+``bench/results/aggregation_accuracy.md``, ``bench/results/aggregation_crack.md`` and
+``bench/results/aggregation_tip_dofs.md`` (``NAME.md`` with ``--name``).
 """
 
 import os
@@ -342,6 +348,40 @@ def crack() -> None:
     print("\n".join(lines))
 
 
+def tip_dofs(args) -> None:
+    """The tip_dofs part (module docstring): prints and writes a Markdown table."""
+    elements = [(e.split(":")[0], int(e.split(":")[1])) for e in args.elements]
+    lines = [
+        "| element | tip dofs | " + " | ".join(f"n = {n}" for n in args.sizes) + " | rates |",
+        "|---|---|" + "---|" * len(args.sizes) + "---|",
+    ]
+    for cell, degree in elements:
+        for dofs in ("nodal", "gathered"):
+            errors = []
+            for n in args.sizes:
+                case = williams_case(n, degree, tip_radius=0.3, cell=cell, tip_dofs=dofs)
+                case.problem.solve()
+                errors.append(williams_energy_error(case))
+                note(f"{cell} P{degree} {dofs} n = {n}: energy error {errors[-1]:.3e}")
+            rates = [
+                math.log(e0 / e1) / math.log(n1 / n0)
+                for e0, e1, n0, n1 in zip(
+                    errors, errors[1:], args.sizes, args.sizes[1:], strict=False
+                )
+            ]
+            lines.append(
+                f"| {cell} P{degree} | {dofs} | "
+                + " | ".join(f"{e:.3e}" for e in errors)
+                + " | "
+                + ", ".join(f"{r:.2f}" for r in rates)
+                + " |"
+            )
+            note(lines[-1])
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / f"{args.name or 'aggregation_tip_dofs'}.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
@@ -388,6 +428,8 @@ def main() -> None:
         conditioning(args, "crack")
     if "crack" in args.parts:
         crack()
+    if "tip_dofs" in args.parts:
+        tip_dofs(args)
 
 
 def conditioning(args, kind: str = "interface") -> None:
