@@ -260,7 +260,7 @@ BOUNDARY_SLIVER = ((0.6634857837558401, 0.33158051795101273), 1.3866863116139594
 
 @pytest.mark.mpi
 @pytest.mark.parametrize(
-    "cell, degree, law", [("triangle", 2, "free"), ("quadrilateral", 2, "frictionless")]
+    "cell, degree, law", [("triangle", 2, "free"), ("triangle", 2, "frictionless")]
 )
 def test_aggregation_carries_the_dirichlet_values(cell, degree, law):
     """A dof extended from a root holding Dirichlet dofs takes their prescribed values
@@ -288,7 +288,7 @@ def test_aggregation_carries_the_dirichlet_values(cell, degree, law):
     )
     problem.loads.add_displacement(boundary, {-1: _rigid_motion, 1: _rigid_motion})
     E = prescribed_extension(problem)
-    assert E is not None  # some aggregated dof reads a Dirichlet dof
+    assert E is not None and E.norm() > 1.0  # aggregated dofs read Dirichlet dofs
     E.destroy()
     problem.solve()
     space, error = problem.space, 0.0
