@@ -46,15 +46,21 @@ basis: ``"shifted"`` without aggregation, ``"plain"`` with it): the energy error
 its rate and the condition number of the matrix the solver factors (tip-transformed;
 ``bench/crack_convergence.py``'s estimate, n <= 64).
 
+Part ``tip_dofs``: the Williams crack (r_e = 0.3) on ``--elements`` and ``--sizes``
+with nodal and gathered branch dofs (``tip_dofs``, :mod:`xfem_contact.fem.tip_dofs`):
+energy errors and rates. ``--tip-dofs gathered`` gathers the cracks' branch dofs in the
+``crack_conditioning`` part (written to ``..._gathered``).
+
 Run: ``python bench/aggregation.py [--parts conditioning crack_conditioning accuracy
-crack] [--circles 30] [--sizes 8 16 32] [--treatments none "aggregation 0.25"]
+crack tip_dofs] [--circles 30] [--sizes 8 16 32] [--treatments none "aggregation 0.25"]
 [--tip-basis plain] [--tip-radius none] [--dense-below 0] [--accuracy-columns LABEL ...]
 [--name NAME]``; writes
 ``bench/results/aggregation.{json,md}`` (conditioning; ``NAME.{json,md}`` with
 ``--name``),
 ``bench/results/aggregation_crack_conditioning.{json,md}``,
-``bench/results/aggregation_accuracy.md`` (``NAME.md`` with ``--name``) and
-``bench/results/aggregation_crack.md``.
+``bench/results/aggregation_accuracy.md`` (``NAME.md`` with ``--name``),
+``bench/results/aggregation_crack.md`` and
+``bench/results/aggregation_tip_dofs.md`` (``NAME.md`` with ``--name``).
 """
 
 import os
@@ -178,11 +184,20 @@ def crack_levelsets(tip, angle):
 
 
 def free_crack(
-    mesh, tip, angle, degree, ghost_penalty, aggregation, tip_basis="auto", tip_radius="auto"
+    mesh,
+    tip,
+    angle,
+    degree,
+    ghost_penalty,
+    aggregation,
+    tip_basis="auto",
+    tip_radius="auto",
+    tip_dofs="nodal",
 ) -> Problem:
     """A crack with free lips in the unit square, its boundary clamped, geometric tip
     enrichment of the default radius (of this crack; kept by ``update_interface``) or
-    ``tip_radius`` (None: topological), the tip basis ``tip_basis``."""
+    ``tip_radius`` (None: topological), the tip basis ``tip_basis``, the branch dofs
+    ``tip_dofs``."""
     phi, psi = crack_levelsets(tip, angle)
     cut = CutMesh(mesh, phi, degree=degree, tangent=psi)
     problem = Problem(
@@ -194,6 +209,7 @@ def free_crack(
         aggregation=aggregation,
         tip_basis=tip_basis,
         tip_radius=tip_radius,
+        tip_dofs=tip_dofs,
     )
     zero = lambda x: np.zeros((2, x.shape[1]))  # noqa: E731
     on_boundary = lambda x: (  # noqa: E731
@@ -338,6 +354,40 @@ def crack() -> None:
     print("\n".join(lines))
 
 
+def tip_dofs(args) -> None:
+    """The tip_dofs part (module docstring): prints and writes a Markdown table."""
+    elements = [(e.split(":")[0], int(e.split(":")[1])) for e in args.elements]
+    lines = [
+        "| element | tip dofs | " + " | ".join(f"n = {n}" for n in args.sizes) + " | rates |",
+        "|---|---|" + "---|" * len(args.sizes) + "---|",
+    ]
+    for cell, degree in elements:
+        for dofs in ("nodal", "gathered"):
+            errors = []
+            for n in args.sizes:
+                case = williams_case(n, degree, tip_radius=0.3, cell=cell, tip_dofs=dofs)
+                case.problem.solve()
+                errors.append(williams_energy_error(case))
+                note(f"{cell} P{degree} {dofs} n = {n}: energy error {errors[-1]:.3e}")
+            rates = [
+                math.log(e0 / e1) / math.log(n1 / n0)
+                for e0, e1, n0, n1 in zip(
+                    errors, errors[1:], args.sizes, args.sizes[1:], strict=False
+                )
+            ]
+            lines.append(
+                f"| {cell} P{degree} | {dofs} | "
+                + " | ".join(f"{e:.3e}" for e in errors)
+                + " | "
+                + ", ".join(f"{r:.2f}" for r in rates)
+                + " |"
+            )
+            note(lines[-1])
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / f"{args.name or 'aggregation_tip_dofs'}.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
@@ -360,6 +410,12 @@ def main() -> None:
         default="auto",
         choices=["auto", "none"],
         help="the cracks' tip enrichment: the default zone, or the tip cells' nodes (none)",
+    )
+    parser.add_argument(
+        "--tip-dofs",
+        default="nodal",
+        choices=["nodal", "gathered"],
+        help="the cracks' branch unknowns: each vertex's, or one per tip and function",
     )
     parser.add_argument(
         "--dense-below",
@@ -385,6 +441,8 @@ def main() -> None:
         conditioning(args, "crack")
     if "crack" in args.parts:
         crack()
+    if "tip_dofs" in args.parts:
+        tip_dofs(args)
 
 
 def conditioning(args, kind: str = "interface") -> None:
@@ -417,6 +475,7 @@ def conditioning(args, kind: str = "interface") -> None:
                         aggregation,
                         args.tip_basis,
                         None if args.tip_radius == "none" else "auto",
+                        args.tip_dofs,
                     )
                 for a, b, c in samples:
                     if kind == "interface":
@@ -464,6 +523,8 @@ def conditioning(args, kind: str = "interface") -> None:
         name += f"_{args.tip_basis}"
     if kind == "crack" and args.tip_radius != "auto":
         name += "_topological"
+    if kind == "crack" and args.tip_dofs != "nodal":
+        name += f"_{args.tip_dofs}"
     name = args.name or name
     (RESULTS / f"{name}.md").write_text("\n".join(lines) + "\n")
     (RESULTS / f"{name}.json").write_text(json.dumps({"rows": rows, "args": vars(args)}))

@@ -105,11 +105,13 @@ def williams_case(
     comm: MPI.Comm = MPI.COMM_WORLD,
     aggregation: float | None = None,
     tip_basis: str = "auto",
+    tip_dofs: str = "nodal",
 ) -> CrackCase:
     """The exact Williams field of ``K = (K_I, K_II)`` on the square ``[-1, 1]^2`` (``n``
     cells a side) with a crack from its left side to a tip near the centre, imposed on the
     whole boundary (each lip's value where the crack meets it). Geometric tip enrichment
-    of radius ``tip_radius`` (m; None: topological); ``aggregation``, ``tip_basis``: see
+    of radius ``tip_radius`` (m; None: topological); ``aggregation``, ``tip_basis``,
+    ``tip_dofs``: see
     :class:`~xfem_contact.mechanics.problem.Problem`."""
     d, normal = _frame()
     tip = OFFSET
@@ -129,6 +131,7 @@ def williams_case(
         tip_radius=tip_radius,
         aggregation=aggregation,
         tip_basis=tip_basis,
+        tip_dofs=tip_dofs,
     )
     displacement = _williams_sides(field)
     problem.loads.add_displacement(_on_boundary(1.0), {-1: displacement(-1), 1: displacement(1)})

@@ -93,20 +93,15 @@ class Aggregation(typing.NamedTuple):
             self.vals[entries],
         )
 
-    def without_sources(self, fixed: npt.NDArray[np.int64]) -> Aggregation:
-        """The same with the dofs whose extension reads a dof of ``fixed`` (global dofs
-        of ``W``, e.g. all processes' Dirichlet ones) left as unknowns: a prescribed
-        dof's column must stay its identity row's alone."""
-        reads = np.zeros(self.dofs.size, dtype=bool)
-        reads[self.rows[np.isin(self.sources, fixed)]] = True
-        keep = ~reads
-        position = np.cumsum(keep) - 1
-        entries = keep[self.rows]
-        return Aggregation(
-            self.dofs[keep],
-            position[self.rows[entries]],
-            self.sources[entries],
-            self.vals[entries],
+    def split_sources(self, prescribed: npt.NDArray[np.int64]) -> tuple[Aggregation, Aggregation]:
+        """The entries whose source is not in ``prescribed`` (global dofs of ``W``, e.g.
+        all processes' Dirichlet ones) and those whose source is: the same constrained
+        dofs in both, ``u_c = sum_j N_j u_j`` split into its unknown and its prescribed
+        part."""
+        reads = np.isin(self.sources, prescribed)
+        return (
+            Aggregation(self.dofs, self.rows[~reads], self.sources[~reads], self.vals[~reads]),
+            Aggregation(self.dofs, self.rows[reads], self.sources[reads], self.vals[reads]),
         )
 
 

@@ -36,19 +36,16 @@ from xfem_contact.fem.branch import (
     UFL,
     branch_values,
     checked_tip_basis,
-    null_pins,
     side_values,
     tied_values,
 )
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.subspaces import collapse
+from xfem_contact.fem.tip_dofs import branch_support, checked_tip_dofs
 from xfem_contact.fem.tip_scale import default_tip_radius
-from xfem_contact.geometry.crack import CROSSED, TIP
+from xfem_contact.geometry.crack import CROSSED
 
 _logger = logging.getLogger(__name__)
-#: Relative tolerance of the tip radius: the mesh generator rounds a node's coordinates
-#: differently on 1 and 2 processes (1 ulp)
-_RADIUS_TOLERANCE = 1e-10
 
 
 class DofCounts(typing.NamedTuple):
@@ -97,6 +94,10 @@ class EnrichedSpace:
             vertices (the same space for degree 2, where ``N_i I(R F_k)`` is a standard
             function; degree 1 and cell aggregation take ``"plain"`` only); ``"auto"``
             (default): ``"shifted"`` for degree 2 without aggregation, else ``"plain"``.
+        tip_dofs: ``"nodal"`` (default): every vertex of the zone carries its own branch
+            unknowns; ``"gathered"``: one unknown per tip, branch function and component,
+            with a smooth cut-off for the ramp (:mod:`~xfem_contact.fem.tip_dofs`; needs
+            a tip radius).
 
     A crack's multipliers live on the nodes of the cells it crosses (none on a tip
     cell's own: the lips' traction there oscillates, ``docs/crack_enrichment.md``). A crack
@@ -131,6 +132,7 @@ class EnrichedSpace:
         tip_radius: float | str | None = None,
         aggregation: float | None = None,
         tip_basis: str = "auto",
+        tip_dofs: str = "nodal",
     ):
         if degree not in (1, 2):
             raise ValueError(f"Displacement degree must be 1 or 2, got {degree}")
@@ -178,6 +180,7 @@ class EnrichedSpace:
         if cut.crack is not None and cut.crack.union is not None:  # several cracks
             cut.crack.union.check_tip_radius(tip_radius)  # each tip zone within its crack's
         self.tip_radius = tip_radius
+        self.tip_dofs = checked_tip_dofs(tip_dofs, tip_radius if cut.crack is not None else 0)
         #: The ramp ``R`` of the branch functions (P1, set with the active dofs), or None
         self.ramp: dolfinx.fem.Function | None = None
         if self.branch_field is not None and tip_radius is not None:
@@ -314,49 +317,13 @@ class EnrichedSpace:
             carrying = cut.cut_cells[length > 0.0]
             active |= self._mark(field, carrying) > 0
         if self.branch_field is not None:
-            active |= self._branch_support()
+            active |= branch_support(self)
         self._ties = self._tied(active)
         if self.interpolants is not None:
             self._interpolate(active)
         if self.aggregation_threshold is not None:
             self._aggregation = aggregate(self, self.aggregation_threshold, active)
         return active
-
-    def _branch_support(self) -> npt.NDArray[np.bool_]:
-        """Per dof of ``W``: a branch dof of a cell where the :attr:`ramp` is not 0 (set
-        here), or of a tip cell without a tip radius."""
-        crack, field = self.cut.crack, self.branch_field
-        if self.tip_radius is None:
-            return self._mark(field, crack.cells(TIP, self.cut.cut_cells)) > 0
-        mesh = self.cut.mesh
-        tip_cells = crack.cells(TIP, self.cut.cut_cells).astype(np.int32)
-        local = float(mesh.h(2, tip_cells).max()) if tip_cells.size else 0.0
-        h = mesh.comm.allreduce(local, op=MPI.MAX)
-        R = self.ramp
-        if self.tip_radius < h:
-            _logger.warning(
-                "tip_radius = %.6g m is smaller than the tip cells (diameter %.6g m): the "
-                "branch functions enrich the tip cells' nodes",
-                self.tip_radius,
-                h,
-            )
-            R.x.array[:] = 0.0
-            R.x.array[R.function_space.dofmap.list[tip_cells].ravel()] = 1.0
-            R.x.scatter_reverse(dolfinx.la.InsertMode.add)
-            R.x.array[:] = R.x.array > 0
-        else:
-            x = R.function_space.tabulate_dof_coordinates()[:, : crack.tips.shape[1]]
-            distance = np.linalg.norm(x[:, None, :] - crack.tips[None], axis=2).min(axis=1)
-            # a node at the radius is in, whatever rounding its coordinates carry
-            R.x.array[:] = distance <= self.tip_radius * (1.0 + _RADIUS_TOLERANCE)
-        R.x.scatter_forward()
-        ramp_cells = R.function_space.dofmap.list[: self.cut.cell_sides.size]
-        flags = self._mark(field, np.flatnonzero(R.x.array[ramp_cells].max(axis=1) > 0)) > 0
-        V, parent = self.field_space(field)  # F_1, F_2 dropped at one node: no null vectors
-        gdim, bs, xb = crack.tips.shape[1], V.dofmap.index_map_bs, V.tabulate_dof_coordinates()
-        pins = null_pins(xb[:, :gdim], crack.tips, crack.directions, 0.5 * h, mesh.comm)
-        flags[parent[(np.flatnonzero(pins)[:, None] * bs + np.arange(2 * gdim)).ravel()]] = False
-        return flags
 
     def _tied_nodes(self, active: npt.NDArray[np.bool_]) -> npt.NDArray[np.bool_]:
         """Per local dof of field 0's own space (:meth:`field_space`): whether it and

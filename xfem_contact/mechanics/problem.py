@@ -26,11 +26,10 @@ from xfem_contact.mechanics.composition import Materials, interface_laws, side_a
 from xfem_contact.mechanics.contexts import interface_context, samples, status_counts
 from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.laws import InterfaceLaw, large_sliding
-from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.mechanics.loads import Loads, SideFields
 from xfem_contact.mechanics.parameters import bound_copy
 from xfem_contact.mechanics.rigid_modes import check_support
-from xfem_contact.mechanics.solving import linear_solve, newton_solver
+from xfem_contact.mechanics.solving import linear_solve, newton_solver, prolongation_parts
 from xfem_contact.solvers.log_lines import lines_to
 from xfem_contact.solvers.newton import NewtonFailure, ReducedNewton
 from xfem_contact.solvers.options import (
@@ -59,7 +58,9 @@ class Problem:
             ghost penalty (it extends the field), else those with support on their side.
         aggregation: Cell aggregation (see :class:`EnrichedSpace`): the side volume
             fraction below which a cut cell's dofs are extended from a root cell; None:
-            off. Dirichlet dofs, and dofs whose extension reads one, stay unknowns.
+            off. Dirichlet dofs stay unknowns; a dof extended from Dirichlet dofs takes
+            their prescribed values
+            (:func:`~xfem_contact.mechanics.solving.prescribed_extension`).
         kinematics: ``"small"`` (linear elasticity, small sliding) or ``"large"`` (Saint
             Venant-Kirchhoff bulk, contact laws in large sliding: the slave/master hybrid
             element of :mod:`xfem_contact.mechanics.sliding`).
@@ -71,6 +72,9 @@ class Problem:
         tip_basis: The functions of a crack's branch dofs, ``"auto"`` (default:
             ``"shifted"`` for degree 2 without ``aggregation``, else ``"plain"``),
             ``"plain"`` or ``"shifted"``, see :class:`EnrichedSpace`.
+        tip_dofs: A crack's branch unknowns, ``"nodal"`` (default: each vertex of the
+            zone its own) or ``"gathered"`` (one per tip, function and component, with a
+            smooth cut-off), see :class:`EnrichedSpace`.
         petsc_options: PETSc options (names without prefix) of the solver, over the
             defaults and presets of :mod:`xfem_contact.solvers.options` (see
             :meth:`solver_options`); change them later with :attr:`petsc_options`.
@@ -96,6 +100,7 @@ class Problem:
         pairing: str = DEFAULT.pairing,
         tip_radius: float | str | None = "auto",
         tip_basis: str = "auto",
+        tip_dofs: str = "nodal",
         petsc_options: dict | None = None,
         petsc_options_prefix: str | None = None,
     ):
@@ -129,6 +134,7 @@ class Problem:
             tip_radius=tip_radius,
             aggregation=aggregation,
             tip_basis=tip_basis,
+            tip_dofs=tip_dofs,
         )
         check_ghosts(self.mesh)
         #: Loads, supports and Dirichlet data (``loads.bcs``), and the pseudo-time
@@ -318,15 +324,7 @@ class Problem:
     def prolongation(self):
         """The prolongation ``R`` (full x reduced, ``x = R y``) of the active dofs and the
         laws' multiplier prolongations. Collective."""
-        prolongations = [
-            p
-            for name, law in self.laws.items()
-            if (p := law.prolongation(self.contexts[name], self.space)) is not None
-        ]
-        fixed = None if self.space.aggregation is None else self.loads.dirichlet_dofs()
-        return prolongation_matrix(
-            self.space, combine_prolongations(prolongations, self.mesh.comm), fixed
-        )
+        return prolongation_matrix(self.space, *prolongation_parts(self))
 
     def restriction(self):
         """Deprecated name of :meth:`prolongation` (it returns ``R`` with ``x = R y``)."""

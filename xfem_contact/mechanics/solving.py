@@ -12,11 +12,13 @@ from typing import TYPE_CHECKING
 
 from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.forms import form
+from xfem_contact.fem.prolongation import prescribed_extension as fem_prescribed_extension
 from xfem_contact.mechanics.fieldsplit_data import (
     fieldsplit_dofs,
     rigid_modes,
     vertex_interpolation,
 )
+from xfem_contact.mechanics.lbb_space import combine_prolongations
 from xfem_contact.solvers.linear import solve_reduced, tip_transform
 from xfem_contact.solvers.newton import ReducedNewton, weak_method
 from xfem_contact.solvers.options import uses_fieldsplit
@@ -25,7 +27,31 @@ from xfem_contact.solvers.report import SolveReport
 if TYPE_CHECKING:
     from xfem_contact.mechanics.problem import Problem
 
-__all__ = ["linear_solve", "newton_solver"]
+__all__ = ["linear_solve", "newton_solver", "prescribed_extension", "prolongation_parts"]
+
+
+def prolongation_parts(problem: Problem) -> tuple:
+    """The arguments of ``problem``'s prolongation after its space
+    (:func:`~xfem_contact.fem.prolongation.prolongation_matrix`): the laws' combined
+    multiplier prolongation and, with cell aggregation, the Dirichlet dofs (which stay
+    unknowns). Collective."""
+    prolongations = [
+        p
+        for name, law in problem.laws.items()
+        if (p := law.prolongation(problem.contexts[name], problem.space)) is not None
+    ]
+    fixed = None if problem.space.aggregation is None else problem.loads.dirichlet_dofs()
+    return combine_prolongations(prolongations, problem.mesh.comm), fixed
+
+
+def prescribed_extension(problem: Problem):
+    """The prescribed part ``E`` of cell aggregation's extension for ``problem``
+    (``x = E g + R y``, ``g`` the Dirichlet values, ``R`` of its
+    :meth:`~xfem_contact.mechanics.problem.Problem.prolongation`;
+    :func:`~xfem_contact.fem.prolongation.prescribed_extension`), or None. Collective."""
+    if problem.space.aggregation is None:
+        return None
+    return fem_prescribed_extension(problem.space, *prolongation_parts(problem))
 
 
 def linear_solve(problem: Problem, petsc_options: dict) -> SolveReport:
@@ -39,15 +65,23 @@ def linear_solve(problem: Problem, petsc_options: dict) -> SolveReport:
     a = form(problem.bilinear_form())
     L = form(problem.loads.linear_form())
     timer, residuals = phase("linear solve"), []
-    w, reason = solve_reduced(
-        a,
-        L,
-        problem.loads.bcs,
-        problem.space,
-        petsc_options,
-        problem.petsc_options_prefix,
-        residuals=residuals,
-    )
+    R, E = problem.prolongation(), prescribed_extension(problem)
+    try:
+        w, reason = solve_reduced(
+            a,
+            L,
+            problem.loads.bcs,
+            problem.space,
+            petsc_options,
+            problem.petsc_options_prefix,
+            R=R,
+            residuals=residuals,
+            extension=E,
+        )
+    finally:
+        for matrix in (R, E):
+            if matrix is not None:
+                matrix.destroy()
     problem.w.x.array[:] = w.x.array
     return SolveReport(
         residuals, reason=reason, total_time=seconds(timer), w=problem.w, space=problem.space
@@ -74,4 +108,5 @@ def newton_solver(problem: Problem, petsc_options: dict) -> ReducedNewton:
         couplings=list(problem.couplings.values()),
         field_space=space.field_space,
         transform=tip_transform(space, off=fieldsplit or bool(problem.couplings)),
+        extension=prescribed_extension(problem),
     )

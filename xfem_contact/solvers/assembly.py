@@ -430,6 +430,21 @@ class ReducedMatrix:
             self._full.PtAP(self.R, result=self.mat)
         return self.mat
 
+    @property
+    def full(self) -> PETSc.Mat | None:
+        """The full matrix ``A`` of the ``PtAP`` path at the last assembly, else None."""
+        return self._full
+
+    def full_matrix(self) -> PETSc.Mat:
+        """The full matrix ``A`` (with the Dirichlet conditions) at the last assembly:
+        :attr:`full` on the ``PtAP`` path, else assembled here (the caller destroys
+        that one). Collective."""
+        if self._full is not None:
+            return self._full
+        A = dolfinx.fem.petsc.assemble_matrix(self.a, bcs=self.bcs)
+        A.assemble()
+        return A
+
     def release(self) -> PETSc.Mat:
         """Hand :attr:`mat` over to the caller (who destroys it) and destroy the rest.
         Collective."""

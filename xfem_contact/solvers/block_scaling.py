@@ -21,6 +21,11 @@ and Burgardt, IJNME 64, 2005, whose local preconditioning is step 2):
    (symmetrised; eigenvalues floored at ``1e-14`` of the largest, none dropped); every
    other unknown keeps the scaling ``D`` of :mod:`xfem_contact.solvers.scaling`.
 
+With gathered tip dofs (:mod:`~xfem_contact.fem.tip_dofs`: one column per tip, branch
+function and component, shared by the zone's vertices) ``T`` subtracts from each such
+column the interpolant of ``R F_k`` on every standard node of the zone, and ``S`` is
+the scaling ``D`` alone (a column in every vertex's block would couple them all).
+
 ``Z = T S`` is fixed (made from the first Jacobian); the solvers factor ``Z^T J_r Z``.
 Any invertible ``Z`` gives the same solution in exact arithmetic. Measured
 (``bench/crack_convergence.py --parts conditioning``): see ``docs/crack_enrichment.md``.
@@ -72,7 +77,8 @@ def tip_scaling(space: EnrichedSpace, R: PETSc.Mat, J: PETSc.Mat) -> PETSc.Mat:
     columns = reduced_columns(space, R)
     T = shift_matrix(space, R, columns)
     JT = J.ptap(T)
-    S = node_block_scaling(JT, node_blocks(space, R, columns))
+    gathered = space.tip_dofs == "gathered"  # a tip's column is in every zone node's block
+    S = node_block_scaling(JT, [] if gathered else node_blocks(space, R, columns))
     Z = T.matMult(S)
     for obj in (T, JT, S):
         obj.destroy()
@@ -204,7 +210,8 @@ def _branch_at_nodes(space: EnrichedSpace) -> tuple[dict[int, np.ndarray], np.nd
 
 def shift_matrix(space: EnrichedSpace, R: PETSc.Mat, columns: np.ndarray) -> PETSc.Mat:
     """``T = I + C``: each branch column minus the interpolant of its function on the
-    standard nodes inside its support (step 1 of the module docstring). Collective."""
+    standard nodes inside its support (step 1 of the module docstring; a column shared
+    by several nodes' branch dofs, gathered, minus the sum of theirs). Collective."""
     gdim = space.cut.mesh.geometry.dim
     (Vb, pb), (V0, p0), (V1, p1) = (space.field_space(f) for f in (space.branch_field, 0, 1))
     hats = _hats_at_nodes(space)
@@ -212,14 +219,15 @@ def shift_matrix(space: EnrichedSpace, R: PETSc.Mat, columns: np.ndarray) -> PET
     H = hats[M, K]
     F, side_of = _branch_at_nodes(space)
     bcells, cells0, cells1 = Vb.dofmap.list, V0.dofmap.list, V1.dofmap.list
-    rows, cols, vals = [], [], []
+    rows, cols, vals, dofs = [], [], [], []
     for comp in range(gdim):
         minus = columns[p0[cells0[:, M] * gdim + comp]]  # (cells, pairs)
         plus = columns[p1[cells1[:, M] * gdim + comp]]
         node = cells0[:, M]
         tied = minus == plus
         for j in range(4):
-            e = columns[pb[bcells[:, K] * 4 * gdim + gdim * j + comp]]
+            dof = pb[bcells[:, K] * 4 * gdim + gdim * j + comp]
+            e = columns[dof]
             for col, s in ((minus, -1), (plus, 1)):
                 Fs = np.where(
                     tied, np.where(side_of[node] > 0, F[1][j, node], F[-1][j, node]), F[s][j, node]
@@ -228,14 +236,20 @@ def shift_matrix(space: EnrichedSpace, R: PETSc.Mat, columns: np.ndarray) -> PET
                 rows.append(col[keep])
                 cols.append(e[keep])
                 vals.append(-(H[None, :] * Fs)[keep])
+                dofs.append(dof[keep])
     first, last = R.getOwnershipRangeColumn()
-    rows, cols, vals = (np.concatenate(a) for a in (rows, cols, vals))
+    rows, cols, vals, dofs = (np.concatenate(a) for a in (rows, cols, vals, dofs))
     owned = (rows >= first) & (rows < last)
+    rows, cols, vals, dofs = rows[owned], cols[owned], vals[owned], dofs[owned]
+    # the same (row, branch dof) from each cell sharing it: kept once; then the branch
+    # dofs sharing a column summed
+    _, once = np.unique(np.stack([rows, dofs]), axis=1, return_index=True)
+    keys, inverse = np.unique(np.stack([rows[once], cols[once]]), axis=1, return_inverse=True)
+    vals = np.bincount(inverse.ravel(), weights=vals[once], minlength=keys.shape[1])
     n = last - first
-    # the identity, then the entries (the same one from each cell sharing it: kept once)
-    rows = np.concatenate([np.arange(first, last), rows[owned]])
-    cols = np.concatenate([np.arange(first, last), cols[owned]])
-    vals = np.concatenate([np.ones(n), vals[owned]])
+    rows = np.concatenate([np.arange(first, last), keys[0]])
+    cols = np.concatenate([np.arange(first, last), keys[1]])
+    vals = np.concatenate([np.ones(n), vals])
     return _csr(R.getComm(), n, rows - first, cols, vals)
 
 

@@ -4,7 +4,8 @@ The same prolongation as :class:`~xfem_contact.solvers.newton.ReducedNewton`:
 ``a`` and ``L`` are assembled with Dirichlet conditions and reduced with the operator
 ``R`` of :mod:`xfem_contact.fem.prolongation`, ``A_r = R^T A R`` (straight into the
 reduced numbering, :mod:`xfem_contact.solvers.assembly`) and ``b_r = R^T b``; the
-solution is ``x = R y``.
+solution is ``x = R y``, or ``x = E g + R y`` where cell aggregation extends Dirichlet
+values ``g`` (:func:`~xfem_contact.fem.prolongation.prescribed_extension`).
 The solver factors the symmetrically scaled ``D A_r D`` (:mod:`xfem_contact.solvers.scaling`),
 or, with a crack's tip enrichment, ``Z^T A_r Z`` with ``x = R Z y`` for the change of
 unknowns ``Z`` of :mod:`xfem_contact.solvers.block_scaling`.
@@ -18,7 +19,7 @@ from petsc4py import PETSc
 
 from xfem_contact._deprecation import renamed
 from xfem_contact.fem.enrichment import EnrichedSpace
-from xfem_contact.fem.prolongation import prolongation_matrix
+from xfem_contact.fem.prolongation import prescribed_offset, prolongation_matrix
 from xfem_contact.solvers.assembly import ReducedMatrix
 from xfem_contact.solvers.block_scaling import refined, scaled, tip_transform
 from xfem_contact.solvers.options import applied_options, checked_prefix, merged_options
@@ -32,8 +33,10 @@ def assemble_reduced(
     L: dolfinx.fem.Form,
     bcs: list[dolfinx.fem.DirichletBC],
     R: PETSc.Mat,
+    offset: PETSc.Vec | None = None,
 ) -> tuple[PETSc.Mat, PETSc.Vec]:
-    """Assemble ``a`` and ``L`` with Dirichlet conditions and reduce them by ``R``.
+    """Assemble ``a`` and ``L`` with Dirichlet conditions and reduce them by ``R``
+    (for ``x = offset + R y``: the right-hand side ``R^T (b - A offset)``).
 
     Collective.
 
@@ -45,6 +48,9 @@ def assemble_reduced(
             :func:`dolfinx.fem.petsc.set_bc` do.
         R: Prolongation, global shape ``(dim W, n_reduced)``, see
             :func:`xfem_contact.fem.prolongation.prolongation_matrix`. Not modified.
+        offset: The prescribed part of ``x`` off the Dirichlet dofs
+            (:func:`~xfem_contact.fem.prolongation.prescribed_offset`), laid out as
+            ``W``'s owned dofs, or None.
 
     Returns:
         The reduced matrix ``R^T A R``, global shape ``(n_reduced, n_reduced)``,
@@ -53,11 +59,18 @@ def assemble_reduced(
     """
     reduced = ReducedMatrix(a, bcs, R)
     reduced.assemble()
-    A_r = reduced.release()
     b = dolfinx.fem.petsc.assemble_vector(L)
     dolfinx.fem.petsc.apply_lifting(b, [a], bcs=[bcs])
     b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     dolfinx.fem.petsc.set_bc(b, bcs)
+    if offset is not None:  # zero on the Dirichlet dofs, whose rows of A are the identity
+        A = reduced.full_matrix()
+        A.mult(offset, (Ax := offset.duplicate()))
+        b.axpy(-1.0, Ax)
+        Ax.destroy()
+        if A is not reduced.full:
+            A.destroy()
+    A_r = reduced.release()
     b_r = R.createVecRight()
     R.multTranspose(b, b_r)
     b.destroy()
@@ -74,6 +87,7 @@ def solve_reduced(
     R: PETSc.Mat | None = None,
     residuals: list[float] | None = None,
     tip_scaling: bool = True,
+    extension: PETSc.Mat | None = None,
 ) -> tuple[dolfinx.fem.Function, int]:
     """Solve ``a(u, v) = L(v)`` on the reduced space of ``R`` (one KSP solve).
 
@@ -95,9 +109,13 @@ def solve_reduced(
             after the solve are appended to it (``|D b|``, ``|D b - D A D y_s|``).
         tip_scaling: With a crack's tip enrichment, factor ``Z^T A_r Z`` with ``x = R Z y``
             (:func:`~xfem_contact.solvers.block_scaling.tip_scaling`) instead of ``D A_r D``.
+        extension: The prescribed part ``E`` of cell aggregation's extension
+            (:func:`~xfem_contact.fem.prolongation.prescribed_extension`, for the same
+            ``R``), or None: the solution is then ``x = E g + R y``, ``g`` the Dirichlet
+            values. Not destroyed.
 
     Returns:
-        The solution ``x = R y`` on ``space.W`` (zero on inactive dofs, ghosts
+        The solution ``x = R y`` (``E g + R y``) on ``space.W`` (zero on inactive dofs, ghosts
         updated) and the KSP's converged reason (> 0).
 
     Raises:
@@ -115,7 +133,11 @@ def solve_reduced(
         if R is None:
             R = prolongation_matrix(space)
             owned.append(R)
-        A, b = assemble_reduced(a, L, bcs, R)
+        offset = None
+        if extension is not None:
+            offset = prescribed_offset(extension, bcs, space.W)
+            owned.append(offset)
+        A, b = assemble_reduced(a, L, bcs, R, offset)
         owned += [A, b]
         transform = tip_transform(space, off=not tip_scaling)
         if transform is None:
@@ -165,6 +187,8 @@ def solve_reduced(
             owned.append(y)
         w = dolfinx.fem.Function(space.W)
         R.mult(y, w.x.petsc_vec)
+        if offset is not None:
+            w.x.petsc_vec.axpy(1.0, offset)
         w.x.scatter_forward()
         return w, reason
     finally:

@@ -25,6 +25,7 @@ from petsc4py import PETSc
 from xfem_contact._deprecation import renamed, renamed_keyword
 from xfem_contact._timers import phase, seconds
 from xfem_contact.fem.forms import form_parts
+from xfem_contact.fem.prolongation import prescribed_offset
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
 from xfem_contact.solvers.block_scaling import TipFactor
 from xfem_contact.solvers.fieldsplit_sets import fieldsplit_sets
@@ -117,6 +118,10 @@ class ReducedNewton:
             then factors ``Z^T J_r Z`` (:class:`~xfem_contact.solvers.block_scaling.TipFactor`);
             SNES's unknowns and residual norms stay ``D``-scaled. Not with couplings or a
             fieldsplit preconditioner.
+        extension: The prescribed part ``E`` of cell aggregation's extension
+            (:func:`~xfem_contact.fem.prolongation.prescribed_extension`, for the same
+            ``R``), or None: the iterates are then ``w = E g + R y``, ``g`` the Dirichlet
+            values when a solve starts. Not destroyed.
         splits: Deprecated name of ``fieldsplit_dofs``.
     """
 
@@ -135,6 +140,7 @@ class ReducedNewton:
         interpolation=None,
         field_space: Callable | None = None,
         transform: Callable[[PETSc.Mat, PETSc.Mat], PETSc.Mat] | None = None,
+        extension: PETSc.Mat | None = None,
         *,
         splits: dict[str, np.ndarray] | None = None,
     ):
@@ -142,6 +148,9 @@ class ReducedNewton:
             "ReducedNewton", "splits", "fieldsplit_dofs", splits, fieldsplit_dofs
         )
         self.w, self.bcs, self.R = w, bcs, R
+        self.extension = extension
+        #: ``E g`` of the current solve (None without an extension)
+        self.offset: PETSc.Vec | None = None
         self.couplings = list(couplings or [])
         timer = phase("Newton set-up: selection")
         chosen = selection(R, w.function_space)
@@ -238,6 +247,8 @@ class ReducedNewton:
     def _update(self, y: PETSc.Vec) -> None:
         x = self.w.x.petsc_vec
         self.R.mult(y, x)
+        if self.offset is not None:
+            x.axpy(1.0, self.offset)
         self.w.x.scatter_forward()
 
     def _residual(self, snes, y, F_r):
@@ -322,10 +333,15 @@ class ReducedNewton:
             )
 
     def _start_from_w(self) -> None:
-        """``y`` from the current ``w``: the least-squares ``(R^T R)^-1 R^T w`` (exact
-        when ``w`` lies in the range of ``R``, e.g. after a previous solve), by CG on
-        ``R^T R``; the matrix and its solver are destroyed afterwards (they would stay
-        allocated through the Newton solve, whose peak memory they would add to)."""
+        """``y`` from the current ``w``: the least-squares ``(R^T R)^-1 R^T (w - E g)``
+        (exact when ``w`` lies in the range, e.g. after a previous solve), by CG on
+        ``R^T R``, with the offset ``E g`` taken anew from the Dirichlet values; the
+        matrix and its solver are destroyed afterwards (they would stay allocated
+        through the Newton solve, whose peak memory they would add to)."""
+        if self.extension is not None:
+            if self.offset is not None:
+                self.offset.destroy()
+            self.offset = prescribed_offset(self.extension, self.bcs, self.w.function_space)
         RtR = self.R.transposeMatMult(self.R)
         projection = PETSc.KSP().create(self.R.getComm())
         projection.setOperators(RtR)
@@ -333,7 +349,11 @@ class ReducedNewton:
         projection.getPC().setType("jacobi")
         projection.setTolerances(rtol=1e-14, atol=0.0, max_it=1000)
         rhs = self.R.createVecRight()
-        self.R.multTranspose(self.w.x.petsc_vec, rhs)
+        shifted = self.w.x.petsc_vec.copy()
+        if self.offset is not None:
+            shifted.axpy(-1.0, self.offset)
+        self.R.multTranspose(shifted, rhs)
+        shifted.destroy()
         projection.solve(rhs, self.y)
         for obj in (projection, RtR, rhs):
             obj.destroy()
@@ -412,6 +432,8 @@ class ReducedNewton:
             coupling.destroy()
         for obj in (self.snes, self.b, self.y, self.F_r, self.R, self.D, *self._fieldsplit_objects):
             obj.destroy()
+        if self.offset is not None:
+            self.offset.destroy()
         if self.tip is not None:
             self.tip.destroy()
         self.jacobian_forms.destroy()
