@@ -191,7 +191,7 @@ def quadric(x):
 
 def test_rule_error_on_the_exact_quadric_sphere_stays_small():
     """The P2 sphere at h = 1/8 and 1/16: only the rules err. In the tetrahedron's frame
-    their relative area error is 6.8e-9 and 9.7e-9 (1.3e-8 and 1.7e-7 with
+    their relative area error is 1.5e-8 and 1.0e-8 (1.3e-8 and 1.7e-7 with
     ``raise_tolerance=None``); on the hexahedra (the same order)
     5.6e-7 and 2.2e-7, and it rises to 3.2e-6 at h = 1/32. Both frames' errors depend on
     which of two tied axis choices a symmetric box takes (:mod:`saye_axes` breaks ties
@@ -230,8 +230,8 @@ def test_raised_orders_follow_the_cell_size(corner, kuhn):
     zero set of the sphere R = 0.3 about its first shifted centre, against Gauss-Bonnet.
     A fixed tolerance of 1e-6 reference units let area errors of 2.5e-7 and 2.4e-7 of
     the cells' through (summed over the cut cells, a floor of the surface's relative
-    error); the tolerance of ``raise_tolerances``, which falls as ``(h kappa)^3``, leaves
-    1.2e-9 and 2.7e-9."""
+    error); the tolerance of ``raise_tolerances``, which falls as ``(h kappa)^3`` on
+    cells finer than ``h kappa = 1/2``, leaves 1.2e-9 and 2.7e-9."""
     vertices = (np.array(corner) + np.array(kuhn)) / 32.0
     centre, radius = np.array([0.51990505, 0.50843083, 0.50128042]), 0.3
     J = (vertices[1:] - vertices[0]).T

@@ -53,6 +53,7 @@ __all__ = [
     "HEXAHEDRA",
     "RAISE_POWER",
     "RAISE_TOLERANCE",
+    "RESOLVED",
     "classify_p2_tets",
     "hexahedron_map",
     "p2_tet_cut_rules",
@@ -192,14 +193,18 @@ def _to_simplex_bernstein() -> np.ndarray:
     return T
 
 
-RAISE_TOLERANCE = 1e-5
-"""Default ``raise_tolerance`` of :func:`p2_tet_cut_rules` (dimensionless; see
-:func:`raise_tolerances`)."""
+RAISE_TOLERANCE = 1e-6
+"""Default ``raise_tolerance`` of :func:`p2_tet_cut_rules`: the tolerance of coarse cells
+(reference units; see :func:`raise_tolerances`)."""
 
 RAISE_POWER = 3
 """Power of the cell's resolution ``theta = h kappa`` in :func:`raise_tolerances`: the
 rules' change that a cell allows falls as ``h^3``, the order of a P2 interpolant's
 distance to the surface (``h^(k + 1)``)."""
+
+RESOLVED = 0.5
+"""Resolution ``theta = h kappa`` below which :func:`raise_tolerances` falls: cells of
+``theta >= RESOLVED`` keep ``raise_tolerance``."""
 
 ROUND_OFF = 1e-13
 """Least tolerance of :func:`raise_tolerances` (reference units): nearly planar cells,
@@ -211,7 +216,8 @@ def raise_tolerances(
 ) -> npt.NDArray[np.float64]:
     """The change of a box's rules (interface area, side -1 volume; reference units)
     between ``order - 1`` and ``order`` points above which it gets ``2 order`` points, per
-    cell: ``raise_tolerance min(1, theta)^RAISE_POWER``, at least :data:`ROUND_OFF`.
+    cell: ``raise_tolerance min(1, theta / RESOLVED)^RAISE_POWER``, at least
+    :data:`ROUND_OFF`.
 
     ``theta = h |D^2 phi| / |grad phi|`` at the cell's centroid (physical derivatives,
     Frobenius and Euclidean norms; ``h`` the longest edge) is the cell's size against its
@@ -221,14 +227,14 @@ def raise_tolerances(
     a fixed tolerance bounds the relative error of the whole surface by a constant, which
     stops its convergence (the rules' floor), while ``theta^3`` makes the bound fall as
     ``h^3``; the rules actually kept, of ``order`` points, err by less than the change
-    from ``order - 1`` by about ``theta^2`` more. Cells of ``theta >= 1`` (coarse against
-    the surface) keep ``raise_tolerance``.
+    from ``order - 1`` by about ``theta^2`` more. Cells of ``theta >= RESOLVED`` (coarse
+    against the surface) keep ``raise_tolerance``.
 
     Args:
         C: Monomial coefficients ``(ncells, 3, 3, 3)`` in the reference tetrahedron.
         J: Affine Jacobians ``(ncells, 3, 3)`` of the cells (at their centroids), or
             ``None`` (reference cells).
-        raise_tolerance: The tolerance of cells with ``theta >= 1``, ``>= 0``.
+        raise_tolerance: The tolerance of cells of ``theta >= RESOLVED``, ``>= 0``.
 
     Returns:
         Shape ``(ncells,)``.
@@ -249,8 +255,8 @@ def raise_tolerances(
     curved = h * np.linalg.norm(hessian, axis=(1, 2))
     length = np.linalg.norm(slope, axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        theta = np.where(curved < length, curved / length, 1.0)
-    return np.maximum(raise_tolerance * theta**RAISE_POWER, ROUND_OFF)
+        scale = np.where(curved < RESOLVED * length, curved / (RESOLVED * length), 1.0)
+    return np.maximum(raise_tolerance * scale**RAISE_POWER, ROUND_OFF)
 
 
 FRAMES = ("tetrahedron", "hexahedra")
