@@ -221,14 +221,15 @@ def raise_tolerances(
 
     ``theta = h |D^2 phi| / |grad phi|`` at the cell's centroid (physical derivatives,
     Frobenius and Euclidean norms; ``h`` the longest edge) is the cell's size against its
-    zero set's radius of curvature, ``h kappa``. A box's reference area and volume are
-    fractions of the cell's, so the rules' error that a tolerance lets through is a share
-    of each cell's area and volume, and summed over the cut cells a share of the surface's:
+    zero set's radius of curvature, of the order of ``h kappa``. A box's reference area
+    and volume are fractions of the cell's, so the rules' error that a tolerance lets
+    through is a share of each cell's area and volume, and summed over the cut cells a
+    share of the surface's:
     a fixed tolerance bounds the relative error of the whole surface by a constant, which
     stops its convergence (the rules' floor), while ``theta^3`` makes the bound fall as
-    ``h^3``; the rules actually kept, of ``order`` points, err by less than the change
-    from ``order - 1`` by about ``theta^2`` more. Cells of ``theta >= RESOLVED`` (coarse
-    against the surface) keep ``raise_tolerance``.
+    ``h^3`` (the rules kept, of ``order`` points, err by less than the change from
+    ``order - 1`` that it bounds). Cells of ``theta >= RESOLVED`` (coarse against the
+    surface) keep ``raise_tolerance``.
 
     Args:
         C: Monomial coefficients ``(ncells, 3, 3, 3)`` in the reference tetrahedron.
