@@ -26,20 +26,31 @@ gradient from the callable; cells, boxes and axes from the interpolant), as
 
     python bench/cut3d.py --sizes 8 16 32 --kinds tet-P2 hex-Q2 --levelset function callable
 
+``--lenses`` checks the Q2 hexahedra on the sphere's exact zero set cell by cell against
+Gauss-Bonnet: whether a cell certified on one side by the interpolant holds a lens of the
+sphere (which the rules would drop), and each cut cell's area::
+
+    python bench/cut3d.py --sizes 8 16 32 --lenses --centres 8
+
 ``--order k`` sets the Gauss points per interval of Saye's rules (P2 tetrahedra and
 hexahedra; default 4, as ``quadrature_degree = 6`` in ``CutMesh``). ``--min-depth 1``
 splits every box of the P2 tetrahedra that the interface may cross before Saye's rules,
 ``--frame hexahedra`` runs them on the four hexahedra of each tetrahedron instead of on
 truncated boxes of the tetrahedron itself
 (:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`), and
-``--raise-tolerance T`` (``off``: none) sets the tetrahedron frame's raised orders. With
+``--raise-tolerance T`` (``off``: none) sets the tetrahedron frame's raised orders (the
+tolerance of cells coarse against the surface, scaled by ``(2 h kappa)^3`` below
+``h kappa = 1/2``, :func:`~xfem_contact.quadrature.curved_tet_rules.raise_tolerances`). With
 ``--centres K`` each rate of the means gets a 95 % bootstrap interval over the centres.
 
 The fuzz (``--fuzz N``) cuts ``N`` reference cells per kind by random spheres, ellipsoids,
 tori and planes (a third of them moved to pass exactly through a node) and counts the
 failures: a non-positive weight, side volumes missing the cell volume by more than 1e-12,
-or an exception other than the documented refusal of a singular zero set (counted apart);
-with ``--levelset callable`` also those of the P2 / Q2 rules on the exact zero sets::
+an interface area off the exact one (known for planes, clipped exactly, and for spheres on
+their exact zero sets, by Gauss-Bonnet: ``checked``) by more than its tolerance
+(:func:`area_tolerance`; ``worst``: the largest error over it), or an exception other than
+the documented refusal of a singular zero set (counted apart); with ``--levelset
+callable`` also those of the P2 / Q2 rules on the exact zero sets::
 
     python bench/cut3d.py --fuzz 10000 --sizes
 """
@@ -48,7 +59,9 @@ from __future__ import annotations
 
 import argparse
 import functools
+import importlib.util
 import itertools
+import pathlib
 import resource
 import time
 
@@ -56,7 +69,7 @@ import basix
 import numpy as np
 
 from xfem_contact.geometry.cut_tets import classify_tets, cut_tets
-from xfem_contact.quadrature import tet_saye
+from xfem_contact.quadrature import curved_tet_rules
 from xfem_contact.quadrature.curved_tet_rules import classify_p2_tets, p2_tet_cut_rules
 from xfem_contact.quadrature.cut_tet_rules import tet_interface_rule, tet_side_rules
 from xfem_contact.quadrature.saye import classify_hexes, hex_cut_rules
@@ -159,7 +172,7 @@ FRAME = "tetrahedron"
 """Where the P2 tetrahedra's rules run Saye's algorithm (``--frame``)."""
 
 
-RAISE_TOLERANCE = tet_saye.RAISE_TOLERANCE
+RAISE_TOLERANCE = curved_tet_rules.RAISE_TOLERANCE
 """Rule-change tolerance of the P2 tetrahedra's boxes above which their order is doubled
 (``--raise-tolerance``; ``None``: off)."""
 
@@ -297,33 +310,126 @@ def sphere_hexes(
     return volume, area, cut.size, elapsed, points
 
 
+def hex_lenses(n: int, centre: np.ndarray, order: int) -> tuple[int, float, float, float]:
+    """The exact zero set of the sphere about ``centre`` on ``n^3`` Q2 hexahedra, cell by
+    cell against Gauss-Bonnet: the cells certified on one side by the interpolant's
+    Bernstein coefficients where the sphere has area (a lens that the rules never see),
+    the share of the sphere's area in them, and over the cut cells the summed relative
+    error and the largest error of a cell over its exact area."""
+    h = 1.0 / n
+    element = basix.create_element(
+        basix.ElementFamily.P, basix.CellType.hexahedron, 2, basix.LagrangeVariant.gll_warped
+    )
+    corners = origins(n)
+    phi = _sphere(corners[:, None] + h * element.points[None], centre)
+    side = classify_hexes(phi, 2)
+    near = np.linalg.norm(corners + h / 2 - centre, axis=1) - R
+    near = np.flatnonzero(np.abs(near) <= h * np.sqrt(3.0) / 2)  # the cells the sphere meets
+    exact = np.zeros(corners.shape[0])
+    exact[near] = [
+        reference.sphere_area_in_polytope(centre, R, reference.box_planes(x, x + h))
+        for x in corners[near]
+    ]
+    lens = np.flatnonzero((side != 0) & (exact > 0))
+    cut = np.flatnonzero(side == 0)
+    rules = hex_cut_rules(
+        phi[cut], 2, order, exact=lambda rows, X: _sphere(corners[cut[rows]] + h * X, centre)
+    )
+    area = np.bincount(rules.interface.point_rows, rules.interface.weights, minlength=cut.size)
+    error = area * h**2 - exact[cut]
+    total = SHAPES["sphere"][2]
+    worst = np.max(np.abs(error)[exact[cut] > 0] / exact[cut][exact[cut] > 0])
+    return lens.size, exact[lens].sum() / total, error.sum() / total, worst
+
+
 def random_level_set(rng: np.random.Generator):
-    """A random sphere, ellipsoid, torus or plane around the reference cells, as a callable
-    on points ``(..., 3)``."""
+    """A random sphere, ellipsoid, torus or plane around the reference cells: a callable
+    on points ``(..., 3)`` and, for a sphere or a plane, ``(shape, centre, radius |
+    normal)`` (the surface's area in a cell is then exact; else ``None``). Each level set
+    is the signed distance (planes, spheres, tori) or a multiple of it near the surface
+    (ellipsoids), so that ``f - s = 0`` is the sphere of radius ``R + s`` or the plane
+    moved by ``s`` along its normal."""
     centre = rng.uniform(-0.5, 1.5, size=3)
     Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
     shape = rng.choice(["sphere", "ellipsoid", "torus", "plane"])
     if shape == "plane":
         normal = Q[0]
-        return lambda x: (x - centre) @ normal
+        return (lambda x: (x - centre) @ normal), ("plane", centre, normal)
     if shape == "sphere":
         radius = rng.uniform(0.05, 1.5)
-        return lambda x: np.linalg.norm(x - centre, axis=-1) - radius
+        surface = ("sphere", centre, radius)
+        return (lambda x: np.linalg.norm(x - centre, axis=-1) - radius), surface
     if shape == "ellipsoid":
         axes = rng.uniform(0.1, 1.2, size=3)
-        return lambda x: np.linalg.norm(((x - centre) @ Q) / axes, axis=-1) - 1.0
+        return (lambda x: np.linalg.norm(((x - centre) @ Q) / axes, axis=-1) - 1.0), None
     big, small = rng.uniform(0.3, 1.0), rng.uniform(0.05, 0.3)
 
     def torus(x):
         y = (x - centre) @ Q
         return np.hypot(np.hypot(y[..., 0], y[..., 1]) - big, y[..., 2]) - small
 
-    return torus
+    return torus, None
 
 
-def fuzz_cells(kind: str, count: int, seed: int = 0, callable_: bool = False) -> dict[str, int]:
+_REFERENCE = importlib.util.spec_from_file_location(
+    "cut3d_reference", pathlib.Path(__file__).resolve().parents[1] / "tests" / "cut3d_reference.py"
+)
+reference = importlib.util.module_from_spec(_REFERENCE)
+_REFERENCE.loader.exec_module(reference)
+"""The exact references of the tests (polytopes clipped by planes, Gauss-Bonnet)."""
+
+REFERENCE_CELLS = {
+    "tetrahedron": np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+    "hexahedron": reference.box_vertices([0.0] * 3, [1.0] * 3),
+}
+
+
+def exact_area(cell: str, surface, shift: float, exact_zero_set: bool) -> float:
+    """Area of the zero set of ``f - shift`` in the reference ``cell`` for ``surface =
+    (shape, centre, radius | normal)`` of :func:`random_level_set`: for a plane (which
+    every interpolant represents exactly), and for a sphere when the rules follow the exact
+    zero set; else NaN (``None``; a sphere's interpolant, whose error in a cell that the
+    sphere grazes is of the cell's size at any ``h``; a sphere moved through a node, where
+    Gauss-Bonnet's corners meet)."""
+    if surface is None or (surface[0] == "sphere" and (shift != 0 or not exact_zero_set)):
+        return np.nan
+    shape, centre, size = surface
+    vertices = REFERENCE_CELLS[cell]
+    if cell == "tetrahedron":
+        planes, edges = reference.tet_planes(vertices), reference.TET_EDGES
+    else:
+        planes, edges = reference.box_planes([0.0] * 3, [1.0] * 3), reference.box_edges()
+    if shape == "sphere":
+        return reference.sphere_area_in_polytope(centre, size, planes)
+    _, face = reference.clip(planes, vertices, edges, (size, -(centre @ size) - shift), 1)
+    cross = np.cross(face[:, 1] - face[:, 0], face[:, 2] - face[:, 0])
+    return float(np.linalg.norm(cross, axis=1).sum() / 2)
+
+
+AREA_FLOOR = 1e-10
+"""Area tolerance of the fuzz for planes (every rule is exact for them; reference units)."""
+
+
+def area_tolerance(cell: str, surface) -> float:
+    """Tolerance of a cell's interface area against :func:`exact_area`: ``AREA_FLOOR``
+    for a plane, ``AREA_FLOOR + h^2 theta^3`` for a sphere (on its exact zero set), with
+    ``theta = h / R`` (the cell's diameter ``h`` against the radius): the error of the
+    cell's share of a surface whose relative error falls as ``h^3``, as the raised orders
+    allow (``curved_tet_rules.RAISE_POWER``)."""
+    if surface is None or surface[0] == "plane":
+        return AREA_FLOOR
+    h = np.sqrt(2.0) if cell == "tetrahedron" else np.sqrt(3.0)
+    return AREA_FLOOR + h**2 * (h / surface[2]) ** curved_tet_rules.RAISE_POWER
+
+
+def fuzz_cells(kind: str, count: int, seed: int = 0, callable_: bool = False) -> dict[str, float]:
     """Failures of the rules of ``count`` random cuts of one reference cell of ``kind``:
-    ``{"cases", "cut", "weights", "volume", "errors", "refused", "reduced"}``; with
+    ``{"cases", "cut", "weights", "volume", "area", "checked", "errors", "refused",
+    "reduced", "worst"}`` (``area``: interface areas off the exact one by more than
+    :func:`area_tolerance`, of the ``checked`` cases whose area is known,
+    :func:`exact_area`; ``worst``: the largest error over its tolerance; ``unreferenced``:
+    spheres whose Gauss-Bonnet area fell outside 0 .. the cell's boundary area, not
+    checked); with
     ``callable_`` (P2 tetrahedra, Q2 hexahedra), of the rules on the exact zero sets."""
     rng = np.random.default_rng(seed)
     cell = {
@@ -338,13 +444,24 @@ def fuzz_cells(kind: str, count: int, seed: int = 0, callable_: bool = False) ->
         cell[1],
         basix.LagrangeVariant.gll_warped,
     )
-    functions = [random_level_set(rng) for _ in range(count)]
+    functions, surfaces = zip(*(random_level_set(rng) for _ in range(count)), strict=True)
     phi = np.array([f(element.points) for f in functions])
     through = rng.random(count) < 1 / 3
     node = rng.integers(0, element.points.shape[0], size=count)
     shift = np.where(through, phi[np.arange(count), node], 0.0)
     phi[through] -= shift[through, None]  # zero at a node, exactly
     phi[through, node[through]] = 0.0
+    exact_zero_set = callable_ and kind in ("tet-P2", "hex-Q2")
+    exact_areas = np.array(
+        [exact_area(cell[0], s, d, exact_zero_set) for s, d in zip(surfaces, shift, strict=True)]
+    )
+    tolerances = np.array([area_tolerance(cell[0], s) for s in surfaces])
+    # a piece of a sphere in a convex cell is part of the boundary of a convex subset of
+    # the cell, so its area is at most the cell's boundary area: beyond it (or below 0),
+    # Gauss-Bonnet's pieces were not disks, and the case is not checked
+    boundary = 1.5 + np.sqrt(3.0) / 2.0 if cell[0] == "tetrahedron" else 6.0
+    unreferenced = (exact_areas < 0) | (exact_areas > boundary)
+    exact_areas[unreferenced] = np.nan
 
     def exact_of(cells: np.ndarray):
         """The exact level sets of ``cells`` as a function of ``(rows, X)``."""
@@ -359,18 +476,22 @@ def fuzz_cells(kind: str, count: int, seed: int = 0, callable_: bool = False) ->
         return exact if callable_ and kind in ("tet-P2", "hex-Q2") else None
 
     volume = 1.0 / 6.0 if cell[0] == "tetrahedron" else 1.0
-    counts = dict.fromkeys(("cases", "cut", "weights", "volume", "errors", "refused", "reduced"), 0)
-    counts["cases"] = count
+    names = ("cases", "cut", "weights", "volume", "area", "checked", "errors", "refused", "reduced")
+    counts = dict.fromkeys(names, 0)
+    counts["cases"], counts["worst"] = count, 0.0
+    counts["unreferenced"] = int(unreferenced.sum())
     batch = 500
     for start in range(0, count, batch):
         rows = np.arange(start, min(start + batch, count))
         try:
-            _check_batch(kind, phi[rows], volume, counts, exact_of(rows))
+            areas = (exact_areas[rows], tolerances[rows])
+            _check_batch(kind, phi[rows], volume, counts, areas, exact_of(rows))
         except Exception:  # noqa: BLE001 - find the failing cells one by one
             for row in rows:
                 one = rows[row - start : row - start + 1]
                 try:
-                    _check_batch(kind, phi[one], volume, counts, exact_of(one))
+                    areas = (exact_areas[one], tolerances[one])
+                    _check_batch(kind, phi[one], volume, counts, areas, exact_of(one))
                 except ValueError as error:
                     counts["refused" if "singular point" in str(error) else "errors"] += 1
                 except Exception:  # noqa: BLE001 - a fuzz counts every failure
@@ -379,10 +500,16 @@ def fuzz_cells(kind: str, count: int, seed: int = 0, callable_: bool = False) ->
 
 
 def _check_batch(
-    kind: str, phi: np.ndarray, volume: float, counts: dict[str, int], exact=None
+    kind: str,
+    phi: np.ndarray,
+    volume: float,
+    counts: dict[str, float],
+    areas: tuple[np.ndarray, np.ndarray],
+    exact=None,
 ) -> None:
     """Rules of cells ``phi`` (following ``exact`` if given); adds their failures to
-    ``counts`` (raises before adding)."""
+    ``counts`` (raises before adding); ``areas``: the exact interface area of each cell
+    (NaN: unknown, not checked) and its tolerance."""
     n = phi.shape[0]
     if kind == "tet-P1":
         geometry = cut_tets(phi)
@@ -407,6 +534,13 @@ def _check_batch(
     counts["reduced"] += int(reduced)
     counts["weights"] += int(bad.sum())
     counts["volume"] += int((np.abs(minus + plus - volume) > 1e-12).sum())
+    interface = np.bincount(rules[2].point_rows, rules[2].weights, minlength=n)
+    expected, tolerance = areas
+    checked = ~np.isnan(expected)
+    counts["checked"] += int(checked.sum())
+    counts["area"] += int((np.abs(interface - expected)[checked] > tolerance[checked]).sum())
+    ratio = np.abs(interface - expected)[checked] / tolerance[checked]
+    counts["worst"] = max(counts["worst"], float(ratio.max(initial=0.0)))
 
 
 def shifted_centres(n: int, count: int, seed: int = 0) -> np.ndarray:
@@ -572,11 +706,19 @@ def main() -> None:
     parser.add_argument(
         "--raise-tolerance",
         type=lambda text: None if text == "off" else float(text),
-        default=tet_saye.RAISE_TOLERANCE,
+        default=curved_tet_rules.RAISE_TOLERANCE,
         metavar="T",
-        help="P2 tetrahedra (tetrahedron frame): boxes whose rules move by more than T between "
-        "order - 1 and order get 2 order points ('off': never; p2_tet_cut_rules "
-        f"raise_tolerance, default {tet_saye.RAISE_TOLERANCE:g})",
+        help="P2 tetrahedra (tetrahedron frame): boxes whose rules move by more than T "
+        "(times (2 h kappa)^3 where h kappa < 1/2) between order - 1 and order get 2 order "
+        "points ('off': never; p2_tet_cut_rules "
+        f"raise_tolerance, default {curved_tet_rules.RAISE_TOLERANCE:g})",
+    )
+    parser.add_argument(
+        "--lenses",
+        action="store_true",
+        help="Q2 hexahedra, exact zero set of the sphere: per size and centre, the cells "
+        "certified by the interpolant where the sphere has area, and the cut cells' areas "
+        "against Gauss-Bonnet (instead of the volume and area rows)",
     )
     args = parser.parse_args()
     if args.centres < 0:
@@ -589,7 +731,7 @@ def main() -> None:
             continue
         start = time.perf_counter()
         counts = fuzz_cells(kind, args.fuzz, callable_=levelset == "callable")
-        failures = counts["weights"] + counts["volume"] + counts["errors"]
+        failures = counts["weights"] + counts["volume"] + counts["area"] + counts["errors"]
         label = f" ({levelset})" if kind in ("tet-P2", "hex-Q2") else ""
         print(
             f"fuzz {kind}{label}: {counts} -> {failures} failure(s) "
@@ -605,6 +747,14 @@ def main() -> None:
             n, 2, shape=shape, callable_=c, centre=centre
         ),
     }
+    if args.lenses:
+        print("\nhex-Q2: sphere (callable), cell by cell against Gauss-Bonnet")
+        print(f"{'n':>5} {'centre':>6} {'lenses':>6} {'lens area':>9} {'sum err':>9} {'worst':>8}")
+        for n in args.sizes:
+            for k, centre in enumerate(shifted_centres(n, args.centres)):
+                lenses, share, total, worst = hex_lenses(n, centre, args.order)
+                print(f"{n:5d} {k:6d} {lenses:6d} {share:9.2e} {total:+9.2e} {worst:8.2e}")
+        args.sizes = []
     cases = itertools.product(args.shapes, args.kinds if args.sizes else [], args.levelset)
     for shape, kind, levelset in cases:
         if levelset == "callable" and kind in ("tet-P1", "hex-Q1"):

@@ -6,7 +6,14 @@ area at rate >= 3.8, refusals."""
 import basix
 import numpy as np
 import pytest
-from cut3d_reference import TET_EDGES, clip, exponents, simplex_moments, tet_planes
+from cut3d_reference import (
+    TET_EDGES,
+    clip,
+    exponents,
+    simplex_moments,
+    sphere_area_in_polytope,
+    tet_planes,
+)
 
 from xfem_contact.geometry.tensor_levelset import bernstein, coefficients
 from xfem_contact.quadrature.curved_tet_rules import (
@@ -184,7 +191,7 @@ def quadric(x):
 
 def test_rule_error_on_the_exact_quadric_sphere_stays_small():
     """The P2 sphere at h = 1/8 and 1/16: only the rules err. In the tetrahedron's frame
-    their relative area error is 6.8e-9 and 9.7e-9 (1.3e-8 and 1.7e-7 with
+    their relative area error is 1.5e-8 and 1.0e-8 (1.3e-8 and 1.7e-7 with
     ``raise_tolerance=None``); on the hexahedra (the same order)
     5.6e-7 and 2.2e-7, and it rises to 3.2e-6 at h = 1/32. Both frames' errors depend on
     which of two tied axis choices a symmetric box takes (:mod:`saye_axes` breaks ties
@@ -209,6 +216,37 @@ def test_curved_boxes_get_raised_orders(centre):
         f"quadric ellipsoid about {centre}, h = 1/6: volume {errors[0]:.2e}, area {errors[1]:.2e}"
     )
     assert abs(errors[0]) <= 1e-8 and abs(errors[1]) <= 2e-6
+
+
+@pytest.mark.parametrize(
+    "corner, kuhn",
+    [
+        ((21, 21, 9), [(0, 0, 0), (1, 0, 0), (1, 0, 1), (1, 1, 1)]),
+        ((22, 21, 10), [(0, 0, 0), (0, 1, 0), (0, 1, 1), (1, 1, 1)]),
+    ],
+)
+def test_raised_orders_follow_the_cell_size(corner, kuhn):
+    """Two cut tetrahedra of h = 1/32 (Kuhn cubes of bench/cut3d.py's mesh) on the exact
+    zero set of the sphere R = 0.3 about its first shifted centre, against Gauss-Bonnet.
+    A fixed tolerance of 1e-6 reference units let area errors of 2.5e-7 and 2.4e-7 of
+    the cells' through (summed over the cut cells, a floor of the surface's relative
+    error); the tolerance of ``raise_tolerances``, which falls as ``(h kappa)^3`` on
+    cells finer than ``h kappa = 1/2``, leaves 1.2e-9 and 2.7e-9."""
+    vertices = (np.array(corner) + np.array(kuhn)) / 32.0
+    centre, radius = np.array([0.51990505, 0.50843083, 0.50128042]), 0.3
+    J = (vertices[1:] - vertices[0]).T
+
+    def exact(rows, X):
+        return np.linalg.norm(vertices[0] + X @ J.T - centre, axis=1) - radius
+
+    phi = exact(np.zeros(10, dtype=int), nodes())[None]
+    rules = p2_tet_cut_rules(
+        phi, 4, jacobian=lambda rows, X: np.broadcast_to(J, (rows.size, 3, 3)), exact=exact
+    )
+    area = rules.interface.weights.sum() * abs(np.linalg.det(J))
+    expected = sphere_area_in_polytope(centre, radius, tet_planes(vertices))
+    print(f"area error {area / expected - 1:.2e} of the cell's")
+    assert abs(area / expected - 1.0) <= 2e-8
 
 
 @pytest.mark.parametrize("frame", ["tetrahedron", "hexahedra"])

@@ -36,7 +36,7 @@ import numpy.typing as npt
 from xfem_contact.geometry.cut_topology import nodal_values
 from xfem_contact.geometry.exact_lines import ExactLevelSet
 from xfem_contact.geometry.exact_margin import exact_margin
-from xfem_contact.geometry.tensor_levelset import coefficients
+from xfem_contact.geometry.tensor_levelset import coefficients, derivative, gradient
 from xfem_contact.quadrature.rules import RuleSet
 from xfem_contact.quadrature.saye import (
     MAX_DEPTH,
@@ -46,9 +46,19 @@ from xfem_contact.quadrature.saye import (
     saye_points,
 )
 from xfem_contact.quadrature.surface_rules import Jacobian, surface_rules
-from xfem_contact.quadrature.tet_saye import RAISE_TOLERANCE, truncated_saye_points
+from xfem_contact.quadrature.tet_saye import truncated_saye_points
 
-__all__ = ["FRAMES", "HEXAHEDRA", "classify_p2_tets", "hexahedron_map", "p2_tet_cut_rules"]
+__all__ = [
+    "FRAMES",
+    "HEXAHEDRA",
+    "RAISE_POWER",
+    "RAISE_TOLERANCE",
+    "RESOLVED",
+    "classify_p2_tets",
+    "hexahedron_map",
+    "p2_tet_cut_rules",
+    "raise_tolerances",
+]
 
 
 def _subdivision() -> np.ndarray:
@@ -183,6 +193,73 @@ def _to_simplex_bernstein() -> np.ndarray:
     return T
 
 
+RAISE_TOLERANCE = 1e-6
+"""Default ``raise_tolerance`` of :func:`p2_tet_cut_rules`: the tolerance of coarse cells
+(reference units; see :func:`raise_tolerances`)."""
+
+RAISE_POWER = 3
+"""Power of the cell's resolution ``theta = h kappa`` in :func:`raise_tolerances`: the
+rules' change that a cell allows falls as ``h^3``, the order of a P2 interpolant's
+distance to the surface (``h^(k + 1)``)."""
+
+RESOLVED = 0.5
+"""Resolution ``theta = h kappa`` below which :func:`raise_tolerances` falls: cells of
+``theta >= RESOLVED`` keep ``raise_tolerance``."""
+
+ROUND_OFF = 1e-13
+"""Least tolerance of :func:`raise_tolerances` (reference units): nearly planar cells,
+whose rules change by round-off only, keep ``order`` points."""
+
+
+def raise_tolerances(
+    C: np.ndarray, J: np.ndarray | None, raise_tolerance: float
+) -> npt.NDArray[np.float64]:
+    """The change of a box's rules (interface area, side -1 volume; reference units)
+    between ``order - 1`` and ``order`` points above which it gets ``2 order`` points, per
+    cell: ``raise_tolerance min(1, theta / RESOLVED)^RAISE_POWER``, at least
+    :data:`ROUND_OFF`.
+
+    ``theta = h |D^2 phi| / |grad phi|`` at the cell's centroid (physical derivatives,
+    Frobenius and Euclidean norms; ``h`` the longest edge) is the cell's size against its
+    zero set's radius of curvature, of the order of ``h kappa``. A box's reference area
+    and volume are fractions of the cell's, so the rules' error that a tolerance lets
+    through is a share of each cell's area and volume, and summed over the cut cells a
+    share of the surface's:
+    a fixed tolerance bounds the relative error of the whole surface by a constant, which
+    stops its convergence (the rules' floor), while ``theta^3`` makes the bound fall as
+    ``h^3`` (the rules kept, of ``order`` points, err by less than the change from
+    ``order - 1`` that it bounds). Cells of ``theta >= RESOLVED`` (coarse against the
+    surface) keep ``raise_tolerance``.
+
+    Args:
+        C: Monomial coefficients ``(ncells, 3, 3, 3)`` in the reference tetrahedron.
+        J: Affine Jacobians ``(ncells, 3, 3)`` of the cells (at their centroids), or
+            ``None`` (reference cells).
+        raise_tolerance: The tolerance of cells of ``theta >= RESOLVED``, ``>= 0``.
+
+    Returns:
+        Shape ``(ncells,)``.
+    """
+    n = C.shape[0]
+    centroid = np.full((n, 3), 0.25)
+    slope = gradient(C, centroid)
+    hessian = np.stack(
+        [gradient(derivative(C, a), centroid) for a in range(3)], axis=1
+    )  # [n, a, b]
+    if J is None:
+        J = np.broadcast_to(np.eye(3), (n, 3, 3))
+    inverse = np.linalg.inv(J)
+    slope = np.einsum("nji,nj->ni", inverse, slope)  # J^-T grad
+    hessian = np.einsum("nki,nkl,nlj->nij", inverse, hessian, inverse)
+    edges = np.concatenate([J, J[:, :, [1, 2, 2]] - J[:, :, [0, 0, 1]]], axis=2)
+    h = np.linalg.norm(edges, axis=1).max(axis=1)
+    curved = h * np.linalg.norm(hessian, axis=(1, 2))
+    length = np.linalg.norm(slope, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        scale = np.where(curved < RESOLVED * length, curved / (RESOLVED * length), 1.0)
+    return np.maximum(raise_tolerance * scale**RAISE_POWER, ROUND_OFF)
+
+
 FRAMES = ("tetrahedron", "hexahedra")
 """Where :func:`p2_tet_cut_rules` runs Saye's algorithm: on boxes of the reference
 tetrahedron itself (:mod:`~xfem_contact.quadrature.tet_saye`), or on the four hexahedra."""
@@ -212,12 +289,14 @@ def p2_tet_cut_rules(
             tetrahedron (exact for planes), a cell left unresolved at ``max_depth`` going
             to the hexahedra; ``"hexahedra"``: on the four hexahedra of every cell.
         raise_tolerance: In the tetrahedron's frame, a cut box whose rules with
-            ``order - 1`` points per interval differ from ``order``'s by more than this
-            (interface area or side -1 volume, reference units) gets ``2 order`` points
+            ``order - 1`` points per interval differ from ``order``'s by more than its
+            cell's :func:`raise_tolerances` of this (interface area or side -1 volume,
+            reference units) gets ``2 order`` points
             (:func:`~xfem_contact.quadrature.tet_saye.truncated_saye_points`); ``None``:
             ``order`` everywhere. Not used on the hexahedra.
-        jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule;
-            ``None``: reference cells.
+        jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule
+            (and, at the centroids, for :func:`raise_tolerances`); ``None``: reference
+            cells.
         exact: ``(rows, X) -> (m,)``: the level set that ``phi`` interpolates, at points
             ``X`` ``(m, 3)`` of the reference tetrahedron of cells ``rows``; the rules
             then follow its zero set (as
@@ -237,6 +316,8 @@ def p2_tet_cut_rules(
     """
     if frame not in FRAMES:
         raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
+    if raise_tolerance is not None and not raise_tolerance >= 0:
+        raise ValueError(f"raise_tolerance must be >= 0 or None, got {raise_tolerance!r}")
     phi = nodal_values(phi, 10, "P2 tetrahedron", "tetrahedron")
     ncells = phi.shape[0]
     merged = {
@@ -254,12 +335,19 @@ def p2_tet_cut_rules(
         on_chunk = None if exact is None else _from_row(exact, start)
         margin = None if exact is None else exact_margin(chunk, on_chunk)
         if frame == "tetrahedron":
+            C = _tet_coefficients(chunk)
+            tolerance = None
+            if raise_tolerance is not None:
+                J = None
+                if jacobian is not None:
+                    J = jacobian(np.arange(start, start + size), np.full((size, 3), 0.25))
+                tolerance = raise_tolerances(C, J, raise_tolerance)
             points, rest = truncated_saye_points(
-                _tet_coefficients(chunk),
+                C,
                 order,
                 max_depth=max_depth,
                 min_depth=min_depth,
-                raise_tolerance=raise_tolerance,
+                raise_tolerance=tolerance,
                 exact=on_chunk,
                 margin=margin,
             )

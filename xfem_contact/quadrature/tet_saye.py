@@ -28,8 +28,8 @@ the tensor machinery of :mod:`xfem_contact.geometry.tensor_levelset` applies unc
    do not change a rule.
 
 4. Raised orders: the rules of every cut box are also computed with ``order - 1`` points
-   per interval, and a box whose interface area or side -1 volume moves by more than
-   :data:`RAISE_TOLERANCE` (reference units) between the two gets ``2 order`` points.
+   per interval, and a box whose interface area or side -1 volume moves by more than its
+   cell's ``raise_tolerance`` (reference units) between the two gets ``2 order`` points.
    These are the boxes near branch points of the roots (high curvature of the zero set
    in the cell, shallow slopes), where Gauss rules converge slowly; elsewhere the rules
    keep ``order`` points. A raised box whose rules still move by more than
@@ -89,7 +89,7 @@ from xfem_contact.quadrature.saye import (
 from xfem_contact.quadrature.saye_axes import PAIRS
 from xfem_contact.quadrature.tet_saye_axes import CURVED_DEPTH, curved_boxes, truncated_axes
 
-__all__ = ["MIN_SLOPE", "RAISE_TOLERANCE", "truncated_saye_points"]
+__all__ = ["MIN_SLOPE", "truncated_saye_points"]
 
 MIN_SLOPE = 0.2
 """Boxes inside the tetrahedron whose best pair of axes scores below this are subdivided,
@@ -99,19 +99,13 @@ here, where the boxes are those of a sixth of a cube and
 curved ones too."""
 
 
-RAISE_TOLERANCE = 1e-6
-"""Default ``raise_tolerance`` of :func:`truncated_saye_points`: a cut box whose rules'
-interface area or side -1 volume (reference units) changes by more than this between
-``order - 1`` and ``order`` points per interval gets rules of ``2 order`` points."""
-
-
 def truncated_saye_points(
     C: np.ndarray,
     order: int,
     *,
     max_depth: int,
     min_depth: int = 0,
-    raise_tolerance: float | None = RAISE_TOLERANCE,
+    raise_tolerance: float | np.ndarray | None = None,
     exact: ExactLevelSet | None = None,
     margin: np.ndarray | None = None,
 ) -> tuple[SayePoints, np.ndarray]:
@@ -125,9 +119,10 @@ def truncated_saye_points(
         min_depth: Levels of boxes subdivided whenever the interface may cross them.
         raise_tolerance: The rules of each cut box are also computed with
             ``max(1, order - 1)`` points per interval; a box whose interface area or side
-            -1 volume (reference units) differs between the two by more than this gets
-            rules of ``2 order`` points instead (where the roots' branch points are close
-            to the box, the rules converge slowly). ``None``: ``order`` everywhere.
+            -1 volume (reference units) differs between the two by more than this (one
+            value, or one per cell ``(ncells,)``) gets rules of ``2 order`` points instead
+            (where the roots' branch points are close to the box, the rules converge
+            slowly). ``None``: ``order`` everywhere.
         exact: ``(rows, X) -> (m,)``: the level set that ``C`` interpolates, at points
             ``X`` ``(m, 3)`` of the reference tetrahedron of cells ``rows``; the boxes and
             axes stay ``C``'s, but the breakpoints of every line are its roots near
@@ -151,9 +146,12 @@ def truncated_saye_points(
         ValueError: Bad ``order``, ``max_depth`` or ``min_depth``.
     """
     check_parameters(order, max_depth, min_depth)
-    if raise_tolerance is not None and not raise_tolerance >= 0:
-        raise ValueError(f"raise_tolerance must be >= 0 or None, got {raise_tolerance!r}")
     ncells = C.shape[0]
+    tolerance = None
+    if raise_tolerance is not None:
+        tolerance = np.broadcast_to(np.asarray(raise_tolerance, dtype=np.float64), (ncells,))
+        if not (tolerance >= 0).all():
+            raise ValueError(f"raise_tolerance must be >= 0 or None, got {raise_tolerance!r}")
     gauss = _gauss(order)
     parts: dict[str, list[tuple[np.ndarray, ...]]] = {"minus": [], "plus": [], "interface": []}
     unresolved, reduced = [], []
@@ -196,7 +194,8 @@ def truncated_saye_points(
             if group.size:
                 box = (cell[group], lo[group], hi[group], k3, k2)
                 split = depth < max_depth
-                moving = _raised_rules(C, box, order, parts, raise_tolerance, exact, split)
+                allowed = None if tolerance is None else tolerance[box[0]]
+                moving = _raised_rules(C, box, order, parts, allowed, exact, split)
                 unsettled.append(group[moving])
         subdivided = pair < 0
         if unsettled:
@@ -229,7 +228,8 @@ def _gauss(order: int) -> tuple[np.ndarray, np.ndarray]:
 def _raised_rules(C, box, order, parts, tolerance, exact, split):
     """Nested rules of the cut truncated boxes ``box = (cell, lo, hi, k3, k2)`` with
     ``order`` points per interval, and ``2 order`` in the boxes whose rules move by more
-    than ``tolerance`` from ``max(1, order - 1)`` points (see :func:`truncated_saye_points`),
+    than ``tolerance`` ``(m,)`` from ``max(1, order - 1)`` points (see
+    :func:`truncated_saye_points`),
     appended to ``parts``. With ``split``, a raised box whose rules still move by more
     than ``tolerance`` from ``order`` to ``2 order`` points (Gauss rules converging
     slowly: a branch point of the roots in or near the box) gets no rules; the mask
@@ -262,7 +262,7 @@ def _raised_rules(C, box, order, parts, tolerance, exact, split):
             r = raised.size
             for measure in (_box_areas, _box_volumes):
                 change = np.abs(measure(fine, r) - measure(found, m)[raised])
-                unsettled[raised] |= change > tolerance
+                unsettled[raised] |= change > tolerance[raised]
         keep_fine = ~unsettled[raised]
         for side, pieces in fine.items():
             for rows, *columns in pieces:
