@@ -323,7 +323,9 @@ def plot(rows: list[dict], path: pathlib.Path) -> None:
             )
             ax.set_xlabel(label)
             ax.set_title(case, fontsize=10)
-            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+            ax.xaxis.set_minor_locator(matplotlib.ticker.LogLocator(subs=(2.0, 5.0)))
+            for axis in (ax.xaxis.set_major_formatter, ax.xaxis.set_minor_formatter):
+                axis(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
             ax.grid(True, which="both", alpha=0.3)
         row_axes[0].set_ylabel("relative L2 error of the contact pressure")
     handles, labels = axes[0][0].get_legend_handles_labels()
@@ -335,14 +337,14 @@ def plot(rows: list[dict], path: pathlib.Path) -> None:
 
 
 def winners(chosen: list[dict], key: str) -> list[tuple[float, str]]:
-    """At the cost ``key`` of each body-fitted run, which route has reached the lower
-    error: the ``(budget, method)`` changes."""
+    """At the cost ``key`` of each run, which route has reached the lower error within
+    it: the ``(budget, method)`` changes."""
     fit = [r for r in chosen if r["method"] == FIT]
     xf = [r for r in chosen if r["method"] == X]
     out = []
-    for budget in sorted(r[key] for r in fit):
+    for budget in sorted(r[key] for r in chosen):
         a = min((r["error"] for r in xf if r[key] <= budget), default=math.inf)
-        b = min(r["error"] for r in fit if r[key] <= budget)
+        b = min((r["error"] for r in fit if r[key] <= budget), default=math.inf)
         winner = X if a < b else FIT
         if not out or out[-1][1] != winner:
             out.append((budget, winner))
@@ -385,8 +387,15 @@ def summary(rows: list[dict]) -> list[str]:
     return lines + [""] + said
 
 
+def ordered(rows: list[dict]) -> list[dict]:
+    """The rows by case, sweep (as :data:`SWEEPS`) and dofs."""
+    order = {(c, s[1]): (i, j) for i, c in enumerate(CASES) for j, s in enumerate(SWEEPS)}
+    return sorted(rows, key=lambda r: (*order[(r["case"], r["option"])], r["dofs"]))
+
+
 def publish(rows: list[dict], out: pathlib.Path, command: str) -> str:
     """The plot and the markdown beside ``out``; returns the markdown."""
+    rows = ordered(rows)
     plot(rows, out.with_suffix(".png"))
     loads = [r["load"] for r in rows]
     lines = [
@@ -483,8 +492,7 @@ def main():
                 )
                 out.parent.mkdir(parents=True, exist_ok=True)  # a long run keeps its rows
                 out.write_text(json.dumps({"command": command, "rows": rows}, indent=1))
-    order = {(c, s[1]): (i, j) for i, c in enumerate(CASES) for j, s in enumerate(SWEEPS)}
-    rows.sort(key=lambda r: (*order[(r["case"], r["option"])], r["size"]))
+    rows = ordered(rows)
     out.write_text(json.dumps({"command": command, "rows": rows}, indent=1))
     print(publish(rows, out, command))
 
