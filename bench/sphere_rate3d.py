@@ -13,7 +13,7 @@ and largest error over the centres, and the rates of the means.
 
 Run: ``python bench/sphere_rate3d.py [--sizes 4 8 12 16] [--centres 5] [--seed 0]
 [--solver iterative] [--write]``; ``--write`` writes ``bench/results/sphere_rate3d.{json,md}``;
-``--report-only`` redoes the page from the JSON.
+``--report-only`` rewrites the page from the JSON.
 """
 
 import argparse
@@ -126,13 +126,16 @@ def markdown(record: dict) -> str:
             f"| {s['geometric']:.3e} | {'-' if b is None else f'{b:.2f}'} | {s['min']:.3e} | "
             f"{s['max']:.3e} | {s['max'] / s['min']:.1f} |"
         )
-    first, last = sizes[0], sizes[-1]
-    fit = np.polyfit(np.log(sizes), np.log([s["mean"] for s in stats]), 1)[0]
+    if len(sizes) > 1:
+        first, last = sizes[0], sizes[-1]
+        fit = np.polyfit(np.log(sizes), np.log([s["mean"] for s in stats]), 1)[0]
+        lines += [
+            "",
+            f"Least-squares rate of the mean over n = {', '.join(map(str, sizes))}: "
+            f"{-fit:.2f}; from n = {first} to {last}: "
+            f"{rates([first, last], [stats[0]['mean'], stats[-1]['mean']])[0]:.2f}.",
+        ]
     lines += [
-        "",
-        f"Least-squares rate of the mean over n = {fmt(sizes).replace('.00', '')}: "
-        f"{-fit:.2f}; from n = {first} to {last}: "
-        f"{rates([first, last], [stats[0]['mean'], stats[-1]['mean']])[0]:.2f}.",
         "",
         "Per centre (pressure error; the rates between consecutive sizes):",
         "",
@@ -188,7 +191,9 @@ def main() -> None:
         return
     path = RESULTS / f"{args.name}.json"
     if args.report_only:
-        print(markdown(json.loads(path.read_text())))
+        text = markdown(json.loads(path.read_text()))
+        path.with_suffix(".md").write_text(text)
+        print(text)
         return
     command = shlex.join(["python", "bench/sphere_rate3d.py", *sys.argv[1:]])
     record = {"command": command, "sizes": args.sizes, "seed": args.seed, "solver": args.solver}
