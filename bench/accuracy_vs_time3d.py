@@ -2,15 +2,13 @@
 concentric spheres against whole-process time and peak memory, X-FEM against the
 body-fitted route, measured in the same run.
 
-The cases (:mod:`xfem_contact.cases.solid`, SI units):
-
-- ``sticking sphere``: :func:`~xfem_contact.cases.solid.sphere_problem`, a sphere
-  R = 0.2 m in the unit cube, one material, triaxial pressures -1/-2/-3 Pa, ``sticking``;
-  the exact contact pressure is ``n.sigma.n`` of the uniform stress.
-- ``concentric spheres``: :func:`~xfem_contact.cases.solid.composite_sphere_problem`, a
-  ball R = 0.35 m of another material in the cube, ``frictionless``, the cube's boundary
-  held by the exact radial field (3D Lame, hydrostatic compression); the exact contact
-  pressure is uniform.
+The cases (:mod:`xfem_contact.cases.solid`, SI units): the ``sticking sphere``
+(:func:`~xfem_contact.cases.solid.sphere_problem`, R = 0.2 m in the unit cube, one
+material, triaxial pressures -1/-2/-3 Pa, ``sticking``: the exact contact pressure is
+``n.sigma.n`` of the uniform stress) and the ``concentric spheres``
+(:func:`~xfem_contact.cases.solid.composite_sphere_problem`, a ball R = 0.35 m of another
+material in the cube, ``frictionless``, the cube's boundary held by the exact radial field
+of 3D Lame under hydrostatic compression: a uniform exact contact pressure).
 
 X-FEM's level set is the one a user has: the signed distance of the sphere, interpolated
 in P2 (``levelset="distance"``), so the interface and its normal are approximations of
