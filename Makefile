@@ -91,6 +91,7 @@ bench: $(VENV)/.installed bytecode
 	$(PY) bench/cut3d_assembly.py --sizes 16 --quadrature-degrees 2 4 6
 	$(PY) bench/scale3d.py --sizes 4 8 --direct-max 8
 	$(PY) bench/accuracy_vs_time3d.py --quick --out bench/results/accuracy_vs_time3d_quick.json
+	$(PY) bench/sphere_rate3d.py --sizes 4 8 12 16 --centres 5 --write
 	$(PY) bench/robustness3d.py --write
 	@if test -x $(PEER_PY); then $(PY) bench/peer_cut3d.py --peer-python $(PEER_PY); \
 	else echo "skipped bench/peer_cut3d.py (the ngsxfem peer): 'make bench-peer' creates $(PEER_VENV) and runs it"; fi
