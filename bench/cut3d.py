@@ -39,8 +39,9 @@ splits every box of the P2 tetrahedra that the interface may cross before Saye's
 truncated boxes of the tetrahedron itself
 (:func:`~xfem_contact.quadrature.curved_tet_rules.p2_tet_cut_rules`), and
 ``--raise-tolerance T`` (``off``: none) sets the tetrahedron frame's raised orders (the
-tolerance of cells coarse against the surface, scaled by ``(2 h kappa)^3`` below
-``h kappa = 1/2``, :func:`~xfem_contact.quadrature.curved_tet_rules.raise_tolerances`). With
+tolerance; on exact zero sets that of cells coarse against the surface, scaled by
+``(2 h kappa)^3`` below ``h kappa = 1/2``,
+:func:`~xfem_contact.quadrature.curved_tet_rules.raise_tolerances`). With
 ``--centres K`` each rate of the means gets a 95 % bootstrap interval over the centres.
 
 The fuzz (``--fuzz N``) cuts ``N`` reference cells per kind by random spheres, ellipsoids,
@@ -709,7 +710,8 @@ def main() -> None:
         default=curved_tet_rules.RAISE_TOLERANCE,
         metavar="T",
         help="P2 tetrahedra (tetrahedron frame): boxes whose rules move by more than T "
-        "(times (2 h kappa)^3 where h kappa < 1/2) between order - 1 and order get 2 order "
+        "(on exact zero sets: times (2 h kappa)^3 where h kappa < 1/2) between order - 1 and "
+        "order get 2 order "
         "points ('off': never; p2_tet_cut_rules "
         f"raise_tolerance, default {curved_tet_rules.RAISE_TOLERANCE:g})",
     )

@@ -290,10 +290,16 @@ def p2_tet_cut_rules(
             to the hexahedra; ``"hexahedra"``: on the four hexahedra of every cell.
         raise_tolerance: In the tetrahedron's frame, a cut box whose rules with
             ``order - 1`` points per interval differ from ``order``'s by more than its
-            cell's :func:`raise_tolerances` of this (interface area or side -1 volume,
-            reference units) gets ``2 order`` points
+            tolerance (interface area or side -1 volume, reference units) gets ``2
+            order`` points
             (:func:`~xfem_contact.quadrature.tet_saye.truncated_saye_points`); ``None``:
-            ``order`` everywhere. Not used on the hexahedra.
+            ``order`` everywhere. Not used on the hexahedra. The tolerance is this on
+            every cell when the rules follow ``phi``'s zero set, and each cell's
+            :func:`raise_tolerances` of this on an ``exact`` one: there the rules are
+            the only approximation of the surface, so their error must fall with ``h``;
+            an interpolant's zero set is itself ``O(h^3)`` from the surface it samples,
+            and the rules' floor under the fixed tolerance lies below that on the meshes
+            measured (docs' 3D geometry page).
         jacobian: ``(rows, X) -> (m, 3, 3)`` parent Jacobians for the interface rule
             (and, at the centroids, for :func:`raise_tolerances`); ``None``: reference
             cells.
@@ -336,8 +342,8 @@ def p2_tet_cut_rules(
         margin = None if exact is None else exact_margin(chunk, on_chunk)
         if frame == "tetrahedron":
             C = _tet_coefficients(chunk)
-            tolerance = None
-            if raise_tolerance is not None:
+            tolerance = raise_tolerance
+            if raise_tolerance is not None and exact is not None:
                 J = None
                 if jacobian is not None:
                     J = jacobian(np.arange(start, start + size), np.full((size, 3), 0.25))
