@@ -106,19 +106,14 @@ def held_sphere(n, law, **options):
 
 def test_friction_limits_on_the_sphere():
     """Under triaxial compression, spins held: mu = 1e3 is the sticking law's solution
-    to round-off; mu = 0 tends to the frictionless law's with h (the Cartesian
-    multiplier of Coulomb with no tangential part and the scalar one of the frictionless
-    law are two discretisations: max lambda_n difference 0.29, 0.23, 0.10 of max
-    |lambda_n| at n = 2, 4, 8, P1; bench/sphere_friction.py)."""
+    to round-off on a curved interface (the tangent frame turns from cell to cell). The
+    limit mu -> 0 is checked on an exact solution in tests/test_friction_limits3d.py; on
+    the sphere the Cartesian multiplier of Coulomb with no tangential part and the
+    scalar one of the frictionless law are two discretisations of the pressure, which
+    differ by the discretisation error (``python bench/sphere_friction.py --limits``,
+    ``bench/friction_limits3d.py``)."""
     sticking, coulomb = held_sphere(2, "sticking"), held_sphere(2, "coulomb", friction=1e3)
     assert np.abs(coulomb - sticking).max() < 1e-10 * np.abs(sticking).max()
-    differences = []
-    for n in (2, 4):
-        frictionless = held_sphere(n, "frictionless")
-        slipping = held_sphere(n, "coulomb", friction=0.0)
-        differences.append(np.abs(slipping - frictionless).max() / np.abs(frictionless).max())
-    print(f"\nmu = 0 against frictionless, n = 2, 4: {differences}")
-    assert differences[1] < differences[0] < 0.35
 
 
 @pytest.mark.mpi
