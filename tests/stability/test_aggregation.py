@@ -188,13 +188,34 @@ def test_a_prescribed_dof_is_never_a_source():
     bench = _bench()
     n = 8
     mesh = dolfinx.mesh.create_unit_square(MPI.COMM_SELF, n, n, dolfinx.mesh.CellType.triangle)
-    tip, angle = (0.36690109962184747, 0.6252202990915117), 1.3661707578174123
+    tip, angle = GENERIC_CRACK
     C = {}
     for threshold in (None, THRESHOLD):
         problem = bench.free_crack(mesh, tip, angle, 1, 0.0, threshold)
         C[threshold] = bench.scaled_condition(problem) / n**2
     print(f"C = cond h^2: {C[THRESHOLD]:.3e} with aggregation, {C[None]:.3e} without")
     assert C[THRESHOLD] <= CONDITION_FACTOR * C[None], C
+
+
+#: A generic crack of the unit square (tip, angle in rad)
+GENERIC_CRACK = ((0.36690109962184747, 0.6252202990915117), 1.3661707578174123)
+
+
+def sliver_and_generic_conditions(cell: str, sliver) -> dict[str, float]:
+    """``C = cond h^2`` of the scaled matrix of a free P2 crack on an 8 x 8 unit square of
+    ``cell``s with aggregation, for the crack ``sliver`` (tip, angle) and for
+    :data:`GENERIC_CRACK` (keys ``"sliver"``, ``"generic"``)."""
+    import dolfinx.mesh
+
+    bench = _bench()
+    n = 8
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_SELF, n, n, dolfinx.mesh.CellType[cell])
+    C = {}
+    for name, (tip, angle) in {"generic": GENERIC_CRACK, "sliver": sliver}.items():
+        problem = bench.free_crack(mesh, tip, angle, 2, 0.0, THRESHOLD)
+        C[name] = bench.scaled_condition(problem) / n**2
+    print(f"C = cond h^2: {C['sliver']:.3e} at the sliver, {C['generic']:.3e} generic")
+    return C
 
 
 @pytest.mark.serial
@@ -205,19 +226,9 @@ def test_a_sliver_next_to_a_crack_tip_is_aggregated(cell):
     dofs) left one side's untied dofs with nothing else in their support. With those
     cells badly cut, C = cond h^2 is 36 (triangles) and 1.2e3 (quadrilaterals), against
     3.1e2 and 1.5e4 for a generic crack; when they could not be, 1.9e8 and 1.5e15."""
-    import dolfinx.mesh
-
-    bench = _bench()
-    n = 8
-    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_SELF, n, n, dolfinx.mesh.CellType[cell])
-    C = {}
-    for name, (tip, angle) in {
-        "generic": ((0.36690109962184747, 0.6252202990915117), 1.3661707578174123),
-        "sliver": ((0.4814421159654495, 0.43063914096601846), 1.6732139876157714),
-    }.items():
-        problem = bench.free_crack(mesh, tip, angle, 2, 0.0, THRESHOLD)
-        C[name] = bench.scaled_condition(problem) / n**2
-    print(f"C = cond h^2: {C['sliver']:.3e} at the sliver, {C['generic']:.3e} generic")
+    C = sliver_and_generic_conditions(
+        cell, ((0.4814421159654495, 0.43063914096601846), 1.6732139876157714)
+    )
     assert C["sliver"] <= CONDITION_FACTOR * C["generic"], C
 
 
@@ -311,24 +322,8 @@ def test_a_boundary_sliver_is_aggregated(cell):
     slivers whose roots hold Dirichlet dofs. Extended with the prescribed part apart, C =
     cond h^2 is 28 (triangles) and 7.6e2 (quadrilaterals), against 3.1e2 and 1.5e4 for
     a generic crack; while those dofs stayed unknowns, 3.1e7 and 1.3e8."""
-    import dolfinx.mesh
-
-    bench = _bench()
-    n = 8
-    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_SELF, n, n, dolfinx.mesh.CellType[cell])
-    C = {}
-    for name, (tip, angle) in {
-        "generic": ((0.36690109962184747, 0.6252202990915117), 1.3661707578174123),
-        "sliver": BOUNDARY_SLIVER,
-    }.items():
-        problem = bench.free_crack(mesh, tip, angle, 2, 0.0, THRESHOLD)
-        C[name] = bench.scaled_condition(problem) / n**2
-    print(f"C = cond h^2: {C['sliver']:.3e} at the sliver, {C['generic']:.3e} generic")
+    C = sliver_and_generic_conditions(cell, BOUNDARY_SLIVER)
     assert C["sliver"] <= CONDITION_FACTOR * C["generic"], C
-
-
-#: A generic crack of the unit square (tip, angle in rad)
-GENERIC_CRACK = ((0.36690109962184747, 0.6252202990915117), 1.3661707578174123)
 
 
 @pytest.mark.serial
