@@ -3,6 +3,7 @@
 import dolfinx.fem
 import numpy as np
 import ufl
+from mpi4py import MPI
 
 
 def _by_position(points: np.ndarray) -> np.ndarray:
@@ -68,3 +69,15 @@ def max_relative_difference(a: dict, b: dict) -> dict[str, float]:
         "u": max(np.abs(b["u_minus"]).max(), np.abs(b["u_plus"]).max()),
     }
     return {k: float(np.abs(a[k] - b[k]).max() / scales[k.split("_")[0]]) for k in b}
+
+
+def all_ranks_against_one(build) -> dict[str, float]:
+    """:func:`max_relative_difference` of the problem ``build(comm)`` solved on all
+    processes against the same problem solved on each process alone
+    (``MPI.COMM_SELF``), the fields gathered and sorted by position. Collective."""
+    fields = []
+    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+        problem = build(comm)
+        problem.solve()
+        fields.append(gathered_fields(problem))
+    return max_relative_difference(*fields)

@@ -7,7 +7,7 @@ import xfem_contact  # noqa: F401
 # isort: split
 import pytest
 from mpi4py import MPI
-from parallel import gathered_fields, max_relative_difference
+from parallel import all_ranks_against_one
 
 from xfem_contact.cases.paper import annulus_problem, inclusion_problem
 from xfem_contact.cases.rotation import rotating_annulus_problem
@@ -68,12 +68,7 @@ TOLERANCE = 1e-10
 
 @pytest.mark.parametrize("case", list(CASES))
 def test_fields_equal_serial(case):
-    fields = []
-    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
-        problem = CASES[case](comm)
-        problem.solve()
-        fields.append(gathered_fields(problem))
-    differences = max_relative_difference(*fields)
+    differences = all_ranks_against_one(CASES[case])
     if MPI.COMM_WORLD.rank == 0:
         print(case, {k: f"{v:.1e}" for k, v in differences.items()})
     assert all(v <= TOLERANCE for v in differences.values()), differences

@@ -16,7 +16,7 @@ import dolfinx.mesh
 import numpy as np
 import pytest
 from mpi4py import MPI
-from parallel import gathered_fields, max_relative_difference
+from parallel import all_ranks_against_one
 from test_multiplier_degree import assert_p2_restriction_is_p1s
 from test_scenes_3d import solved, sphere_scene
 
@@ -138,13 +138,13 @@ def test_tetrahedra_take_the_nearer_end(monkeypatch):
 def test_the_restricted_sphere_on_unstructured_tetrahedra_parallel_equals_serial():
     """The sticking sphere with the restriction on gmsh's cube (P1, h = 0.2; gmsh meshes
     on one rank, the mesh is the same): its fields gathered by position, 2 ranks = 1."""
-    fields = []
-    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
+
+    def build(comm):
         mesh = unstructured_cube(0.2, comm)
         problem = sphere_problem(None, 1, "sticking", comm=comm, mesh=mesh, lbb="restriction")
-        problem.solve()
-        fields.append(gathered_fields(problem))
-    for name, difference in max_relative_difference(*fields).items():
+        return problem
+
+    for name, difference in all_ranks_against_one(build).items():
         assert difference < 1e-10, (name, difference)
 
 
@@ -153,10 +153,7 @@ def test_the_restricted_sphere_on_unstructured_tetrahedra_parallel_equals_serial
 def test_the_restricted_sphere_parallel_equals_serial():
     """The sticking sphere with the restriction (P1, n = 6): its fields gathered by
     position, 2 ranks = 1 rank."""
-    fields = []
-    for comm in (MPI.COMM_WORLD, MPI.COMM_SELF):
-        problem = sphere_problem(6, 1, "sticking", comm=comm, lbb="restriction")
-        problem.solve()
-        fields.append(gathered_fields(problem))
-    for name, difference in max_relative_difference(*fields).items():
+    for name, difference in all_ranks_against_one(
+        lambda comm: sphere_problem(6, 1, "sticking", comm=comm, lbb="restriction")
+    ).items():
         assert difference < 1e-10, (name, difference)
