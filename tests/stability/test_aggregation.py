@@ -445,3 +445,19 @@ def test_a_root_is_never_a_tip_cell():
     kinds = sorted(set(kind[list(roots)].tolist()))
     print(f"{aggregation.dofs.size} constrained dofs, roots of the kinds {kinds}")
     assert roots and all(kind[r] == CROSSED for r in roots)
+
+
+@pytest.mark.mpi
+def test_aggregated_gathered_crack_is_the_same_on_one_and_two_ranks():
+    """The Williams case of the rate test (Q2, gathered dofs, their ramp of degree 2,
+    aggregation 0.25, n = 16) gives the same energy error on one process and on all."""
+    from xfem_contact.cases.cracks import williams_case, williams_energy_error
+
+    def error(comm):
+        case = williams_case(16, 2, tip_radius=0.5, comm=comm, **WILLIAMS)
+        case.problem.solve()
+        return williams_energy_error(case)
+
+    everywhere, alone = error(MPI.COMM_WORLD), error(MPI.COMM_SELF)
+    print(f"energy error {everywhere:.10e} ({alone:.10e} on one process)")
+    assert abs(everywhere - alone) <= 1e-8 * alone
