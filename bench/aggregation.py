@@ -47,7 +47,8 @@ its rate and the condition number of the matrix the solver factors (tip-transfor
 ``bench/crack_convergence.py``'s estimate, n <= 64).
 
 Part ``tip_dofs``: the Williams crack (r_e = 0.3) on ``--elements`` and ``--sizes``
-with nodal and gathered branch dofs (``tip_dofs``, :mod:`xfem_contact.fem.tip_dofs`):
+with nodal and gathered branch dofs (``tip_dofs``, :mod:`xfem_contact.fem.tip_dofs`),
+for each of ``--treatments`` without a ghost penalty (``none``, ``aggregation 0.25``):
 energy errors and rates. ``--tip-dofs gathered`` gathers the cracks' branch dofs in the
 ``crack_conditioning`` part (written to ``..._gathered``).
 
@@ -72,6 +73,7 @@ import xfem_contact  # noqa: E402, F401  (before dolfinx)
 
 # isort: split
 import argparse
+import itertools
 import json
 import math
 import pathlib
@@ -357,32 +359,37 @@ def crack() -> None:
 def tip_dofs(args) -> None:
     """The tip_dofs part (module docstring): prints and writes a Markdown table."""
     elements = [(e.split(":")[0], int(e.split(":")[1])) for e in args.elements]
+    # the Williams case has no ghost penalty: the treatments without one
+    thresholds = {t: TREATMENTS[t][1] for t in args.treatments if TREATMENTS[t][0] == 0.0}
     lines = [
-        "| element | tip dofs | " + " | ".join(f"n = {n}" for n in args.sizes) + " | rates |",
-        "|---|---|" + "---|" * len(args.sizes) + "---|",
+        "| element | tip dofs | treatment | "
+        + " | ".join(f"n = {n}" for n in args.sizes)
+        + " | rates |",
+        "|---|---|---|" + "---|" * len(args.sizes) + "---|",
     ]
-    for cell, degree in elements:
-        for dofs in ("nodal", "gathered"):
-            errors = []
-            for n in args.sizes:
-                case = williams_case(n, degree, tip_radius=0.3, cell=cell, tip_dofs=dofs)
-                case.problem.solve()
-                errors.append(williams_energy_error(case))
-                note(f"{cell} P{degree} {dofs} n = {n}: energy error {errors[-1]:.3e}")
-            rates = [
-                math.log(e0 / e1) / math.log(n1 / n0)
-                for e0, e1, n0, n1 in zip(
-                    errors, errors[1:], args.sizes, args.sizes[1:], strict=False
-                )
-            ]
-            lines.append(
-                f"| {cell} P{degree} | {dofs} | "
-                + " | ".join(f"{e:.3e}" for e in errors)
-                + " | "
-                + ", ".join(f"{r:.2f}" for r in rates)
-                + " |"
+    for (cell, degree), dofs, (label, threshold) in itertools.product(
+        elements, ("nodal", "gathered"), thresholds.items()
+    ):
+        errors = []
+        for n in args.sizes:
+            case = williams_case(
+                n, degree, tip_radius=0.3, cell=cell, tip_dofs=dofs, aggregation=threshold
             )
-            note(lines[-1])
+            case.problem.solve()
+            errors.append(williams_energy_error(case))
+            note(f"{cell} P{degree} {dofs} {label} n = {n}: energy error {errors[-1]:.3e}")
+        rates = [
+            math.log(e0 / e1) / math.log(n1 / n0)
+            for e0, e1, n0, n1 in zip(errors, errors[1:], args.sizes, args.sizes[1:], strict=False)
+        ]
+        lines.append(
+            f"| {cell} P{degree} | {dofs} | {label} | "
+            + " | ".join(f"{e:.3e}" for e in errors)
+            + " | "
+            + ", ".join(f"{r:.2f}" for r in rates)
+            + " |"
+        )
+        note(lines[-1])
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / f"{args.name or 'aggregation_tip_dofs'}.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))

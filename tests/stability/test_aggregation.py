@@ -390,3 +390,74 @@ def test_tip_dofs_are_checked():
         checked_tip_dofs("grouped", 0.3)
     with pytest.raises(ValueError, match="needs a tip radius"):
         checked_tip_dofs("gathered", None)
+
+
+#: The Williams case of the aggregation tests: Q2, gathered branch dofs, r_e = 0.5 (m)
+WILLIAMS = {"cell": "quadrilateral", "tip_dofs": "gathered", "aggregation": THRESHOLD}
+
+
+@pytest.mark.serial
+def test_aggregation_keeps_the_williams_rate():
+    """Gathered branch dofs with aggregation 0.25 (Q2, r_e = 0.5): energy error 1.80e-2,
+    4.88e-3 at n = 16, 32 (rate 1.89). With the cut-off's interpolant of degree 1 for a
+    ramp, whose slope jumps across the edges a root's polynomial is extended over,
+    1.46e-2, 6.79e-3 (rate 1.11; 1.61e-3 at n = 128 with r_e = 0.3, against 2.08e-3 at
+    n = 64)."""
+    from xfem_contact.cases.cracks import williams_case, williams_energy_error
+
+    errors = []
+    for n in (16, 32):
+        case = williams_case(n, 2, tip_radius=0.5, comm=MPI.COMM_SELF, **WILLIAMS)
+        case.problem.solve()
+        errors.append(williams_energy_error(case))
+    rate = np.log2(errors[0] / errors[1])
+    print(f"energy error {errors[0]:.3e}, {errors[1]:.3e}: rate {rate:.2f}")
+    assert rate >= 1.8, errors
+
+
+@pytest.mark.serial
+def test_a_root_is_never_a_tip_cell():
+    """A crack's tip cells and the cells its extension cuts share their two sides' dofs:
+    the side polynomial of one is the other side's too, and extended across the crack it
+    would erase the jump. The roots of the Williams case (Q2, n = 32, r_e = 0.3, where a
+    badly cut cell next to the tip cell found the tip cell as its nearest root) are
+    crossed or uncut cells only."""
+    from xfem_contact.cases.cracks import williams_case
+    from xfem_contact.geometry.crack import CROSSED
+
+    case = williams_case(32, 2, tip_radius=0.3, comm=MPI.COMM_SELF, **WILLIAMS)
+    space, cut = case.problem.space, case.problem.cut
+    kind = np.full(cut.cell_sides.size, CROSSED)  # uncut cells: roots like crossed ones
+    kind[cut.cut_cells] = cut.crack.kind
+    aggregation = space.aggregation
+    roots = set()
+    for field in (0, 1):
+        dofmap = space.W.sub(field).dofmap.list
+        cells_of = {}
+        for cell, dofs in enumerate(dofmap):
+            for dof in dofs:
+                cells_of.setdefault(int(dof), set()).add(cell)
+        rows = np.flatnonzero(np.isin(aggregation.dofs, dofmap.ravel()))
+        for row in rows:
+            sources = aggregation.sources[aggregation.rows == row]
+            (root,) = set.intersection(*(cells_of[int(s)] for s in sources))
+            roots.add(root)
+    kinds = sorted(set(kind[list(roots)].tolist()))
+    print(f"{aggregation.dofs.size} constrained dofs, roots of the kinds {kinds}")
+    assert roots and all(kind[r] == CROSSED for r in roots)
+
+
+@pytest.mark.mpi
+def test_aggregated_gathered_crack_is_the_same_on_one_and_two_ranks():
+    """The Williams case of the rate test (Q2, gathered dofs, their ramp of degree 2,
+    aggregation 0.25, n = 16) gives the same energy error on one process and on all."""
+    from xfem_contact.cases.cracks import williams_case, williams_energy_error
+
+    def error(comm):
+        case = williams_case(16, 2, tip_radius=0.5, comm=comm, **WILLIAMS)
+        case.problem.solve()
+        return williams_energy_error(case)
+
+    everywhere, alone = error(MPI.COMM_WORLD), error(MPI.COMM_SELF)
+    print(f"energy error {everywhere:.10e} ({alone:.10e} on one process)")
+    assert abs(everywhere - alone) <= 1e-8 * alone

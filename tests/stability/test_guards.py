@@ -2,7 +2,8 @@
 
 Guards: the ghost penalty (cut fractions), cell aggregation (cut fractions without the
 ghost penalty; the stabilised pair's inf-sup constant; a crack's slivers next to its
-tip), the harmonic-mean augmentation
+tip; the Williams rate with gathered tip dofs; roots off a crack's tip cells), the
+harmonic-mean augmentation
 (stiffness contrast), the Coulomb clamp (friction cone), the objective bulk (a large
 rotation in one step or ten). The LBB check carries its own counter-test (``lbb="none"``).
 Marked ``guards``: ``pytest -m guards`` runs these alone.
@@ -18,6 +19,7 @@ import test_materials
 import test_rotation
 
 import xfem_contact.fem.aggregation as aggregation_module
+import xfem_contact.fem.enrichment as enrichment_module
 import xfem_contact.mechanics.problem as problem_module
 from xfem_contact.mechanics.bulk import SmallStrain
 from xfem_contact.mechanics.laws import contact
@@ -64,6 +66,23 @@ def without_aggregation_next_to_a_tip(monkeypatch):
     return lambda: test_aggregation.test_a_sliver_next_to_a_crack_tip_is_aggregated("triangle")
 
 
+def with_a_degree_one_ramp_under_aggregation(monkeypatch):
+    monkeypatch.setattr(enrichment_module, "ramp_degree", lambda tip_dofs, degree, aggregated: 1)
+    return test_aggregation.test_aggregation_keeps_the_williams_rate
+
+
+def with_roots_at_a_crack_tip(monkeypatch):
+    codes = aggregation_module._cell_codes
+
+    def tip_cells_are_roots(*args):  # a tip or extension cell as any well cut cell
+        out = codes(*args)
+        out[out == aggregation_module._SHARED] = aggregation_module._WELL
+        return out
+
+    monkeypatch.setattr(aggregation_module, "_cell_codes", tip_cells_are_roots)
+    return test_aggregation.test_a_root_is_never_a_tip_cell
+
+
 def with_arithmetic_mean_augmentation(monkeypatch):
     monkeypatch.setattr(
         contact.ContactLaw,
@@ -90,6 +109,8 @@ GUARDS = {
     "cell aggregation": without_aggregation,
     "cell aggregation (inf-sup)": without_aggregation_in_the_inf_sup_test,
     "cell aggregation next to a crack tip": without_aggregation_next_to_a_tip,
+    "cell aggregation's ramp of the displacement degree": with_a_degree_one_ramp_under_aggregation,
+    "cell aggregation's roots off a crack tip": with_roots_at_a_crack_tip,
     "harmonic-mean augmentation": with_arithmetic_mean_augmentation,
     "Coulomb clamp": without_coulomb_clamp,
     "objective bulk": with_small_strain_bulk,

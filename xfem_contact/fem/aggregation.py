@@ -30,10 +30,13 @@ prolongation (the LBB restriction) already replaces stay its own.
 A crack's cells are aggregated only where the crack crosses them: its tip cells and the
 cells cut by its extension ahead of a tip are never badly cut (their nodes are tied: one
 unknown for both sides, whatever a side's share), and tied dofs are never constrained.
+Nor are they roots or on the way to one: their side polynomial is the other side's too,
+and extended to a badly cut cell behind the tip it would give both sides one field there.
 A crossed cell next to a tip cell is aggregated like any other, its untied dofs extended
 and its tied ones kept: its sliver on one side leaves that side's untied dofs with
-nothing else in their support. The branch unknowns and the ramp are unchanged: in the
-tip zone only the side fields of badly cut cells are extended.
+nothing else in their support. The branch unknowns are unchanged (gathered ones take a
+ramp of the displacement degree, :func:`~xfem_contact.fem.tip_dofs.ramp_degree`): in
+the tip zone only the side fields of badly cut cells are extended.
 
 All arrays here are process-local unless stated; the functions that gather are
 collective. The cells and roots are gathered on every process (interface-sized data).
@@ -61,8 +64,10 @@ if typing.TYPE_CHECKING:
 _logger = logging.getLogger(__name__)
 #: Newton steps of the pull-back of a node into its root cell (bilinear maps: 2-3 suffice)
 _PULL_BACK_STEPS = 20
-#: Codes of a cell for one side: not touched by the side, well cut (or uncut), badly cut
-_OUTSIDE, _WELL, _BAD = 0, 1, 2
+#: Codes of a cell for one side: not touched by the side, well cut (or uncut), badly cut,
+#: and touched but never a root nor on the way to one (a crack's tip cells and the cells
+#: its extension cuts: their two sides share their dofs)
+_OUTSIDE, _WELL, _BAD, _SHARED = 0, 1, 2, 3
 
 
 class Aggregation(typing.NamedTuple):
@@ -180,11 +185,14 @@ def _eligible_cells(space: EnrichedSpace) -> np.ndarray:
 
 
 def _cell_codes(cut, side, threshold, areas, eligible) -> npt.NDArray[np.float64]:
-    """Per owned cell: :data:`_OUTSIDE`, :data:`_WELL` or :data:`_BAD` for ``side``."""
+    """Per owned cell: :data:`_OUTSIDE`, :data:`_WELL`, :data:`_BAD` or :data:`_SHARED`
+    for ``side``."""
     fraction = side_areas(cut, side, areas) / areas
     touched = (cut.cell_sides == side) | (cut.cell_sides == 0)
     codes = np.where(touched, _WELL, _OUTSIDE).astype(np.float64)
     codes[touched & eligible & (fraction < threshold)] = _BAD
+    if cut.crack is not None:
+        codes[cut.cut_cells[cut.crack.kind != CROSSED]] = _SHARED
     return codes
 
 
@@ -225,7 +233,7 @@ def _field_aggregation(space, field, owned_codes, active) -> Aggregation:
     n_owned = cell_map.size_local
     codes = _ghosted_cell_values(mesh, owned_codes)
     bad = np.flatnonzero(codes[:n_owned] == _BAD).astype(np.int32)
-    well = np.flatnonzero(codes[:n_owned] == _WELL).astype(np.int32)
+    well = np.flatnonzero(np.isin(codes[:n_owned], (_WELL, _SHARED))).astype(np.int32)
     W = space.W
     n_dofs = W.dofmap.index_map.size_local
     of_field = np.zeros(active.size, dtype=bool)
@@ -360,7 +368,7 @@ def _roots(table: _BadCells) -> dict[int, int]:
     root = {c: c for c, code in table.codes.items() if code == _WELL}
     adjacent: dict[int, list[int]] = {}
     for cell, other in table.neighbours.tolist():
-        if table.codes[other] != _OUTSIDE:
+        if table.codes[other] in (_WELL, _BAD):
             adjacent.setdefault(cell, []).append(other)
     pending = set(table.ids.tolist())
     while pending:

@@ -41,7 +41,7 @@ from xfem_contact.fem.branch import (
 )
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.fem.subspaces import collapse
-from xfem_contact.fem.tip_dofs import branch_support, checked_tip_dofs
+from xfem_contact.fem.tip_dofs import branch_support, checked_tip_dofs, ramp_degree
 from xfem_contact.fem.tip_scale import default_tip_radius
 from xfem_contact.geometry.crack import CROSSED
 
@@ -181,10 +181,12 @@ class EnrichedSpace:
             cut.crack.union.check_tip_radius(tip_radius)  # each tip zone within its crack's
         self.tip_radius = tip_radius
         self.tip_dofs = checked_tip_dofs(tip_dofs, tip_radius if cut.crack is not None else 0)
-        #: The ramp ``R`` of the branch functions (P1, set with the active dofs), or None
+        #: The ramp ``R`` of the branch functions (Lagrange of :func:`ramp_degree`, set
+        #: with the active dofs), or None
         self.ramp: dolfinx.fem.Function | None = None
         if self.branch_field is not None and tip_radius is not None:
-            self.ramp = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, ("Lagrange", 1)))
+            R = ("Lagrange", ramp_degree(self.tip_dofs, degree, aggregation is not None))
+            self.ramp = dolfinx.fem.Function(dolfinx.fem.functionspace(mesh, R))
         self.W = dolfinx.fem.functionspace(mesh, basix.ufl.mixed_element(elements))
         extent = mesh.comm.allreduce(float(np.abs(mesh.geometry.x).max()), op=MPI.MAX)
         #: Level set values (m) taken for 0: a node on a crack's line

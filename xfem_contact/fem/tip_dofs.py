@@ -9,8 +9,9 @@ With ``tip_dofs="gathered"`` the branch dofs of every vertex near one tip take o
 value per branch function ``F_k`` and component (the dof gathering of Laborde, Pommier,
 Renard and Salaün, IJNME 64, 2005): the vertices' hats sum to 1 on the cells where the
 ramp is not 0, so the enrichment is ``R(x) sum_k F_k a_k`` with constant ``a_k``, the
-cut-off method of Chahine, Laborde and Renard (2008). The ramp ``R`` is then the P1
-interpolant of a smooth cut-off of the distance ``d`` to the nearest tip,
+cut-off method of Chahine, Laborde and Renard (2008). The ramp ``R`` is then the
+Lagrange interpolant (P1; with cell aggregation, of the displacement degree:
+:func:`ramp_degree`) of a smooth cut-off of the distance ``d`` to the nearest tip,
 ``1 - 10 s^3 + 15 s^4 - 6 s^5`` with ``s = d / r_e`` (1 at the tip, 0 from ``r_e`` on,
 its first and second derivatives 0 at both ends). Its slopes are fixed by ``r_e``, not by
 ``h``, so ``(1 - R) u`` is as smooth as ``u`` off the tip and the standard functions
@@ -18,6 +19,12 @@ approximate it at their full order (a cut-off with a jump of its second derivati
 lowers the rate of degree 2). The few gathered unknowns, each shifted by its
 interpolant on the standard nodes (:mod:`xfem_contact.solvers.block_scaling`), add no
 near-dependence that grows as ``h -> 0``, whatever the number of vertices in the zone.
+
+Cell aggregation (:mod:`~xfem_contact.fem.aggregation`) gives a badly cut cell's
+standard dofs its root's polynomial: the standard part ``(1 - R) u`` must then be one
+polynomial on the root and the badly cut cell to the order of the element. The P1
+interpolant's slopes jump across every edge of the zone by ``h`` times the cut-off's
+second derivative; the interpolant of degree 2 jumps by ``h^2`` times the third.
 """
 
 from __future__ import annotations
@@ -36,7 +43,14 @@ from xfem_contact.geometry.crack import TIP
 if typing.TYPE_CHECKING:
     from xfem_contact.fem.enrichment import EnrichedSpace
 
-__all__ = ["TIP_DOFS", "branch_groups", "branch_support", "checked_tip_dofs", "cutoff"]
+__all__ = [
+    "TIP_DOFS",
+    "branch_groups",
+    "branch_support",
+    "checked_tip_dofs",
+    "cutoff",
+    "ramp_degree",
+]
 
 _logger = logging.getLogger(__name__)
 #: Relative tolerance of the tip radius: the mesh generator rounds a node's coordinates
@@ -58,6 +72,16 @@ def checked_tip_dofs(tip_dofs: str, tip_radius) -> str:
             "tip_dofs='gathered' needs a tip radius (tip_radius a length or 'auto', not None)"
         )
     return tip_dofs
+
+
+def ramp_degree(tip_dofs: str, degree: int, aggregated: bool) -> int:
+    """The Lagrange degree of the ramp ``R``: 1, or the displacement ``degree`` for
+    gathered dofs with cell aggregation (``aggregated``). The cut-off's interpolant of
+    degree 1 has slopes that jump across cell edges by ``h`` times the cut-off's second
+    derivative, which the standard functions follow at no cost; an aggregated dof
+    extends its root's polynomial across an edge and cannot (module docstring). Nodal
+    dofs keep their ramp of vertex values 0 and 1."""
+    return degree if tip_dofs == "gathered" and aggregated else 1
 
 
 def cutoff(distance: npt.NDArray[np.float64], radius: float) -> npt.NDArray[np.float64]:

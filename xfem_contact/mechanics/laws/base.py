@@ -79,7 +79,7 @@ class InterfaceContext:
             no process has one.
         split: The fields of a Function on the mixed space, e.g. ``split(w_old)`` (the
             space's ``split``: the displacements with a crack's branch functions).
-        ramp: The ramp ``R`` of a crack's branch functions (P1; see
+        ramp: The ramp ``R`` of a crack's branch functions (Lagrange; see
             :class:`~xfem_contact.fem.enrichment.EnrichedSpace`), None without.
         interpolants: Per side, the interpolants subtracted from ``R F_k`` (the space's
             :attr:`~xfem_contact.fem.enrichment.EnrichedSpace.interpolants`), None without.
