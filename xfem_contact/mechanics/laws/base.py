@@ -100,6 +100,7 @@ class InterfaceContext:
     ramp: dolfinx.fem.Function | None = None
     interpolants: dict[int, tuple[dolfinx.fem.Function, ...]] | None = None
     ghost_penalty: float = 0.0
+    ghost_penalty_higher: float = 1.0
     #: Point values cached for the fixed rules (basis tables, dofs, the normal) and the
     #: objects made :meth:`once`
     _cache: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
@@ -127,7 +128,12 @@ class InterfaceContext:
             if patch:
                 h = self.cell_size.x.array[V0.dofmap.list[:, 0]]
                 lengths = patch_trace_lengths(
-                    self.cut, self.name, self.degree, self.ghost_credit(), h
+                    self.cut,
+                    self.name,
+                    self.degree,
+                    self.ghost_credit(),
+                    h,
+                    self.ghost_penalty_higher,
                 )
             else:
                 lengths = side_trace_lengths(self.cut, self.name, self.degree)
@@ -437,9 +443,10 @@ class InterfaceLaw(abc.ABC):
         """The law's name and options (for summaries)."""
         return {"law": self.name}
 
-    def check_ghost_penalty(self, ctx: InterfaceContext, value: float) -> None:
-        """Refuse a new ghost penalty weight ``value`` that the forms built on ``ctx``
-        rely on being larger (ValueError); none here."""
+    def check_ghost_penalty(self, ctx: InterfaceContext, name: str, value: float) -> None:
+        """Refuse a new value of the ghost penalty's parameter ``name``
+        (``"ghost_penalty"`` or ``"ghost_penalty_higher"``) that the forms built on
+        ``ctx`` rely on being larger (ValueError); none here."""
         return None
 
 
