@@ -83,6 +83,8 @@ class InterfaceContext:
             :class:`~xfem_contact.fem.enrichment.EnrichedSpace`), None without.
         interpolants: Per side, the interpolants subtracted from ``R F_k`` (the space's
             :attr:`~xfem_contact.fem.enrichment.EnrichedSpace.interpolants`), None without.
+        ghost_penalty: The ghost penalty's weight as built (the patch lengths credit it).
+        ghost_penalty_higher: Its factor of the second-derivative jumps as built.
     """
 
     cut: CutMesh
@@ -150,9 +152,10 @@ class InterfaceContext:
     def ghost_credit(self) -> dict[int, float]:
         """Per side ``eta_s = g 2 mu_s / (2 mu_s + d lambda_s)`` (``g`` the
         :attr:`ghost_penalty`, ``d`` the dimension): the ghost penalty of side ``s``
-        bounds ``eta_s sum_j h^(2j+1) |[grad^j q]|^2`` on a facet for every component
-        ``q`` of ``C^1/2 eps`` (``|C^1/2 e|^2 <= (2 mu + d lambda) |e|^2``). 0 for a side
-        whose material varies by region."""
+        bounds ``eta_s sum_j c_j h^(2j+1) |[grad^j q]|^2`` on a facet for every
+        component ``q`` of ``C^1/2 eps`` (``|C^1/2 e|^2 <= (2 mu + d lambda) |e|^2``;
+        ``c_0 = 1``, ``c_j`` the :attr:`ghost_penalty_higher` for ``j >= 1``). 0 for a
+        side whose material varies by region."""
         out = {}
         for s, m in self.materials.items():
             material = getattr(m, "material", None)
