@@ -287,6 +287,10 @@ ACCURACY_TREATMENTS = {
     "aggregation 0.25 alone": {"aggregation": 0.25, "ghost_penalty": 0.0},
     "ghost penalty 0.01, stabilization length 'cut'": {"stabilization_length": "cut"},
     "ghost penalty 0.01, stabilization length 'patch'": {"stabilization_length": "patch"},
+    "ghost penalty 0.01 (higher derivatives 0.01), stabilization length 'patch'": {
+        "stabilization_length": "patch",
+        "ghost_penalty_higher": 0.01,
+    },
 }
 
 

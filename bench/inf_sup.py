@@ -20,7 +20,8 @@ The studies (``--study``):
 The treatments (``--treatments``): none, restriction, stabilized; stabilized with the
 ghost penalty raised to the stabilisation's weight (0.1), with cell aggregation, or with
 the scale of the cut (``stabilization_length="cut"``, or ``"patch"``, credited through
-the ghost penalty); ``--weight`` sets the stabilisation's weight ``gamma``.
+the ghost penalty, also with its higher derivatives' factor ``ghost_penalty_higher``
+0.01); ``--weight`` sets the stabilisation's weight ``gamma``.
 Prints, per element, treatment and n, the least and median beta, the count of
 indefinite pairs (beta^2 < 0; without a treatment, round-off of a zero eigenvalue: a
 spurious multiplier), the count of samples whose displacement block has a negative
@@ -59,6 +60,7 @@ from mpi4py import MPI
 from xfem_contact.fem.cutmesh import CutMesh
 from xfem_contact.io.meshes import ghosted_partitioner
 from xfem_contact.io.progress import note
+from xfem_contact.mechanics.defaults import DEFAULT
 from xfem_contact.mechanics.inf_sup import InfSup, inf_sup_constant
 from xfem_contact.mechanics.laws import Bonded
 from xfem_contact.mechanics.materials import Material
@@ -86,15 +88,17 @@ DEFAULT_ELEMENTS = {
     "crack": ("P1-P1", "P2-P1", "P2-P2"),
     "3d": ("P1-P1", "P2-P1"),
 }
-#: label: (lbb, ghost penalty, cell aggregation; None: the default)
+#: label: (lbb, ghost penalty, cell aggregation, stabilisation length, the ghost
+#: penalty's factor of higher derivatives; None: the default)
 TREATMENTS = {
-    "none": ("none", None, None, "cell"),
-    "restriction": ("restriction", None, None, "cell"),
-    "stabilized": ("stabilized", None, None, "cell"),
-    "stabilized, ghost 0.1": ("stabilized", 0.1, None, "cell"),
-    "stabilized, aggregation 0.25": ("stabilized", None, 0.25, "cell"),
-    "stabilized, cut length": ("stabilized", None, None, "cut"),
-    "stabilized, patch length": ("stabilized", None, None, "patch"),
+    "none": ("none", None, None, "cell", None),
+    "restriction": ("restriction", None, None, "cell", None),
+    "stabilized": ("stabilized", None, None, "cell", None),
+    "stabilized, ghost 0.1": ("stabilized", 0.1, None, "cell", None),
+    "stabilized, aggregation 0.25": ("stabilized", None, 0.25, "cell", None),
+    "stabilized, cut length": ("stabilized", None, None, "cut", None),
+    "stabilized, patch length": ("stabilized", None, None, "patch", None),
+    "stabilized, patch length, higher 0.01": ("stabilized", None, None, "patch", 0.01),
 }
 #: The treatments of each study's default result (the others: ``--treatments``); a crack
 #: refuses the stabilisation (it squares the tip's singular traction on the lips)
@@ -204,7 +208,7 @@ def sample(
     """The :class:`InfSup` of each cut of one mesh and ``""``; or None and the reason the
     problem refuses the treatment. ``weight``: the stabilisation's ``gamma`` (None: the
     default of the treatment's length)."""
-    treatment, ghost_penalty, aggregation, length = TREATMENTS[lbb]
+    treatment, ghost_penalty, aggregation, length, higher = TREATMENTS[lbb]
     law = Bonded(
         lbb=treatment,
         multiplier_degree=multiplier,
@@ -220,6 +224,7 @@ def sample(
                 MATERIAL,
                 law,
                 ghost_penalty=ghost_penalty,
+                ghost_penalty_higher=DEFAULT.ghost_penalty_higher if higher is None else higher,
                 aggregation=aggregation,
                 tip_radius=None,
             )

@@ -20,6 +20,7 @@ CHANGES = [
     (("law", "multiplier_stabilization"), 0.3),
     (("law", "multiplier_extension"), 1e-6),
     (("bulk", "ghost_penalty"), 0.1),
+    (("bulk", "ghost_penalty_higher"), 0.01),
     (("inside", "E"), 300e6),
     (("inside", "nu"), 0.3),
 ]
@@ -167,6 +168,7 @@ def settable():
         "multiplier_stabilization": (*attribute(law, "multiplier_stabilization"), -1.0, ">= 0"),
         "multiplier_extension": (*attribute(law, "multiplier_extension"), -1.0, ">= 0"),
         "ghost_penalty": (*attribute(problem, "ghost_penalty"), -1.0, ">= 0"),
+        "ghost_penalty_higher": (*attribute(problem, "ghost_penalty_higher"), -1.0, ">= 0"),
         "t": (loads.set_time, lambda: loads.time, -1.0, ">= 0"),
         "stiffness": (*attribute(handles.pop("stiffness"), "value"), 0.0, "> 0 Pa/m"),
     }
@@ -184,6 +186,7 @@ RANGED = [
     "multiplier_stabilization",
     "multiplier_extension",
     "ghost_penalty",
+    "ghost_penalty_higher",
     "t",
     "stiffness",
 ]

@@ -106,3 +106,18 @@ def test_without_the_ghost_penalty_nothing_is_borrowed(cell):
     own = side_trace_lengths(cut, None, 2)
     for s in (-1, 1):
         assert lengths[s] == pytest.approx(own[s], rel=1e-10)
+
+
+def test_the_credit_of_the_second_derivative_jumps_follows_their_factor():
+    """P2: the strains' gradient jumps (the ghost penalty's second-derivative jumps)
+    lend too; with their factor ``higher`` lowered the credited side's length falls, and
+    it stays above the credit of the value jumps alone (``higher = 0``)."""
+    cut = corner_cut()
+    eta = 0.3
+    ncells = cut.mesh.topology.index_map(2).size_local
+    h = np.full(ncells, np.sqrt(2.0))
+    length = {
+        higher: patch_trace_lengths(cut, None, 2, {-1: eta, 1: eta}, h, higher)[1][0]
+        for higher in (1.0, 0.01, 0.0)
+    }
+    assert length[1.0] > length[0.01] > length[0.0] > side_trace_lengths(cut, None, 2)[1][0]

@@ -17,23 +17,15 @@ import xfem_contact  # noqa: F401  (before dolfinx)
 import numpy as np
 import pytest
 
-from xfem_contact.cases.paper import INCLUSION_E, inclusion_errors, inclusion_problem
+from xfem_contact.cases.paper import (
+    INCLUSION_E,
+    inclusion_errors,
+    inclusion_problem,
+    pressure_fourier_misfit,
+)
 from xfem_contact.mechanics.materials import Material
 
 CONTRASTS = [1.0, 1e2, 1e4, 1e6, 1e-2, 1e-4, 1e-6]
-
-
-def fourier_misfit(problem, modes: int = 9) -> float:
-    """Largest deviation of lambda_n from its least-squares fit by ``modes`` Fourier
-    modes of the angle, over the mean |lambda_n| (the smooth part is what the square's
-    boundary adds to the uniform infinite-plate pressure)."""
-    samples = problem.interface_samples(problem.w)
-    theta = np.arctan2(np.array(samples["y"]) - 0.5, np.array(samples["x"]) - 0.5)
-    lam = np.array(samples["lambda_n"])
-    k = np.arange(modes)
-    basis = np.c_[np.cos(np.outer(theta, k)), np.sin(np.outer(theta, k[1:]))]
-    smooth = basis @ np.linalg.lstsq(basis, lam, rcond=None)[0]
-    return float(np.abs(lam - smooth).max() / np.abs(lam).mean())
 
 
 @pytest.mark.mpi
@@ -50,18 +42,25 @@ def test_stiffness_contrast_keeps_the_interface_closed_and_smooth(contrast):
     assert np.all(np.isfinite(state["lambda_n"]))
     assert np.all(state["lambda_n"] > -2.0)  # below the rigid-inclusion limit (-1.79 Pa)
     if contrast >= 1e-2:  # softer ones carry ~nothing: relative smoothness means nothing
-        assert fourier_misfit(problem) < 5e-2
+        assert pressure_fourier_misfit(problem) < 5e-2
 
 
-def patch_misfit(contrast: float) -> float:
+def patch_misfit(contrast: float, higher: float = 1.0) -> float:
     """The Fourier misfit of :func:`test_stiffness_contrast_keeps_the_interface_closed_and_smooth`
-    with the scale of the cut credited through the ghost penalty."""
+    with the scale of the cut credited through the ghost penalty, whose jumps of second
+    derivatives weigh ``higher`` times the gradient's."""
     materials = {-1: Material(contrast * INCLUSION_E, 0.0), 1: Material(INCLUSION_E, 0.0)}
     problem = inclusion_problem(
-        16, 2, "sticking", loading="hydrostatic", materials=materials, stabilization_length="patch"
+        16,
+        2,
+        "sticking",
+        loading="hydrostatic",
+        materials=materials,
+        stabilization_length="patch",
+        ghost_penalty_higher=higher,
     )
     problem.solve()
-    return fourier_misfit(problem)
+    return pressure_fourier_misfit(problem)
 
 
 @pytest.mark.mpi
@@ -75,6 +74,15 @@ def test_the_patch_length_keeps_a_stiff_inclusion_smooth(contrast):
 @pytest.mark.xfail(strict=True, reason="the soft inclusion's slivers: misfit 0.123")
 def test_the_patch_length_keeps_a_soft_inclusion_smooth():
     assert patch_misfit(1e-2) < 5e-2
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("contrast", [1e-2, 1e2, 1e6])
+def test_weak_higher_ghost_jumps_keep_every_contrast_smooth(contrast):
+    """``ghost_penalty_higher=0.01`` with the patch length: misfit 0.041, 0.023, 0.023
+    (0.123, 0.047, 0.048 with the full second-derivative jumps, whose consistency
+    error biases the matrix's traction on the interface)."""
+    assert patch_misfit(contrast, higher=0.01) < 5e-2
 
 
 @pytest.mark.mpi

@@ -74,3 +74,14 @@ def test_lowering_the_credited_ghost_penalty_is_refused():
     problem.ghost_penalty = 0.05
     with pytest.raises(ValueError, match="ghost_penalty 0.001 is below 0.01"):
         problem.ghost_penalty = 0.001
+
+
+def test_lowering_the_credited_higher_derivatives_factor_is_refused():
+    """The patch lengths credit the ghost penalty's second-derivative jumps too."""
+    mesh = dolfinx.mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    cut = CutMesh(mesh, lambda x: np.hypot(x[0] - 0.5, x[1] - 0.5) - 0.3, degree=2)
+    law = Bonded(lbb="stabilized", stabilization_length="patch")
+    problem = Problem(cut, 2, Material(100e6, 0.3), law, ghost_penalty_higher=0.01)
+    problem.ghost_penalty_higher = 0.1
+    with pytest.raises(ValueError, match="ghost_penalty_higher 0.001 is below 0.01"):
+        problem.ghost_penalty_higher = 0.001

@@ -114,6 +114,23 @@ def pressure_total_variation(problem: ContactProblem, centre=INCLUSION_CENTRE) -
     return float(np.abs(np.diff(np.r_[values, values[:1]])).sum())
 
 
+def pressure_fourier_misfit(
+    problem: ContactProblem, modes: int = 9, centre=INCLUSION_CENTRE
+) -> float:
+    """Largest deviation of ``lambda_n`` around a closed interface from its
+    least-squares fit by ``modes`` Fourier modes of the polar angle about ``centre``,
+    over the mean ``|lambda_n|`` (dimensionless): the multiplier's oscillation at the
+    mesh scale, apart from the smooth variation a finite body adds to the pressure.
+    Collective."""
+    samples = problem.interface_samples(problem.w)
+    theta = np.arctan2(np.array(samples["y"]) - centre[1], np.array(samples["x"]) - centre[0])
+    lam = np.array(samples["lambda_n"])
+    k = np.arange(modes)
+    basis = np.c_[np.cos(np.outer(theta, k)), np.sin(np.outer(theta, k[1:]))]
+    smooth = basis @ np.linalg.lstsq(basis, lam, rcond=None)[0]
+    return float(np.abs(lam - smooth).max() / np.abs(lam).mean())
+
+
 def integrate(expr) -> float:
     """Global value of a functional (collective)."""
     f = form(expr)

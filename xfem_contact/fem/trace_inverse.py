@@ -167,6 +167,7 @@ def patch_trace_lengths(
     degree: int,
     ghost: dict[int, float],
     h: npt.NDArray[np.float64],
+    higher: float = 1.0,
 ) -> dict[int, np.ndarray]:
     """``{-1: l_-, 1: l_+}`` (m) of the cut cells of interface ``name`` (rows of
     ``cut.cut_cells``, 0 on other interfaces' cells), each side's trace length
@@ -174,7 +175,7 @@ def patch_trace_lengths(
     docs' stability page derives the bound):
 
         int_(Gamma_T) p^2 ds <= (kappa_T int_(T_s) p^2 dx + sum_K [theta int_(K_s) q_K^2 dx
-                                 + eta sum_(j<k) h^(2j+1) int_F |grad^j (p - q_K)|^2]) / l_s
+                                 + eta sum_(j<k) c_j h^(2j+1) int_F |grad^j (p - q_K)|^2]) / l_s
 
     for ``p`` in the strain space ``S`` on ``T`` and any ``q_K`` in ``S`` on ``K``. A
     cut cell ``T`` borrows from a facet neighbour ``K`` that is not cut (entirely on
@@ -191,6 +192,8 @@ def patch_trace_lengths(
             penalty's weight; 0 without it).
         h: Cell diameters of the ghost penalty's ``h`` (m), per local cell (ghosts
             included).
+        higher: ``c_j`` for ``j >= 1`` (``c_0 = 1``): the ghost penalty's factor of
+            the jumps of second and higher derivatives of the displacement.
 
     Collective (the neighbours' masses are scattered to the ghost cells).
     """
@@ -260,7 +263,7 @@ def patch_trace_lengths(
                 bases[T, K] = _basis_change(exponents, centres, h, T, K)
                 h_facet = 0.5 * (h[T] + h[K])  # the ghost penalty's avg(h)
                 jumps[T, F] = _jump_mass(
-                    mesh, F, facet_rule, degree, exponents, centres[T], h[T], h_facet
+                    mesh, F, facet_rule, degree, exponents, centres[T], h[T], h_facet, higher
                 )
             M_K = bases[T, K].T @ M_K @ bases[T, K]
             G = ghost[s] * jumps[T, F]
@@ -391,11 +394,12 @@ def _facet_rule(mesh: dolfinx.mesh.Mesh, degree: int):
 
 
 def _jump_mass(
-    mesh, F, rule, degree, exponents, centre, h_cell, h_facet
+    mesh, F, rule, degree, exponents, centre, h_cell, h_facet, higher=1.0
 ) -> npt.NDArray[np.float64]:
-    """``sum_(j<k) h_facet^(2j+1) int_F grad^j phi . grad^j phi^T ds`` for the
+    """``sum_(j<k) c_j h_facet^(2j+1) int_F grad^j phi . grad^j phi^T ds`` for the
     monomials about ``centre`` scaled by ``h_cell`` (``k`` the displacement's
-    ``degree``: the ghost penalty jumps ``grad^(j+1) u``), shape ``(m, m)``."""
+    ``degree``: the ghost penalty jumps ``grad^(j+1) u``; ``c_0 = 1``, ``c_j =
+    higher`` for ``j >= 1``), shape ``(m, m)``."""
     tdim = mesh.topology.dim
     X, w = rule
     nodes = dolfinx.mesh.entities_to_geometry(mesh, tdim - 1, np.array([F], dtype=np.int32))[0]
@@ -413,7 +417,8 @@ def _jump_mass(
             # |grad^j q|^2 = sum over |alpha| = j of j! / alpha! (d^alpha q)^2
             multiplicity = math.factorial(j) / np.prod([math.factorial(a) for a in alpha])
             d = _monomials(exponents, Y, alpha, h_cell)
-            G += h_facet ** (2 * j + 1) * multiplicity * (d * (w * measure)) @ d.T
+            weight = 1.0 if j == 0 else higher
+            G += weight * h_facet ** (2 * j + 1) * multiplicity * (d * (w * measure)) @ d.T
     return G
 
 

@@ -50,14 +50,21 @@ class SmallStrain:
         degree: Displacement degree (the ghost penalty jumps derivatives 1..degree).
         h: Cell diameters (DG0, m).
         ghost_penalty: Dimensionless weight ``gamma``: for each side,
-            ``gamma * 2 mu * sum_k h^(2k-1) [d^k u][d^k v]`` on the interior facets of
-            cut cells, k = 1..degree (zero for smooth solutions: exact polynomial
+            ``gamma * 2 mu * sum_k c_k h^(2k-1) [d^k u][d^k v]`` on the interior facets
+            of cut cells, k = 1..degree (zero for smooth solutions: exact polynomial
             fields stay exact). A Constant of the forms; 0 at construction leaves the
             term out of them (it cannot be switched on later).
+        ghost_penalty_higher: ``c_k`` for ``k >= 2`` (``c_1 = 1``): the weight of the
+            jumps of the second and higher derivatives relative to the gradient's
+            (degree 2 only). A Constant of the forms. Their jumps are the only ones of
+            the same order as the discretisation error (an interpolant's lower-order
+            jumps converge faster), so they carry most of the term's consistency
+            error; any positive value removes a sliver's top-degree modes.
     """
 
     name = "bulk"
     ghost_penalty = Parameter(minimum=0.0)
+    ghost_penalty_higher = Parameter(minimum=0.0)
     #: Polynomial degree of the integrand per degree of the displacement (uncut cells
     #: outside a crack's tip zone)
     integrand_degree = 2
@@ -69,6 +76,7 @@ class SmallStrain:
         degree: int,
         h: dolfinx.fem.Function,
         ghost_penalty: float = DEFAULT.ghost_penalty,
+        ghost_penalty_higher: float = DEFAULT.ghost_penalty_higher,
     ):
         cut = space.cut
         self.cut, self.materials, self.degree, self.h = cut, materials, degree, h
@@ -79,6 +87,7 @@ class SmallStrain:
             degree_of_cut = {"quadrature_degree": cut.quadrature_degree}
             self.zone = TipZone(cut, lambda: branch_cells(space), degree_of_cut)
         self.ghost_penalty = ghost_penalty
+        self.ghost_penalty_higher = ghost_penalty_higher
         #: Whether the forms hold the ghost penalty (its weight > 0 at construction)
         self.penalised = self.ghost_penalty > 0
         bind(self, cut.mesh)
@@ -148,6 +157,8 @@ class SmallStrain:
             scale = constant(self, "ghost_penalty") * 2.0 * mu
             du, dv = ufl.grad(trial[i]), ufl.grad(test[i])
             for k in range(1, self.degree + 1):
+                if k == 2:
+                    scale = scale * constant(self, "ghost_penalty_higher")
                 terms.append(
                     scale * h ** (2 * k - 1) * ufl.inner(ufl.jump(du), ufl.jump(dv)) * dS(i + 1)
                 )

@@ -29,6 +29,7 @@ def interface_context(
     ramp: dolfinx.fem.Function | None = None,
     interpolants: dict | None = None,
     ghost_penalty: float = 0.0,
+    ghost_penalty_higher: float = 1.0,
 ) -> InterfaceContext:
     """The context of interface ``name`` on the current cut of ``cut``.
 
@@ -45,6 +46,7 @@ def interface_context(
         ramp: The ramp of a crack's branch functions (the space's), None without.
         interpolants: The interpolants subtracted from them (the space's), None without.
         ghost_penalty: The ghost penalty's weight (the patch trace lengths' credit).
+        ghost_penalty_higher: Its factor of the jumps of second and higher derivatives.
 
     Collective.
     """
@@ -68,6 +70,7 @@ def interface_context(
         ramp=ramp,
         interpolants=interpolants,
         ghost_penalty=ghost_penalty,
+        ghost_penalty_higher=ghost_penalty_higher,
     )
 
 

@@ -24,6 +24,9 @@ DEFAULTS: dict[str, Default] = {
         "small", "'small' (linear elasticity) or 'large' (Saint Venant-Kirchhoff)"
     ),
     "ghost_penalty": Default(0.01, "dimensionless weight of the ghost penalty (0: none)"),
+    "ghost_penalty_higher": Default(
+        1.0, "factor of the ghost penalty's jumps of second and higher derivatives (degree 2)"
+    ),
     "min_support_fraction": Default(
         None, "enriched dofs kept down to this cut fraction (None: all with the ghost penalty)"
     ),

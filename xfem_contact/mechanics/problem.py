@@ -54,6 +54,8 @@ class Problem:
             (names of ``cut.interface_names``).
         ghost_penalty: Weight of the ghost penalty (see :class:`SmallStrain`); None:
             the default's, 0 for a crack (it spoils the tip's field: energy error x3).
+        ghost_penalty_higher: Factor of the ghost penalty's jumps of second and higher
+            derivatives relative to the gradient's (see :class:`SmallStrain`).
         min_support_fraction: See :class:`EnrichedSpace`. Default: every dof with the
             ghost penalty (it extends the field), else those with support on their side.
         aggregation: Cell aggregation (see :class:`EnrichedSpace`): the side volume
@@ -93,6 +95,7 @@ class Problem:
         law: InterfaceLaw | str | Mapping[str, InterfaceLaw | str] = DEFAULT.law,
         *,
         ghost_penalty: float | None = None,
+        ghost_penalty_higher: float = DEFAULT.ghost_penalty_higher,
         min_support_fraction: float | None = DEFAULT.min_support_fraction,
         aggregation: float | None = DEFAULT.aggregation,
         kinematics: str = DEFAULT.kinematics,
@@ -141,7 +144,14 @@ class Problem:
         self.loads = Loads(SideFields(self.space))
         self.cell_size = cell_size(self.mesh)
         bulk = BULK_MODELS[kinematics]
-        self.bulk = bulk(self.space, side_materials.bulk, degree, self.cell_size, ghost_penalty)
+        self.bulk = bulk(
+            self.space,
+            side_materials.bulk,
+            degree,
+            self.cell_size,
+            ghost_penalty,
+            ghost_penalty_higher,
+        )
         #: The materials as Constants of the forms (``Moduli`` per side, per interface
         #: name on side -1 when given so): set ``E`` or ``nu`` on them (no new compile)
         self.materials = side_materials.user
@@ -182,6 +192,7 @@ class Problem:
                 self.space.ramp,
                 self.space.interpolants,
                 float(self.bulk.ghost_penalty),
+                float(self.bulk.ghost_penalty_higher),
             )
             for name in self.laws
         }
@@ -225,8 +236,21 @@ class Problem:
     @ghost_penalty.setter
     def ghost_penalty(self, value: float) -> None:
         for name, law in self.laws.items():
-            law.check_ghost_penalty(self.contexts[name], value)
+            law.check_ghost_penalty(self.contexts[name], "ghost_penalty", value)
         self.bulk.ghost_penalty = value
+
+    @property
+    def ghost_penalty_higher(self) -> float:
+        """Factor of the ghost penalty's jumps of second and higher derivatives (a
+        Constant of the forms: settable, see
+        :class:`~xfem_contact.mechanics.bulk.SmallStrain`; the laws may refuse a value)."""
+        return self.bulk.ghost_penalty_higher
+
+    @ghost_penalty_higher.setter
+    def ghost_penalty_higher(self, value: float) -> None:
+        for name, law in self.laws.items():
+            law.check_ghost_penalty(self.contexts[name], "ghost_penalty_higher", value)
+        self.bulk.ghost_penalty_higher = value
 
     @property
     def linear(self) -> bool:

@@ -83,6 +83,8 @@ class InterfaceContext:
             :class:`~xfem_contact.fem.enrichment.EnrichedSpace`), None without.
         interpolants: Per side, the interpolants subtracted from ``R F_k`` (the space's
             :attr:`~xfem_contact.fem.enrichment.EnrichedSpace.interpolants`), None without.
+        ghost_penalty: The ghost penalty's weight as built (the patch lengths credit it).
+        ghost_penalty_higher: Its factor of the second-derivative jumps as built.
     """
 
     cut: CutMesh
@@ -100,6 +102,7 @@ class InterfaceContext:
     ramp: dolfinx.fem.Function | None = None
     interpolants: dict[int, tuple[dolfinx.fem.Function, ...]] | None = None
     ghost_penalty: float = 0.0
+    ghost_penalty_higher: float = 1.0
     #: Point values cached for the fixed rules (basis tables, dofs, the normal) and the
     #: objects made :meth:`once`
     _cache: dict = dataclasses.field(default_factory=dict, repr=False, compare=False)
@@ -127,7 +130,12 @@ class InterfaceContext:
             if patch:
                 h = self.cell_size.x.array[V0.dofmap.list[:, 0]]
                 lengths = patch_trace_lengths(
-                    self.cut, self.name, self.degree, self.ghost_credit(), h
+                    self.cut,
+                    self.name,
+                    self.degree,
+                    self.ghost_credit(),
+                    h,
+                    self.ghost_penalty_higher,
                 )
             else:
                 lengths = side_trace_lengths(self.cut, self.name, self.degree)
@@ -144,9 +152,10 @@ class InterfaceContext:
     def ghost_credit(self) -> dict[int, float]:
         """Per side ``eta_s = g 2 mu_s / (2 mu_s + d lambda_s)`` (``g`` the
         :attr:`ghost_penalty`, ``d`` the dimension): the ghost penalty of side ``s``
-        bounds ``eta_s sum_j h^(2j+1) |[grad^j q]|^2`` on a facet for every component
-        ``q`` of ``C^1/2 eps`` (``|C^1/2 e|^2 <= (2 mu + d lambda) |e|^2``). 0 for a side
-        whose material varies by region."""
+        bounds ``eta_s sum_j c_j h^(2j+1) |[grad^j q]|^2`` on a facet for every
+        component ``q`` of ``C^1/2 eps`` (``|C^1/2 e|^2 <= (2 mu + d lambda) |e|^2``;
+        ``c_0 = 1``, ``c_j`` the :attr:`ghost_penalty_higher` for ``j >= 1``). 0 for a
+        side whose material varies by region."""
         out = {}
         for s, m in self.materials.items():
             material = getattr(m, "material", None)
@@ -437,9 +446,10 @@ class InterfaceLaw(abc.ABC):
         """The law's name and options (for summaries)."""
         return {"law": self.name}
 
-    def check_ghost_penalty(self, ctx: InterfaceContext, value: float) -> None:
-        """Refuse a new ghost penalty weight ``value`` that the forms built on ``ctx``
-        rely on being larger (ValueError); none here."""
+    def check_ghost_penalty(self, ctx: InterfaceContext, name: str, value: float) -> None:
+        """Refuse a new value of the ghost penalty's parameter ``name``
+        (``"ghost_penalty"`` or ``"ghost_penalty_higher"``) that the forms built on
+        ``ctx`` rely on being larger (ValueError); none here."""
         return None
 
 

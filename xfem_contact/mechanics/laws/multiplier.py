@@ -120,15 +120,17 @@ class MultiplierLaw(InterfaceLaw):
             "stabilization_length": self.stabilization_length,
         }
 
-    def check_ghost_penalty(self, ctx: InterfaceContext, value: float) -> None:
+    def check_ghost_penalty(self, ctx: InterfaceContext, name: str, value: float) -> None:
         """With ``stabilization_length="patch"`` the trace lengths credit the ghost
         penalty the context was built with (:meth:`InterfaceContext.trace_lengths`): a
-        lower weight would void their bound, and is refused (a higher one keeps it)."""
-        if self.stabilization_length == "patch" and value < ctx.ghost_penalty:
+        lower weight or factor ``name`` would void their bound, and is refused (a
+        higher one keeps it)."""
+        built = getattr(ctx, name)
+        if self.stabilization_length == "patch" and value < built:
             raise ValueError(
-                f"ghost_penalty {value!r} is below {ctx.ghost_penalty!r}, the weight the "
+                f"{name} {value!r} is below {built!r}, the value the "
                 "stabilization_length='patch' lengths were computed with (they credit it): "
-                "build the problem with the lower ghost_penalty"
+                f"build the problem with the lower {name}"
             )
 
     def prolongation(self, ctx: InterfaceContext, space):
