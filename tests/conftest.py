@@ -44,6 +44,20 @@ def unit_cube(n: int, cell: str, distorted: bool = False, comm=MPI.COMM_WORLD):
     return mesh
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _assembled_kernels_optimized(request, tmp_path_factory):
+    """Modules marked ``assembly_bound`` compile their kernels with the library's own
+    flags (:data:`~xfem_contact.fem.forms.JIT_DEFAULTS`, -O1) instead of the suite's
+    -O0: they assemble large 3D kernels many times, so optimised code costs them less
+    than its compilation. An empty DOLFINx configuration folder for the module's time."""
+    if request.node.get_closest_marker("assembly_bound") is None:
+        yield
+        return
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("XDG_CONFIG_HOME", str(tmp_path_factory.mktemp("library-jit-options")))
+        yield
+
+
 def pytest_collection_modifyitems(config, items):
     """Tests marked ``parallel`` compare a run on all ranks with serial runs: on one
     rank they would compare a run with itself, so the serial suite skips them."""

@@ -9,11 +9,14 @@ import importlib.util
 import pathlib
 
 import numpy as np
+import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location("robustness3d", ROOT / "bench" / "robustness3d.py")
 robustness3d = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(robustness3d)
+
+pytestmark = pytest.mark.assembly_bound
 
 
 #: The short sweep's solves: every law once, on a sphere and on an ellipsoid
