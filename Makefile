@@ -35,6 +35,8 @@ test: $(VENV)/.installed bytecode
 # a config folder of their own: the suite's meshes are small, so its time on an empty
 # cache is the C compiler's (a crack's tip-zone kernel: about 30 s at -O1, 5 s at -O0).
 # FFCx names a module by its flags, so these kernels never serve the demos or benchmarks.
+# Test modules marked assembly_bound (assembling the same 3D kernels over many Newton
+# steps) keep the library's -O1 (tests/conftest.py).
 TEST_CONFIG := $(VENV)/test-config
 TEST_ENV := XDG_CONFIG_HOME=$(CURDIR)/$(TEST_CONFIG)
 
