@@ -257,3 +257,51 @@ def sphere_area_in_polytope(
         m = [v / np.linalg.norm(v) for v in m]
         area -= math.acos(float(np.clip(m[0] @ m[1], -1.0, 1.0)))
     return radius**2 * area
+
+
+def torus_area_in_polytope(
+    centre: np.ndarray,
+    radii: tuple[float, float],
+    planes: list[tuple[np.ndarray, float]],
+    count: int = 200000,
+) -> float:
+    """Area of the torus about the z axis through ``centre`` (``radii = (R, r)``) inside the
+    convex polytope ``g.x + c0 <= 0`` (``planes``). In the parametrisation ``x = centre +
+    ((R + r cos u) cos v, (R + r cos u) sin v, r sin u)``, ``dA = r (R + r cos u) du dv`` does
+    not depend on ``v`` and each facet keeps an arc of ``v`` in closed form
+    (``A cos v + B sin v + C <= 0``), so the inner integral is exact; the outer one is the
+    midpoint rule on ``count`` intervals of the ``u`` where the arcs are not empty (found
+    on ``count`` intervals of the circle)."""
+    step = 2 * np.pi / count
+    u = (np.arange(count) + 0.5) * step
+    held = np.flatnonzero(_torus_arcs(centre, radii, planes, u) > 0)
+    if held.size == 0:
+        return 0.0
+    if held[0] == 0 or held[-1] == count - 1:
+        raise ValueError("the polytope's piece of the torus wraps around u = 0")
+    lo, hi = u[held[0]] - step, u[held[-1]] + step
+    step = (hi - lo) / count
+    u = lo + (np.arange(count) + 0.5) * step
+    return float(_torus_arcs(centre, radii, planes, u).sum() * step)
+
+
+def _torus_arcs(centre, radii, planes, u: np.ndarray) -> np.ndarray:
+    """``r (R + r cos u)`` times the length of the arc of ``v`` inside the polytope, at each
+    ``u``."""
+    big, small = radii
+    rho = big + small * np.cos(u)
+    ends, conditions = [np.zeros_like(u), np.full_like(u, 2 * np.pi)], []
+    for g, c0 in planes:
+        A, B = g[0] * rho, g[1] * rho
+        C = g[2] * small * np.sin(u) + g @ centre + c0
+        M, alpha = np.hypot(A, B), np.arctan2(B, A)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            beta = np.arccos(np.clip(-C / M, -1.0, 1.0))  # cos(v - alpha) <= -C / M
+        ends += [np.mod(alpha + beta, 2 * np.pi), np.mod(alpha - beta, 2 * np.pi)]
+        conditions.append((A, B, C))
+    ends = np.sort(np.stack(ends, axis=1), axis=1)
+    middle = 0.5 * (ends[:, 1:] + ends[:, :-1])
+    inside = np.ones(middle.shape, dtype=bool)
+    for A, B, C in conditions:
+        inside &= A[:, None] * np.cos(middle) + B[:, None] * np.sin(middle) + C[:, None] <= 0
+    return small * rho * (np.diff(ends, axis=1) * inside).sum(axis=1)

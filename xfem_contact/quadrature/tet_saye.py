@@ -38,7 +38,9 @@ the tensor machinery of :mod:`xfem_contact.geometry.tensor_levelset` applies unc
 
 Given the level set that ``psi`` interpolates as a function (``exact``), the boxes and
 axes stay ``psi``'s (a box lies on one side only when ``psi``'s Bernstein coefficients
-keep their sign by the cell's ``margin``, a bound of ``|exact - psi|``), but the
+keep their sign by the cell's ``margin``, a bound of ``|exact - psi|``, at every depth:
+raised boxes that still move are subdivided down to ``max_depth``, where a thin lens of
+the exact zero set is as likely as above), but the
 breakpoints of every line (the slanted face's included) are the function's roots near
 ``psi``'s, the sides of the height intervals its signs and the area vectors its
 gradient, as in :mod:`xfem_contact.quadrature.saye`.
@@ -131,10 +133,11 @@ def truncated_saye_points(
             (:func:`~xfem_contact.geometry.exact_lines.central_gradient`). ``None``:
             ``C``'s zero set.
         margin: Per cell ``(ncells,)``, a bound of ``|exact - psi|`` on it
-            (:func:`~xfem_contact.geometry.exact_margin.exact_margin`): above
-            ``max_depth`` a box lies on one side only when ``psi``'s Bernstein
+            (:func:`~xfem_contact.geometry.exact_margin.exact_margin`): at every depth,
+            ``max_depth`` included, a box lies on one side only when ``psi``'s Bernstein
             coefficients are all ``< -margin`` or all ``>= margin`` (else its rules look
-            for ``exact``'s roots). ``None``: 0.
+            for ``exact``'s roots; a box at ``max_depth`` without a monotone axis leaves
+            its cell unresolved). ``None``: 0.
 
     Returns:
         The points of the resolved cells (a :class:`~xfem_contact.quadrature.saye.SayePoints`;
@@ -162,7 +165,7 @@ def truncated_saye_points(
             break
         B = bernstein(C[cell], lo, hi)
         truncated = hi.sum(axis=1) > 1.0
-        sides = certified_boxes(B, None if depth == max_depth else margin, cell)
+        sides = certified_boxes(B, margin, cell)
         for side, whole in sides.items():
             plain = whole & ~truncated
             parts[side].append(_tensor_rule(cell[plain], lo[plain], hi[plain], gauss))
