@@ -7,9 +7,10 @@ built on *cut edges* (mesh edges whose two end vertices lie on opposite sides
 of the interface, sides ``-1``/``+1`` per vertex):
 
 * every cut edge gets exactly one *vital vertex*, one of its two ends
-  (:func:`vital_vertices`): on triangle and quadrilateral edges by a greedy covering
-  (the vertex on most cut edges first), on tetrahedron and hexahedron edges the end
-  nearer the interface;
+  (:func:`vital_vertices`): by a greedy covering (the vertex on most cut edges first),
+  the end nearer the interface, or the covering after the ends of the crossings near
+  them (the rule per cell type:
+  :data:`xfem_contact.mechanics.lbb_space.VITAL_RULE`);
 * every vital vertex carries one independent multiplier unknown; the
   multiplier at the intersection point of a cut edge is that of its vital
   vertex;
