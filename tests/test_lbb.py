@@ -209,3 +209,21 @@ def test_nearer_end():
     ]
     with pytest.raises(ValueError, match="distances has shape"):
         lbb.vital_vertices(edges, sides, distance[edges][:3])
+
+
+def test_near_crossings_before_the_covering():
+    """A far vertex on three cut edges whose crossings lie within a tenth of the edge
+    from their other ends: the covering alone makes it the one vital vertex (the three
+    near ends its mean), the near crossings make their ends vital first, and a vertex so
+    made vital takes all its cut edges. Order independent."""
+    edges = np.array([[0, 2], [1, 2], [5, 2], [5, 6]])
+    sides = np.tile([1, -1], (4, 1))
+    distance = np.array([0.05, 0.05, 0.95, 0.0, 0.0, 0.05, 0.4])
+    assert lbb.vital_vertices(edges, sides).tolist() == [2, 2, 2, 5]
+    vital = lbb.vital_vertices(edges, sides, distance[edges], near_share=0.25)
+    assert vital.tolist() == [0, 1, 5, 5]
+    flipped = edges[::-1, ::-1]
+    again = lbb.vital_vertices(flipped, sides[::-1, ::-1], distance[flipped], near_share=0.25)
+    assert again.tolist() == [5, 5, 1, 0]
+    with pytest.raises(ValueError, match="near_share must be in"):
+        lbb.vital_vertices(edges, sides, distance[edges], near_share=0.7)

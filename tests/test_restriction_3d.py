@@ -1,6 +1,6 @@
 """The vital-vertex restriction (``lbb="restriction"``) on tetrahedra and hexahedra: each
 cut edge's vital vertex is its end nearer the interface
-(``xfem_contact.mechanics.lbb_space.NEARER_END``).
+(``xfem_contact.mechanics.lbb_space.VITAL_RULE``).
 
 Measured (sphere R = 0.2 about the centre of the unit cube, ``python bench/inf_sup.py
 --solid``): P1-P1 tetrahedra, beta at n = 8, 12, 16, 20: 0.231, 0.222, 0.208, 0.205
@@ -126,7 +126,7 @@ def test_tetrahedra_take_the_nearer_end(monkeypatch):
     R = problem.prolongation()
     nearer = R.getSize()[1]
     R.destroy()
-    monkeypatch.setitem(lbb_space.NEARER_END, "tetrahedron", (False, False))
+    monkeypatch.setitem(lbb_space.VITAL_RULE, "tetrahedron", ("covering", "covering"))
     problem = sphere_problem(6, 1, "sticking", levelset="quadric", lbb="restriction")
     R = problem.prolongation()
     assert R.getSize()[1] < nearer

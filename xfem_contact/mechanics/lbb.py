@@ -7,9 +7,10 @@ built on *cut edges* (mesh edges whose two end vertices lie on opposite sides
 of the interface, sides ``-1``/``+1`` per vertex):
 
 * every cut edge gets exactly one *vital vertex*, one of its two ends
-  (:func:`vital_vertices`): on triangle and quadrilateral edges by a greedy covering
-  (the vertex on most cut edges first), on tetrahedron and hexahedron edges the end
-  nearer the interface;
+  (:func:`vital_vertices`): by a greedy covering (the vertex on most cut edges first),
+  the end nearer the interface, or the covering after the ends of the crossings near
+  them (the rule per cell type:
+  :data:`xfem_contact.mechanics.lbb_space.VITAL_RULE`);
 * every vital vertex carries one independent multiplier unknown; the
   multiplier at the intersection point of a cut edge is that of its vital
   vertex;
@@ -63,10 +64,14 @@ def _check_sides(edges: npt.NDArray[np.int64], sides: npt.ArrayLike) -> None:
 
 
 def vital_vertices(
-    edges: npt.ArrayLike, sides: npt.ArrayLike, distances: npt.ArrayLike | None = None
+    edges: npt.ArrayLike,
+    sides: npt.ArrayLike,
+    distances: npt.ArrayLike | None = None,
+    near_share: float | None = None,
 ) -> npt.NDArray[np.int64]:
-    """The vital vertex of each cut edge: by deterministic greedy covering, or (given
-    ``distances``) the end nearer the interface.
+    """The vital vertex of each cut edge: by deterministic greedy covering, (given
+    ``distances``) the end nearer the interface, or (given both ``distances`` and
+    ``near_share``) the covering after the near crossings' ends.
 
     Greedy covering (``distances`` None): duplicate edges (in either orientation) are
     merged. Each vertex gets a count, the number of its cut edges not yet assigned.
@@ -94,19 +99,30 @@ def vital_vertices(
     nearer end of one of its cut edges is vital; an edge may have both ends vital
     (its farther end being nearer on another edge).
 
+    Near crossings first (``near_share``): an edge whose crossing lies within
+    ``near_share`` of its length from one end (``min(d) / (d_0 + d_1) < near_share``)
+    makes that end vital, and every cut edge of such a vertex is assigned to it (to
+    its nearer end when both ends are such vertices); the greedy covering then assigns
+    the other edges. A vertex that (nearly) lies on the interface is thus never the
+    mean of farther vertices, whose shape functions hardly reach the crossing.
+
     Args:
         edges: ``(m, 2)`` global vertex ids of the two ends of each cut edge.
         sides: ``(m, 2)`` side (``-1`` or ``+1``) of those ends; checked for
             consistency (opposite sides on each edge, one side per vertex).
         distances: ``(m, 2)`` distance (or absolute level set, any unit) of those ends
             to the interface; the same value for a vertex in every row.
+        near_share: with ``distances``, the share of an edge's length (0 .. 1/2) within
+            which its crossing makes its nearer end vital before the covering.
 
     Returns:
         ``(m,)`` int64: the global id of the vital vertex of each input edge.
     """
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     _check_sides(edges, sides)
-    if distances is not None:
+    if near_share is not None and not 0.0 <= near_share <= 0.5:
+        raise ValueError(f"near_share must be in [0, 1/2], got {near_share}")
+    if distances is not None and near_share is None:
         return _nearer_ends(edges, distances)
     canon, inverse = _canonical_edges(edges)
     k = canon.shape[0]
@@ -125,9 +141,11 @@ def vital_vertices(
     offsets = np.zeros(nv + 1, dtype=np.int64)
     np.cumsum(np.bincount(ends, minlength=nv), out=offsets[1:])
 
-    count = np.diff(offsets).astype(np.int64)
     owner = np.full(k, -1, dtype=np.int64)  # local id of the vital vertex
-    remaining = k
+    if near_share is not None:
+        owner = _near_crossings(edges, distances, near_share, verts, local, inverse)
+    count = np.bincount(local[owner < 0].ravel(), minlength=nv).astype(np.int64)
+    remaining = int(np.count_nonzero(owner < 0))
     while remaining > 0:
         v = int(np.argmax(count))
         incident = inc_edges[offsets[v] : offsets[v + 1]]
@@ -138,6 +156,24 @@ def vital_vertices(
         np.subtract.at(count, others, 1)
         count[v] = 0
     return verts[owner][inverse]
+
+
+def _near_crossings(edges, distances, near_share, verts, local, inverse) -> np.ndarray:
+    """``(k,)`` local vital vertex of each unique edge (``local``, ``(k, 2)``, of the
+    sorted vertex ids ``verts``; ``inverse`` the unique edge of each input row) assigned
+    by the near crossings' ends of :func:`vital_vertices`, -1 for the others."""
+    distances = np.asarray(distances, dtype=np.float64).reshape(-1, 2)
+    if distances.shape != edges.shape:
+        raise ValueError(f"distances has shape {distances.shape}, edges {edges.shape}")
+    share = distances.min(axis=1) / distances.sum(axis=1)
+    near = _nearer_ends(edges, distances)
+    forced = np.isin(verts, near[share < near_share])
+    # each unique edge's nearer end (local id), from its first input row
+    first = np.zeros(local.shape[0], dtype=np.int64)
+    first[inverse[::-1]] = np.arange(inverse.size)[::-1]
+    nearer = np.searchsorted(verts, near[first])
+    a, b = forced[local[:, 0]], forced[local[:, 1]]
+    return np.where(a & b, nearer, np.where(a, local[:, 0], np.where(b, local[:, 1], -1)))
 
 
 def _nearer_ends(edges: npt.NDArray[np.int64], distances: npt.ArrayLike) -> npt.NDArray[np.int64]:

@@ -16,22 +16,29 @@ from xfem_contact.fem.prolongation import MultiplierProlongation
 from xfem_contact.geometry.crack import NONE, TIP
 from xfem_contact.mechanics import lbb as lbb_module
 
-#: Per cell type, whether each cut edge's vital vertex is its end nearer the interface
-#: (else the greedy covering of :func:`xfem_contact.mechanics.lbb.vital_vertices`), for an
-#: interface and for a crack's lips. The nodal multiplier's value where the interface
+#: Per cell type, how each cut edge's vital vertex is chosen, for an interface and for a
+#: crack's lips (:func:`xfem_contact.mechanics.lbb.vital_vertices`): ``"nearer"``, the end
+#: nearer the interface; ``"covering"``, the greedy covering; ``"covering, near
+#: crossings"``, the covering after the ends of the crossings within
+#: :data:`NEAR_SHARE` of an edge. The nodal multiplier's value where the interface
 #: crosses a cut edge mixes its two ends, and a non-vital end takes the mean of several
 #: vital vertices: where the covering made the farther end vital, the crossing hardly
 #: sees that vertex's unknown, and the inf-sup constant of P1-P1 triangles fell with h
 #: (docs' stability page). The nearer end's shape function is at least 1/2 at the
-#: crossing. On a crack's lips on triangles the covering keeps the larger constant; on
-#: tetrahedron edges the covering's few vital vertices lose the pressure's accuracy.
-NEARER_END = {
-    "interval": (False, False),
-    "triangle": (True, False),
-    "quadrilateral": (False, False),
-    "tetrahedron": (True, True),
-    "hexahedron": (True, True),
+#: crossing. On a crack's lips on triangles the covering with the near crossings keeps
+#: the larger constant and the stress intensity factors' accuracy that the nearer ends
+#: lose; on tetrahedron edges the covering's few vital vertices lose the pressure's
+#: accuracy.
+VITAL_RULE = {
+    "interval": ("covering", "covering"),
+    "triangle": ("nearer", "covering, near crossings"),
+    "quadrilateral": ("covering", "covering"),
+    "tetrahedron": ("nearer", "nearer"),
+    "hexahedron": ("nearer", "nearer"),
 }
+#: Share of a cut edge's length within which its crossing makes its nearer end vital
+#: before the covering (rule ``"covering, near crossings"``)
+NEAR_SHARE = 0.25
 
 
 def _links(cell_type: dolfinx.mesh.CellType) -> np.ndarray:
@@ -73,9 +80,9 @@ def vital_vertex_prolongation(
     the cut cells (a crack's: those it crosses and its tip cells, so that the tip
     cells' own vertices carry the multiplier too; not the cells cut ahead of its tips,
     where it would act on nothing) are gathered globally, vital vertices chosen
-    identically on every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`: the
-    greedy covering on quadrilaterals and a crack's lips on triangles, else the end
-    nearer the interface, :data:`NEARER_END`), and
+    identically on every process (:func:`xfem_contact.mechanics.lbb.vital_vertices`, by
+    the rule of :data:`VITAL_RULE`; a crack's tip cell's edges crossed ahead of the tip
+    left out), and
     each multiplier dof of a vertex on a cut edge expressed by
     :func:`xfem_contact.mechanics.lbb.prolongation`; a vertex of a cut cell on no cut
     edge takes the mean of the rows of its cut cells' vertices on one.
@@ -93,7 +100,7 @@ def vital_vertex_prolongation(
         interface: The interface whose cut cells carry the field (None: all).
     """
     mesh = cut.mesh
-    nearer = NEARER_END[mesh.topology.cell_type.name][cut.crack is not None]
+    rule = VITAL_RULE[mesh.topology.cell_type.name][cut.crack is not None]
     tdim = mesh.topology.dim
     mesh.topology.create_connectivity(tdim, 1)
     mesh.topology.create_connectivity(1, 0)
@@ -119,12 +126,12 @@ def vital_vertex_prolongation(
     crossing = vertex_side[ends[:, 0]] != vertex_side[ends[:, 1]]
     edges, ends = edges[crossing], ends[crossing]
     if cut.crack is not None:
-        ends = ends[~_sliver_extension_edges(cut, edges, ends, vertex_phi, cell_vertices, c2e)]
+        ends = ends[~_extension_edges(cut, edges, ends, vertex_phi, cell_vertices, c2e)]
     degree = space.multiplier_degrees[field]
     if degree > 1:  # the vertices' nodes, and every other node tied to its vertices
         nodes, node_of_vertex = _lagrange_nodes(mesh, degree, cell_vertices, vertex_side)
         return _prolongation_of_nodes(
-            mesh, space, field, nodes, node_of_vertex[ends], cut_cells, vertex_phi[ends], nearer
+            mesh, space, field, nodes, node_of_vertex[ends], cut_cells, vertex_phi[ends], rule
         )
     gdim = mesh.geometry.dim
 
@@ -134,7 +141,7 @@ def vital_vertex_prolongation(
 
     nodes = _Nodes(cell_vertices, vertex_side, vmap, positions)
     return _prolongation_of_nodes(
-        mesh, space, field, nodes, ends, cut_cells, vertex_phi[ends], nearer
+        mesh, space, field, nodes, ends, cut_cells, vertex_phi[ends], rule
     )
 
 
@@ -163,12 +170,12 @@ def _prolongation_of_nodes(
     ends: np.ndarray,
     cut_cells: np.ndarray,
     phi_ends: np.ndarray,
-    nearer: bool,
+    rule: str,
 ) -> MultiplierProlongation:
     """The prolongation of ``field``'s dofs at ``nodes`` from the vital vertices of the
     cut edges ``ends`` (local node pairs of vertices, ``(m, 2)``; duplicates allowed, the
-    level set at them ``phi_ends``) of ``cut_cells``, each the end nearer the interface
-    if ``nearer`` (:data:`NEARER_END`), else by the greedy covering; a vertex of a cut
+    level set at them ``phi_ends``) of ``cut_cells``, chosen by ``rule``
+    (:data:`VITAL_RULE`); a vertex of a cut
     cell on no cut edge takes the mean of the rows of its cut cells' vertices on one, a
     node off the vertices that of its linked vertices (``nodes.links``). Collective."""
     comm, vmap = mesh.comm, nodes.index_map
@@ -188,10 +195,12 @@ def _prolongation_of_nodes(
     label = np.empty_like(order)
     label[order] = np.arange(order.size)
     by_position = label[np.searchsorted(ids, all_ends)]
-    distances = None
-    if nearer:
+    distances, near_share = None, None
+    if rule != "covering":
         distances = np.concatenate(comm.allgather(np.abs(phi_ends).reshape(-1, 2)))
-    vital = ids[order][lbb_module.vital_vertices(by_position, all_sides, distances)]
+    if rule == "covering, near crossings":
+        near_share = NEAR_SHARE
+    vital = ids[order][lbb_module.vital_vertices(by_position, all_sides, distances, near_share)]
     rows, cols, vals, reduced = lbb_module.prolongation(all_ends, vital)
     # Vertices of cut cells on no cut edge (e.g. the far corner of a quadrilateral
     # cut near one vertex) take the mean of the prolongated rows of the cut-edge
@@ -305,23 +314,15 @@ def combine_prolongations(
     )
 
 
-#: A tip cell whose piece of the crack is shorter than this share of its longest edge
-#: gives the edges that only the crack's extension crosses no vital vertex
-SLIVER_SHARE = 0.25
-
-
-def _sliver_extension_edges(
-    cut: CutMesh, edges, ends, vertex_phi, cell_vertices, c2e
-) -> np.ndarray:
+def _extension_edges(cut: CutMesh, edges, ends, vertex_phi, cell_vertices, c2e) -> np.ndarray:
     """Mask of the cut ``edges`` (local indices, ``(m,)``; their end vertices ``ends``,
-    ``(m, 2)``) to leave out of the vital-vertex choice: those a tip cell's zero line
-    crosses ahead of the tip (``psi > 0`` at the crossing, ``psi`` the crack's tangential
-    level set, a signed distance along the crack, interpolated linearly along the edge)
-    when the tip cell's piece of the crack (``-psi`` at its crossing behind the tip) is
-    shorter than :data:`SLIVER_SHARE` of the cell's longest edge. A vital vertex there
-    would be fixed by a sliver of the crack alone (the tip just past a mesh edge, or the
-    crack clipping a corner of the tip cell); an edge the crack itself crosses keeps its
-    vertex. Not collective."""
+    ``(m, 2)``) to leave out of the vital-vertex choice: the edges of a tip cell that the
+    crack's zero line crosses ahead of the tip (``psi > 0`` at the crossing, ``psi`` the
+    crack's tangential level set, a signed distance along the crack, interpolated
+    linearly along the edge). No lip is there: a vital vertex of such an edge would
+    carry an unknown seen only by the tip cell's piece of the crack, the nearer to the
+    tip the less (the inf-sup constant's weakest mode sat on such vertices). An edge the
+    crack itself crosses keeps its vertex. Not collective."""
     psi = cut.crack.tangent.function
     vertex_psi = np.zeros_like(vertex_phi)
     vertex_psi[cell_vertices] = psi.x.array[
@@ -331,15 +332,8 @@ def _sliver_extension_edges(
     t = p[:, 0] / (p[:, 0] - p[:, 1])
     crossing_psi = s[:, 0] + t * (s[:, 1] - s[:, 0])
     num_edges = int(c2e.array.max(initial=-1)) + 1
-    edge_psi = np.full(num_edges, np.nan)
-    edge_psi[edges] = crossing_psi
     ne_cell = c2e.offsets[1] - c2e.offsets[0]
     tips = cut.cut_cells[cut.crack.kind == TIP]
-    tip_edges = c2e.array.reshape(-1, ne_cell)[tips]
-    tip_psi = edge_psi[tip_edges]  # (tip cells, edges of a cell); NaN: not cut
-    piece = -np.where(tip_psi <= 0.0, tip_psi, 0.0).min(axis=1, initial=0.0)
-    corners = cut.mesh.geometry.x[cut.mesh.geometry.dofmaps[0][tips][:, : cell_vertices.shape[1]]]
-    longest = np.linalg.norm(corners[:, :, None] - corners[:, None], axis=-1).max(axis=(1, 2))
-    drop = np.zeros(num_edges, dtype=bool)
-    drop[tip_edges[piece < SLIVER_SHARE * longest].ravel()] = True
-    return drop[edges] & (crossing_psi > 0.0)
+    in_tip_cell = np.zeros(num_edges, dtype=bool)
+    in_tip_cell[c2e.array.reshape(-1, ne_cell)[tips].ravel()] = True
+    return in_tip_cell[edges] & (crossing_psi > 0.0)
