@@ -8,6 +8,7 @@ import pytest
 from cut3d_reference import sphere_area_in_polytope, tet_planes
 
 from xfem_contact.geometry.exact_margin import SAFETY, exact_margin
+from xfem_contact.geometry.simplex_bernstein import lattice_to_bernstein
 from xfem_contact.quadrature.curved_tet_rules import classify_p2_tets, p2_tet_cut_rules
 
 #: A cell of the Kuhn mesh of n = 32 and the sphere R = 0.3 about a shifted centre (the
@@ -68,6 +69,22 @@ def test_margin_bounds_a_cubic_and_vanishes_for_quadratics():
     quadratic = lambda rows, Y: Y[:, 0] ** 2 - Y[:, 1] * Y[:, 2] + 0.3  # noqa: E731
     phi = quadratic(np.zeros(10, int), p2_nodes())[None]
     assert exact_margin(phi, quadratic)[0] <= 1e-15
+
+
+def test_bernstein_coefficients_of_exact_lattice_values_are_exact():
+    """The lattice-to-Bernstein matrices are exact rationals rounded once: a constant
+    error of 1 (or 7) and the linear error ``x + y`` have Bernstein coefficients at most
+    exactly 1 (7, 1), so the margin is exactly SAFETY times that; P2's matrix has the
+    entries 1, 2 and -1/2 of ``2 phi_mid - (phi_a + phi_b) / 2``."""
+    phi = np.zeros((3, 10))
+    for c in (1.0, 7.0):
+        margin = exact_margin(phi, lambda rows, X, c=c: np.full(len(rows), c))
+        assert (margin == SAFETY * c).all(), margin - SAFETY * c
+    margin = exact_margin(phi, lambda rows, X: X[:, 0] + X[:, 1])
+    assert (margin == SAFETY).all(), margin - SAFETY
+    T = lattice_to_bernstein(2)
+    assert set(np.unique(T)) == {-0.5, 0.0, 1.0, 2.0}
+    assert (T.sum(axis=1) == 1.0).all()
 
 
 @pytest.mark.parametrize("frame", ["tetrahedron", "hexahedra"])

@@ -19,14 +19,13 @@ Bernstein coefficients are all below ``-margin`` (all ``>= margin``) lies on sid
 from __future__ import annotations
 
 import functools
-import itertools
-import math
 
 import basix
 import numpy as np
 import numpy.typing as npt
 
 from xfem_contact.geometry.exact_lines import ExactLevelSet
+from xfem_contact.geometry.simplex_bernstein import lattice_indices, lattice_to_bernstein
 
 __all__ = ["SAFETY", "exact_margin"]
 
@@ -40,24 +39,12 @@ def _lattice() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The cubic lattice of the reference tetrahedron ``(20, 3)``, the P2 basis at it
     ``(20, 10)`` (Basix ``gll_warped`` order) and the matrix ``(20, 20)`` taking values
     at the lattice to the Bernstein coefficients of the cubic that interpolates them."""
-    alphas = [a for a in itertools.product(range(4), repeat=4) if sum(a) == 3]
+    alphas = lattice_indices(3)
     X = np.array([a[1:] for a in alphas], dtype=np.float64) / 3.0
-    lam = np.column_stack([1.0 - X.sum(axis=1), X])  # barycentric coordinates
-    M = np.array(
-        [
-            [
-                math.factorial(3)
-                / math.prod(math.factorial(k) for k in alpha)
-                * np.prod(lam[i] ** np.array(alpha))
-                for alpha in alphas
-            ]
-            for i in range(len(alphas))
-        ]
-    )
     p2 = basix.create_element(
         basix.ElementFamily.P, basix.CellType.tetrahedron, 2, basix.LagrangeVariant.gll_warped
     )
-    return X, p2.tabulate(0, X)[0, :, :, 0], np.linalg.inv(M)
+    return X, p2.tabulate(0, X)[0, :, :, 0], lattice_to_bernstein(3)
 
 
 def exact_margin(phi: npt.ArrayLike, exact: ExactLevelSet) -> npt.NDArray[np.float64]:

@@ -36,6 +36,7 @@ import numpy.typing as npt
 from xfem_contact.geometry.cut_topology import nodal_values
 from xfem_contact.geometry.exact_lines import ExactLevelSet
 from xfem_contact.geometry.exact_margin import exact_margin
+from xfem_contact.geometry.simplex_bernstein import lattice_indices, lattice_to_bernstein
 from xfem_contact.geometry.tensor_levelset import coefficients, derivative, gradient
 from xfem_contact.quadrature.rules import RuleSet
 from xfem_contact.quadrature.saye import (
@@ -179,18 +180,15 @@ def classify_p2_tets(
 
 @functools.cache
 def _to_simplex_bernstein() -> np.ndarray:
-    """Matrix ``(10, 10)``: P2 nodal values -> Bernstein coefficients on the tetrahedron
+    """Matrix ``(10, 10)``: P2 nodal values (Basix ``gll_warped`` order) -> Bernstein
+    coefficients on the tetrahedron, coefficient ``k`` that of node ``k``'s multi-index
     (a vertex's is its value, an edge's ``2 phi_mid - (phi_a + phi_b) / 2``)."""
     p2 = basix.create_element(
         basix.ElementFamily.P, basix.CellType.tetrahedron, 2, basix.LagrangeVariant.gll_warped
     )
-    x = p2.points
-    T = np.eye(10)
-    for node in range(4, 10):
-        ends = [(i, j) for i in range(4) for j in range(i) if np.allclose(2 * x[node], x[i] + x[j])]
-        a, b = ends[0]
-        T[node, node], T[node, a], T[node, b] = 2.0, -0.5, -0.5
-    return T
+    order = {a[1:]: i for i, a in enumerate(lattice_indices(2))}
+    perm = [order[tuple(int(v) for v in np.rint(2 * x))] for x in p2.points]
+    return lattice_to_bernstein(2)[np.ix_(perm, perm)]
 
 
 RAISE_TOLERANCE = 1e-6
