@@ -36,7 +36,7 @@ scale3d_ranks24_band3d``; n = 34: ``--sizes 34 --ranks 1 2 --solvers plain itera
 the coarse level solved to a tolerance under FGMRES ``--sizes 16 24 34 --solvers plain
 iterative --name scale3d_flexible``, ``--sizes 50 --solvers plain iterative --name
 scale3d_3m_flexible`` and the GMRES preset again (``--sizes 24 --solvers iterative
---option ksp_type=gmres --name scale3d_24_gmres``).
+--option ksp_type=gmres --name scale3d_24_gmres``, n = 34: ``--name scale3d_1m_gmres``).
 ``bench/memory3d.py`` shows where the memory goes.
 """
 
