@@ -2,8 +2,8 @@
 
 For each ``--sizes`` n (cells per edge of the unit cube, P2 tetrahedra): the triaxial
 sticking sphere of :func:`xfem_contact.cases.solid.sphere_problem` (quadric level set)
-solved with the ``iterative`` preset (GMRES + band multigrid: GAMG with the six rigid
-modes per side on the coarse level) and, up to ``--direct-max``, the ``direct`` one
+solved with the ``iterative`` preset (FGMRES + band multigrid: GMRES + GAMG with the six
+rigid modes per side on the coarse level) and, up to ``--direct-max``, the ``direct`` one
 (MUMPS LDL^T), and the floor: plain DOLFINx P2 elasticity on the same mesh by CG + GAMG
 with the six rigid modes (``bench/plain_elasticity.py --mesh cube``: the same loads and
 point constraints, no sphere). Each solve is a process of its own, measured from the
@@ -31,8 +31,12 @@ iterative --name scale3d_1_6m``, ``--sizes 50 --solvers plain iterative --name s
 --direct-max 12 --name scale3d_ranks``, ``--sizes 20 --ranks 1 2 --solvers plain iterative
 --repeat 2 --sleep-waits --name scale3d_ranks20_band3d`` (n = 24: ``--sizes 24 ... --name
 scale3d_ranks24_band3d``; n = 34: ``--sizes 34 --ranks 1 2 --solvers plain iterative
---sleep-waits --name scale3d_1m_ranks``) and ``--sizes 16 --ranks 1 2
---solvers plain direct --direct-max 16 --sleep-waits --name scale3d_direct16``.
+--sleep-waits --name scale3d_1m_ranks``), ``--sizes 16 --ranks 1 2
+--solvers plain direct --direct-max 16 --sleep-waits --name scale3d_direct16``, and with
+the coarse level solved to a tolerance under FGMRES ``--sizes 16 24 34 --solvers plain
+iterative --name scale3d_flexible``, ``--sizes 50 --solvers plain iterative --name
+scale3d_3m_flexible`` and the GMRES preset again (``--sizes 24 --solvers iterative
+--option ksp_type=gmres --name scale3d_24_gmres``, n = 34: ``--name scale3d_1m_gmres``).
 ``bench/memory3d.py`` shows where the memory goes.
 """
 

@@ -381,14 +381,20 @@ def test_sphere_spins_under_frictionless_contact_are_a_warning():
         check_support(problem)
 
 
-def test_iterative_preset_in_3d_gives_the_direct_answer(solved_sphere):
-    """The iterative preset (GMRES, band multigrid with GAMG on six rigid modes per
-    side) on the sticking sphere: the direct solver's fields. The Jacobian and the
+@pytest.mark.parametrize(
+    ("given", "krylov", "coarse"),
+    [({}, "fgmres", "gmres"), ({"ksp_type": "gmres"}, "gmres", "richardson")],
+)
+def test_iterative_preset_in_3d_gives_the_direct_answer(solved_sphere, given, krylov, coarse):
+    """The iterative preset (FGMRES, band multigrid with GAMG on six rigid modes per
+    side) on the sticking sphere: the direct solver's fields. FGMRES lets the coarse
+    level be solved to a relative tolerance (GMRES + GAMG); under GMRES, which needs a
+    fixed preconditioner, it is three Richardson iterations of GAMG. The Jacobian and the
     coarse level are stored in 3 x 3 node blocks (GAMG aggregates nodes), the band
     factored LDL^T (the Jacobian is symmetric) and solved by its factors."""
     direct = solved_sphere(2, "sticking")
     iterative = sphere_problem(4, 2, "sticking")
-    iterative.petsc_options = preset("iterative")
+    iterative.petsc_options = preset("iterative") | given
     iterative.solve()
     scale = np.abs(direct.w.x.array).max()
     assert np.abs(iterative.w.x.array - direct.w.x.array).max() < 1e-8 * scale
@@ -398,6 +404,9 @@ def test_iterative_preset_in_3d_gives_the_direct_answer(solved_sphere):
     assert not context._built  # the blocks released after the Krylov solve
     with applied_options(newton._prefix, newton.options):  # as in a Newton step's set-up
         context.setUp(pc)
+    assert newton.snes.getKSP().getType() == krylov
+    solve = context.ksp_u.getPC().getMGCoarseSolve()
+    assert solve.getType() == coarse
     assert newton.J_r.getType().endswith("baij")
     assert newton.J_r.getBlockSize() == context.A_c.getBlockSize() == 3
     assert context.ksp_band is None  # factored LDL^T: solved by its factors, J_bb released

@@ -11,8 +11,11 @@ One application to a residual ``r`` (a petsc4py Python PC, ``pc_type = python``)
    ``A_uu`` read in place from ``J`` (a virtual sub-matrix: no copy), smoothed by
    Chebyshev-Jacobi; the coarse level ``P^T A_uu P + (B P)^T (B P)`` (augmented: it
    holds the floating bodies) by algebraic multigrid (GAMG with the rigid modes), so
-   that memory and time grow linearly with the dofs. For degree 1, GAMG on the
-   augmented block;
+   that memory and time grow linearly with the dofs: three Richardson iterations of its
+   V-cycle (a fixed linear operator), or under a flexible Krylov method
+   (:data:`~xfem_contact.solvers.options.FLEXIBLE_KRYLOV`, the outer ``ksp_type``)
+   GMRES + GAMG to a relative tolerance, whose contraction does not degrade with the
+   mesh size as the V-cycle's does. For degree 1, GAMG on the augmented block;
 2. ``x_b += J_bb^-1 (r - J x)_b``: an exact (LU) solve on the band ``b``, the
    displacements of the cut cells and their facet neighbours (where the ghost penalty
    acts) and every multiplier.
@@ -30,11 +33,11 @@ prolongations is released after each Krylov solve (the next set-up extracts it a
 A Jacobian stored by node blocks (BAIJ) gives its blocks through a transient AIJ copy.
 
 Sub-solver options live under the PC's prefix plus ``bmg_u_`` (the PCMG, or GAMG for
-degree 1) and ``bmg_band_`` (the band's LU); the rows ``band_u``, ``band_u_degree1`` and
-``band`` of :data:`~xfem_contact.solvers.options.PRESETS` are the defaults, which options
-in the database override; a symmetric problem's band is factored LDL^T (the row
-``symmetric_band``), its matrix checked symmetric first, and a 3D problem's is ordered by
-METIS (the row ``band_3d``).
+degree 1) and ``bmg_band_`` (the band's LU); the rows ``band_u`` (or ``band_u_flexible``),
+``band_u_degree1`` and ``band`` of :data:`~xfem_contact.solvers.options.PRESETS` are the
+defaults, which options in the database override; a symmetric problem's band is factored
+LDL^T (the row ``symmetric_band``), its matrix checked symmetric first, and a 3D
+problem's is ordered by METIS (the row ``band_3d``).
 """
 
 from __future__ import annotations
@@ -44,7 +47,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from xfem_contact.solvers.assembly import aij
-from xfem_contact.solvers.options import PRESETS
+from xfem_contact.solvers.options import FLEXIBLE_KRYLOV, PRESETS
 from xfem_contact.solvers.scaling import gather
 from xfem_contact.solvers.symmetry import mark_symmetric
 
@@ -220,7 +223,7 @@ class BandMultigrid:
             self._objects += [self.A, space]
             BtB.destroy()
         else:  # degree 2: J's block itself (no copy) smoothed, the coarse level augmented
-            self.u_preset = PRESETS["band_u"]
+            self.u_preset = PRESETS["band_u_flexible" if _flexible(prefix) else "band_u"]
             if self._prolongations is None:  # the pattern of J does not change them
                 self._prolongations = _prolongation(J, self.u, *self._interpolation)
                 self._interpolation = None
@@ -344,6 +347,13 @@ def _orthonormal(vectors: list[PETSc.Vec]) -> list[PETSc.Vec]:
         else:
             v.destroy()
     return kept
+
+
+def _flexible(prefix: str) -> bool:
+    """Whether the Krylov method of the PC's options ``prefix`` (its ``ksp_type`` in the
+    options database, which the package's solvers fill during each solve) is one of
+    :data:`~xfem_contact.solvers.options.FLEXIBLE_KRYLOV`. Not collective."""
+    return PETSc.Options().getString(prefix + "ksp_type", "") in FLEXIBLE_KRYLOV
 
 
 class _defaults:

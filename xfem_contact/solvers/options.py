@@ -126,6 +126,21 @@ def uses_band_multigrid(options: dict) -> bool:
     )
 
 
+#: The Krylov methods that take a preconditioner varying between applications
+FLEXIBLE_KRYLOV = ("fgmres", "gcr")
+
+#: The band multigrid's displacement solve (degree 2) but its coarse level's Krylov
+#: method: a two-level PCMG, the fine level by Chebyshev-Jacobi, the coarse by GAMG
+_BAND_U: dict[str, OptionValue] = {
+    "ksp_type": "preonly",
+    "mg_levels_ksp_type": "chebyshev",
+    "mg_levels_pc_type": "jacobi",
+    "mg_levels_ksp_max_it": 2,
+    "mg_levels_esteig_ksp_type": "cg",  # GMRES's basis would stay allocated
+    "mg_coarse_pc_type": "gamg",
+}
+
+
 class Facts(typing.NamedTuple):
     """What a problem knows of itself when its options are chosen (:func:`problem_options`).
 
@@ -179,7 +194,6 @@ PRESETS: dict[str, Preset] = {
     ),
     "iterative": Preset(
         {
-            "ksp_type": "gmres",
             "ksp_gmres_restart": 10,  # a short basis: its W-sized vectors are memory
             "ksp_rtol": 1e-12,
             "ksp_atol": 1e-30,
@@ -188,7 +202,8 @@ PRESETS: dict[str, Preset] = {
             "pc_python_type": "xfem_contact.solvers.band_multigrid.BandMultigrid",
         },
         "the linear-solver choice 'iterative' (contact problems)",
-        "GMRES(10) preconditioned by the band multigrid "
+        "GMRES(10) on 2D meshes, FGMRES(10) on 3D ones (the rows 'band_2d' and "
+        "'band_3d'), preconditioned by the band multigrid "
         "(xfem_contact.solvers.band_multigrid): an exact solve on the band of the "
         "interface (cut cells, their neighbours, the multipliers) after a two-level "
         "p-multigrid V-cycle on the displacements",
@@ -208,13 +223,27 @@ PRESETS: dict[str, Preset] = {
         "(xfem_contact.solvers.symmetry checks the band's matrix first)",
         lambda facts: facts.symmetric and uses_band_multigrid(facts.options),
     ),
+    "band_2d": Preset(
+        {"ksp_type": "gmres"},
+        "the band multigrid on a 2D mesh",
+        "GMRES: the preconditioner is a fixed linear operator (its coarse level three "
+        "Richardson iterations of GAMG, the row 'band_u')",
+        lambda facts: facts.tdim == 2 and uses_band_multigrid(facts.options),
+    ),
     "band_3d": Preset(
-        {"bmg_band_mat_mumps_icntl_7": 5, "bmg_band_mat_mumps_icntl_13": 1},
+        {
+            "ksp_type": "fgmres",
+            "bmg_band_mat_mumps_icntl_7": 5,
+            "bmg_band_mat_mumps_icntl_13": 1,
+        },
         "the band multigrid on a 3D mesh",
-        "the band's MUMPS factorisation ordered by METIS (fewer factor entries and flops "
-        "than PORD on the shell of cells around a surface) and its root front factored "
-        "without ScaLAPACK (on 2 ranks the triangular solves then share the work instead "
-        "of each doing more than one rank alone)",
+        "FGMRES, which lets the band multigrid solve its coarse level to a relative "
+        "tolerance (the row 'band_u_flexible': a contraction that does not degrade with "
+        "h, as three Richardson iterations of GAMG do); the band's MUMPS factorisation "
+        "ordered by METIS (fewer factor entries and flops than PORD on the shell of cells "
+        "around a surface) and its root front factored without ScaLAPACK (on 2 ranks the "
+        "triangular solves then share the work instead of each doing more than one rank "
+        "alone)",
         lambda facts: facts.tdim == 3 and uses_band_multigrid(facts.options),
     ),
     "crack": Preset(
@@ -251,18 +280,25 @@ PRESETS: dict[str, Preset] = {
         "MUMPS LU of the two bodies' block system",
     ),
     "band_u": Preset(
-        {
-            "ksp_type": "preonly",
-            "mg_levels_ksp_type": "chebyshev",
-            "mg_levels_pc_type": "jacobi",
-            "mg_levels_ksp_max_it": 2,
-            "mg_levels_esteig_ksp_type": "cg",  # GMRES's basis would stay allocated
-            "mg_coarse_ksp_type": "richardson",
-            "mg_coarse_ksp_max_it": 3,
-            "mg_coarse_pc_type": "gamg",
+        _BAND_U | {"mg_coarse_ksp_type": "richardson", "mg_coarse_ksp_max_it": 3},
+        "the band multigrid's displacement solve, degree 2, under a Krylov method that "
+        "needs a fixed preconditioner (not in FLEXIBLE_KRYLOV)",
+        "PCMG with 2 levels (interpolation set by the preconditioner), the coarse level "
+        "by three Richardson iterations of GAMG (a fixed linear operator)",
+        prefix="bmg_u_",
+    ),
+    "band_u_flexible": Preset(
+        _BAND_U
+        | {
+            "mg_coarse_ksp_type": "gmres",  # the coarse level of a Coulomb law: unsymmetric
+            "mg_coarse_ksp_gmres_restart": 10,
+            "mg_coarse_ksp_rtol": 1e-2,
+            "mg_coarse_ksp_max_it": 30,
         },
-        "the band multigrid's displacement solve, degree 2",
-        "PCMG with 2 levels (interpolation set by the preconditioner)",
+        "the band multigrid's displacement solve, degree 2, under a flexible Krylov "
+        "method (FLEXIBLE_KRYLOV)",
+        "PCMG with 2 levels, the coarse level by GMRES + GAMG to a relative tolerance "
+        "of 1e-2 (the preconditioner then varies between applications)",
         prefix="bmg_u_",
     ),
     "band_u_degree1": Preset(
