@@ -19,12 +19,13 @@ about its median says nothing a user would act on.
 
 Run: ``python bench/robustness3d.py [--count 100] [--n 4] [--degree 2] [--cell
 tetrahedron|hexahedron] [--laws sticking ...] [--seed 0] [--aggregation 0.15]
-[--stabilization-length cut] [--inf-sup] [--write]
+[--stabilization-length cell|cut|patch] [--inf-sup] [--write]
 [--name NAME]``;
 prints one row per run, the iteration histogram and the failures per law; ``--write``
 writes ``bench/results/robustness3d.{json,md}`` (``robustness3d_hexahedron.*`` on
 hexahedra, ``NAME.*`` with ``--name``),
-``--render`` rewrites the ``.md`` from the ``.json``, ``--resume`` goes on from it;
+``--render`` rewrites the ``.md`` from the ``.json``, ``--resume`` goes on from it
+(with ``--placements``: reruns those, in place of their rows);
 ``--placements I J ...`` runs only those (the medians are then theirs); ``--inf-sup``
 prints, per placement, the inf-sup constant of the ``bonded`` pair on the same cut
 (:func:`~xfem_contact.mechanics.inf_sup.inf_sup_constant`) and the negative eigenvalues
@@ -46,6 +47,7 @@ from mpi4py import MPI
 
 from xfem_contact.cases.solid import TRIAXIAL, traction_errors, uniform_stress_problem
 from xfem_contact.mechanics.inf_sup import inf_sup_constant
+from xfem_contact.mechanics.laws.multiplier import STABILIZATION_LENGTHS
 
 RESULTS = pathlib.Path(__file__).parent / "results"
 #: Per run label: the law, its options and the uniform stress (Pa, principal values)
@@ -110,7 +112,8 @@ def run(
 ) -> dict:
     """One solve: its Newton iterations, convergence, pressure error, NaN and the
     warnings or the error it raised; ``aggregation``: the problem's cell aggregation
-    threshold (None: off); ``stabilization_length``: the laws' (``"cell"`` or ``"cut"``)."""
+    threshold (None: off); ``stabilization_length``: the laws' (one of
+    :data:`~xfem_contact.mechanics.laws.multiplier.STABILIZATION_LENGTHS`)."""
     name, options, stress = LAWS[law]
     options = options | {"aggregation": aggregation, "stabilization_length": stabilization_length}
     levelset, normals = quadric(placement)
@@ -276,7 +279,7 @@ def main() -> None:
     )
     parser.add_argument(
         "--stabilization-length",
-        choices=["cell", "cut"],
+        choices=list(STABILIZATION_LENGTHS),
         default="cell",
         help="length of the Barbosa-Hughes scale (the laws' stabilization_length)",
     )
@@ -288,7 +291,9 @@ def main() -> None:
         "--render", action="store_true", help="rewrite the .md from the .json run before"
     )
     parser.add_argument(
-        "--resume", action="store_true", help="go on from the .json of a stopped sweep"
+        "--resume",
+        action="store_true",
+        help="go on from the .json of a stopped sweep (with --placements: rerun those)",
     )
     args = parser.parse_args()
     args.command = "python bench/robustness3d.py " + " ".join(sys.argv[1:])
@@ -304,8 +309,17 @@ def main() -> None:
     if args.resume:  # the placements of a stopped sweep's results, with its seed and n
         record = json.loads((RESULTS / f"{results_name(args)}.json").read_text())
         rows, done = record["runs"], record["count"]
+    # --resume with --placements: rerun those of the sweep's placements, in place of
+    # their rows (the record stays that of the whole sweep)
+    redo = set(args.placements or []) if args.resume else set()
+    if redo:
+        rows = [r for r in rows if r["index"] not in redo]
+        args.placements = None
     for index, placement in enumerate(placements(args.count, args.seed)):
-        if index < done or (args.placements and index not in args.placements):
+        if redo:
+            if index not in redo:
+                continue
+        elif index < done or (args.placements and index not in args.placements):
             continue
         for law in args.laws:
             row = run(
@@ -339,9 +353,14 @@ def main() -> None:
                 ),
                 flush=True,
             )
+        rows.sort(key=lambda r: r["index"])  # a rerun placement in its place
         if args.write:  # after each placement: a stopped sweep keeps what it ran
-            write(rows, args, index + 1)
-    table = write(rows, args, args.count) if args.write else report(rows)
+            write(rows, args, max(done, index + 1))
+    table = (
+        write(rows, args, max(done, 1 + max(redo)) if redo else args.count)
+        if args.write
+        else report(rows)
+    )
     for law, t in table.items():
         print(
             f"{law}: {t['runs']} runs, {t['failures']} failures ({t['silent failures']} "

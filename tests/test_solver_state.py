@@ -16,6 +16,7 @@ from petsc4py import PETSc
 from xfem_contact import LinearSolveFailure, Material, NewtonFailure, SolveError
 from xfem_contact.cases.paper import inclusion_problem
 from xfem_contact.mechanics.plain import PlainElasticityProblem
+from xfem_contact.solvers.callback_errors import PETSC_ERR_PYTHON, callback_exception
 
 #: A Krylov solve that cannot converge: one unpreconditioned CG iteration
 ONE_CG_STEP = {"ksp_type": "cg", "pc_type": "none", "ksp_max_it": 1, "ksp_rtol": 1e-12}
@@ -73,6 +74,47 @@ def test_failure_keeps_the_state_before_the_solve():
     assert problem.last_report is failure.value.report
     assert isinstance(failure.value, SolveError)
     assert our_options() == []
+
+
+def test_a_callback_exception_is_raised_as_itself(monkeypatch):
+    """An exception raised in a Newton callback comes out of the solve as itself, not as
+    PETSc's "error code 101" (``PETSC_ERR_PYTHON``, which petsc4py chains the exception
+    to): Ctrl-C during a factorisation is delivered in the next callback, and an ``except
+    Exception`` around the solve must not take that interrupt for a failed solve. The
+    state before the solve is kept, and the same solver solves again (SNES had left its
+    solution vector read-locked)."""
+    problem = inclusion_problem(8, 1, "sticking")
+    original, fault = type(problem).interface_status, [KeyboardInterrupt()]
+
+    def status(self, w, name=None):  # the Newton monitor's callback, at every iterate
+        counts = original(self, w, name)
+        if fault and self.newton.snes.getIterationNumber() > 0:  # after a Newton step
+            raise fault[0]
+        return counts
+
+    monkeypatch.setattr(type(problem), "interface_status", status)
+    before = problem.w.x.array.copy()
+    with pytest.raises(KeyboardInterrupt):
+        problem.solve()
+    assert np.array_equal(problem.w.x.array, before)
+    fault[0] = RuntimeError("the status callback broke")
+    with pytest.raises(RuntimeError, match="the status callback broke"):
+        problem.solve()
+    fault.clear()
+    assert problem.solve().converged  # and the same solver solves again
+    assert our_options() == []
+
+
+def test_callback_exception_through_nested_solves():
+    """A Python preconditioner's own solve nests PETSc's error: the innermost cause is
+    the callback's exception; PETSc's own errors report none."""
+    inner = PETSc.Error(PETSC_ERR_PYTHON)
+    inner.__cause__ = KeyError("deep")
+    outer = PETSc.Error(PETSC_ERR_PYTHON)
+    outer.__cause__ = inner
+    assert callback_exception(outer) is inner.__cause__
+    assert callback_exception(PETSc.Error(76)) is None
+    assert callback_exception(PETSc.Error(PETSC_ERR_PYTHON)) is None
 
 
 def plain_problem() -> PlainElasticityProblem:

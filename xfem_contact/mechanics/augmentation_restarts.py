@@ -45,7 +45,8 @@ def solve_restarting(newton: ReducedNewton, laws: Mapping[str, InterfaceLaw]) ->
 
     Raises:
         NewtonFailure: A failure other than a stall, or the last stall; the laws then keep
-            the augmentation they started with.
+            the augmentation they started with (as they do when any other exception, an
+            interrupt too, ends a solve).
     """
     adaptable = {name: law for name, law in laws.items() if "augmentation" in law.options()}
     given = {name: law.augmentation for name, law in adaptable.items()}
@@ -59,13 +60,15 @@ def solve_restarting(newton: ReducedNewton, laws: Mapping[str, InterfaceLaw]) ->
         except NewtonFailure as failure:
             last = factor == AUGMENTATION_FACTORS[-1]
             if failure.report.reason != STALLED or not adaptable or last:
-                for name, law in adaptable.items():
-                    law.augmentation = given[name]
+                _set_augmentation(adaptable, given)
                 failure.report.earlier = earlier
                 raise
             earlier.append(failure.report)
             newton.w.x.array[:] = start
             continue
+        except BaseException:  # e.g. an interrupt: the laws keep the augmentation given
+            _set_augmentation(adaptable, given)
+            raise
         report.earlier = earlier
         if earlier:
             values = ", ".join(f"{name!r} {law.augmentation:g}" for name, law in adaptable.items())
@@ -79,3 +82,8 @@ def solve_restarting(newton: ReducedNewton, laws: Mapping[str, InterfaceLaw]) ->
             )
         return report
     raise AssertionError("unreachable: the last factor returns or raises")
+
+
+def _set_augmentation(laws: Mapping[str, InterfaceLaw], values: Mapping[str, float]) -> None:
+    for name, law in laws.items():
+        law.augmentation = values[name]

@@ -382,7 +382,9 @@ class Problem:
 
         Raises:
             NewtonFailure: with the iteration history, if SNES does not converge;
-                ``self.w`` then holds the state from before this solve.
+                ``self.w`` then holds the state from before this solve (as it does when
+                a solve is interrupted, or a callback raises: that exception comes out
+                as itself).
             ValueError: the cut was updated after the problem was built.
         """
         if log is not None:
@@ -454,6 +456,9 @@ class Problem:
                 f"{str(failure).splitlines()[0]}; w restored to the state before this solve",
                 failure.report,
             ) from None
+        except BaseException:  # e.g. an interrupt, or a callback's error: w as it was
+            self.w.x.array[:] = accepted
+            raise
 
     @property
     def solver_timings(self) -> dict[str, float]:

@@ -22,6 +22,7 @@ from xfem_contact.fem.enrichment import EnrichedSpace
 from xfem_contact.fem.prolongation import prescribed_offset, prolongation_matrix
 from xfem_contact.solvers.assembly import ReducedMatrix
 from xfem_contact.solvers.block_scaling import refined, scaled, tip_transform
+from xfem_contact.solvers.callback_errors import raised_as_themselves
 from xfem_contact.solvers.options import applied_options, checked_prefix, merged_options
 from xfem_contact.solvers.report import LinearSolveFailure, SolveReport
 from xfem_contact.solvers.scaling import saddle_point_scaling
@@ -163,7 +164,9 @@ def solve_reduced(
             ksp.setFromOptions()
         y = R.createVecRight()
         owned.append(y)
-        with applied_options(prefix, options):  # the factorisation reads options too
+        # the factorisation reads options too; a Python preconditioner's own exception
+        # is raised as itself
+        with applied_options(prefix, options), raised_as_themselves():
             ksp.solve(b, y)
         norms = [b.norm()]
         r = b.duplicate()

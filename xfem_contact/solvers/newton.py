@@ -28,6 +28,7 @@ from xfem_contact.fem.forms import form_parts
 from xfem_contact.fem.prolongation import prescribed_offset
 from xfem_contact.solvers.assembly import ReducedMatrix, selection
 from xfem_contact.solvers.block_scaling import TipFactor
+from xfem_contact.solvers.callback_errors import raised_as_themselves
 from xfem_contact.solvers.fieldsplit_sets import fieldsplit_sets
 from xfem_contact.solvers.jacobian import JacobianForms
 from xfem_contact.solvers.options import (
@@ -379,6 +380,9 @@ class ReducedNewton:
         Raises:
             NewtonFailure: SNES did not converge (reason <= 0), or stalled (reason
                 :data:`STALLED`, see :func:`stalled`); it holds the history.
+            BaseException: what a callback (residual, Jacobian, ``status``) raised, as
+                itself (:mod:`~xfem_contact.solvers.callback_errors`): a
+                ``KeyboardInterrupt`` stays one.
         """
         self.report = NewtonReport()
         timer = phase("Newton solve")
@@ -386,13 +390,18 @@ class ReducedNewton:
         self.jacobian.keep_constant_blocks()  # the uncut cells' linear bulk: once a solve
         for coupling in self.couplings:
             coupling.begin_step(self.w)
-        with applied_options(self._prefix, self.options):
-            try:
+        try:
+            # a callback's own exception (e.g. the ValueError of an unsymmetric Jacobian
+            # for LDL^T, a KeyboardInterrupt) as itself, not as PETSc's "error code 101"
+            with applied_options(self._prefix, self.options), raised_as_themselves():
                 self.snes.solve(None, self.y)
-            except PETSc.Error as error:  # a callback's own error (e.g. an unsymmetric
-                if isinstance(error.__cause__, ValueError):  # Jacobian for LDL^T) is clearer
-                    raise error.__cause__ from None
-                raise
+        except BaseException:
+            # SNES leaves its solution vector read-locked when a callback raises (the
+            # monitor's at the first iterate): a later solve would fail on it (PETSc's
+            # error 73), so the next solve gets a new one
+            locked, self.y = self.y, self.y.duplicate()
+            locked.destroy()
+            raise
         self.report.total_time = seconds(timer)
         self._update(self.y)
         self.report.reason = self.snes.getConvergedReason()
